@@ -1,0 +1,1 @@
+//! kneeform engine.

@@ -1,0 +1,2 @@
+//! kneeform CLI.
+fn main() {}
