@@ -1,1 +1,30 @@
-//! kneeform engine.
+//! kneeform: the UN Regulation No. 21 knee-form push-and-slide inspection of
+//! interior parts, on a sampled height grid (Inui, Gunji and Umezu).
+//!
+//! The pipeline, each step named as in SPEC.md and the paper:
+//!
+//! * [`mesh`]: STL in, triangles in the analysis frame (mm, knee pushed in
+//!   +y, sliding in -x);
+//! * [`grid`]: step 1, the height grid (an orthographic depth buffer);
+//! * [`kneeform`]: the knee-form, its footprint per angle and row intervals;
+//! * [`push`] and [`slide`]: step 2, the fast path; [`paper`]: the
+//!   paper-literal reference;
+//! * [`engine`]: every angle and start, the colliding masks and composite.
+//!
+//! All lengths are mm and all angles degrees.
+
+pub mod engine;
+pub mod grid;
+pub mod kneeform;
+pub mod mesh;
+pub mod output;
+pub mod padded;
+pub mod paper;
+pub mod push;
+pub mod scenario;
+pub mod slide;
+
+pub use engine::{Algorithm, AngleMask, EngineOptions, colliding_masks, composite};
+pub use grid::{GridSpec, HeightGrid};
+pub use kneeform::{Footprint, GridFootprint, KneeForm};
+pub use mesh::{Part, Side};

@@ -1,0 +1,270 @@
+//! The part: an STL file read into triangles in the analysis frame.
+//!
+//! Reading goes through `stl_io` (binary and ASCII, CRLF included). The part is
+//! scaled to mm and, for the right-hand side, mirrored y -> -y so that every
+//! later step works in SPEC's canonical frame (knee pushed in +y, sliding in
+//! -x). Results are mirrored back with [`Side::to_part`].
+
+use std::path::Path;
+
+/// One triangle, three vertices (x, y, z) in mm.
+pub type Triangle = [[f64; 3]; 3];
+
+/// Which side of the vehicle the analysed surface is on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum Side {
+    /// The analysed surface faces -y (SPEC's canonical frame).
+    Left,
+    /// The analysed surface faces +y: mirrored y -> -y on input and back on
+    /// output.
+    Right,
+}
+
+impl Side {
+    /// Maps a y coordinate between the part's frame and the analysis frame
+    /// (the mapping is its own inverse).
+    pub fn to_part(self, y: f64) -> f64 {
+        match self {
+            Side::Left => y,
+            Side::Right => -y,
+        }
+    }
+}
+
+/// Why a part could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    /// The file could not be opened or read.
+    #[error("cannot read {path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The file is not STL, or is truncated.
+    #[error("{path} is not a readable STL file: {reason}")]
+    Format {
+        /// The file.
+        path: String,
+        /// What the STL reader said.
+        reason: String,
+    },
+    /// The file holds no triangles.
+    #[error("{path} holds no triangles")]
+    Empty {
+        /// The file.
+        path: String,
+    },
+    /// A vertex is NaN or infinite.
+    #[error("{path}: triangle {index} has a non-finite coordinate")]
+    NonFinite {
+        /// The file.
+        path: String,
+        /// The triangle's index in the file.
+        index: usize,
+    },
+    /// Every triangle is degenerate.
+    #[error("{path}: all {count} triangles are degenerate (zero area)")]
+    AllDegenerate {
+        /// The file.
+        path: String,
+        /// How many triangles it has.
+        count: usize,
+    },
+}
+
+/// A part in the analysis frame.
+#[derive(Debug, Clone)]
+pub struct Part {
+    /// Non-degenerate triangles, in mm, analysis frame.
+    pub triangles: Vec<Triangle>,
+    /// Triangles in the file.
+    pub file_triangles: usize,
+    /// Triangles skipped because their area is zero.
+    pub degenerate: usize,
+}
+
+/// An axis-aligned box (mm).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Bbox {
+    /// Smallest x, y, z.
+    pub min: [f64; 3],
+    /// Largest x, y, z.
+    pub max: [f64; 3],
+}
+
+impl Part {
+    /// Reads an STL file, scales it by `scale` (to mm) and maps `side` into
+    /// the analysis frame.
+    pub fn read(path: &Path, scale: f64, side: Side) -> Result<Part, MeshError> {
+        let name = path.display().to_string();
+        let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
+            path: name.clone(),
+            source,
+        })?;
+        let triangles = parse_stl(&bytes).map_err(|reason| MeshError::Format {
+            path: name.clone(),
+            reason,
+        })?;
+        Part::from_triangles(&name, triangles, scale, side)
+    }
+
+    /// Builds a part from triangles in the part's own frame and units.
+    pub fn from_triangles(
+        name: &str,
+        triangles: Vec<Triangle>,
+        scale: f64,
+        side: Side,
+    ) -> Result<Part, MeshError> {
+        if triangles.is_empty() {
+            return Err(MeshError::Empty { path: name.into() });
+        }
+        if let Some(index) = triangles.iter().position(|t| t.iter().flatten().any(|c| !c.is_finite())) {
+            return Err(MeshError::NonFinite {
+                path: name.into(),
+                index,
+            });
+        }
+        let file_triangles = triangles.len();
+        let kept: Vec<Triangle> = triangles
+            .into_iter()
+            .map(|t| t.map(|[x, y, z]| [x * scale, side.to_part(y * scale), z * scale]))
+            .filter(|t| !is_degenerate(t))
+            .collect();
+        if kept.is_empty() {
+            return Err(MeshError::AllDegenerate {
+                path: name.into(),
+                count: file_triangles,
+            });
+        }
+        Ok(Part {
+            degenerate: file_triangles - kept.len(),
+            triangles: kept,
+            file_triangles,
+        })
+    }
+
+    /// The bounding box of the part (analysis frame, mm).
+    pub fn bbox(&self) -> Bbox {
+        let mut b = Bbox {
+            min: [f64::INFINITY; 3],
+            max: [f64::NEG_INFINITY; 3],
+        };
+        for v in self.triangles.iter().flatten() {
+            for k in 0..3 {
+                b.min[k] = b.min[k].min(v[k]);
+                b.max[k] = b.max[k].max(v[k]);
+            }
+        }
+        b
+    }
+}
+
+/// A triangle is degenerate when its area is zero: its edge vectors'
+/// cross product vanishes exactly (repeated or collinear vertices).
+fn is_degenerate(t: &Triangle) -> bool {
+    let e1 = [t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]];
+    let e2 = [t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]];
+    let c = [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ];
+    c == [0.0; 3]
+}
+
+/// Parses binary or ASCII STL. Binary files may start with `solid` too, so
+/// a file is taken as binary when its size matches the triangle count in
+/// its header, and as ASCII otherwise.
+fn parse_stl(bytes: &[u8]) -> Result<Vec<Triangle>, String> {
+    let looks_binary = bytes.len() >= 84 && {
+        let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
+        84 + 50 * n == bytes.len() as u64
+    };
+    let text = bytes.trim_ascii_start();
+    let looks_ascii = text.starts_with(b"solid");
+    let normalised: Vec<u8> = if looks_binary {
+        // stl_io takes any file whose first line starts with "solid " as
+        // ASCII; the binary header is free text, so blank it.
+        let mut copy = bytes.to_vec();
+        copy[..80].fill(0);
+        copy
+    } else if looks_ascii {
+        // stl_io wants "solid " with a space; exporters also write a bare
+        // "solid" line.
+        let mut copy = b"solid ".to_vec();
+        copy.extend_from_slice(&text[5..]);
+        copy
+    } else if bytes.len() < 84 {
+        return Err(format!("{} bytes, too short for a binary STL header", bytes.len()));
+    } else {
+        return Err("binary triangle count does not match the file size (truncated?)".into());
+    };
+    let mut cursor = std::io::Cursor::new(normalised);
+    let stl = stl_io::create_stl_reader(&mut cursor)
+        .and_then(|reader| reader.collect::<Result<Vec<_>, _>>())
+        .map_err(|e| e.to_string())?;
+    Ok(stl
+        .into_iter()
+        .map(|t| t.vertices.map(|v| [f64::from(v[0]), f64::from(v[1]), f64::from(v[2])]))
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn binary_stl(tris: &[[[f32; 3]; 3]], header: &[u8]) -> Vec<u8> {
+        let mut out = vec![0u8; 80];
+        out[..header.len()].copy_from_slice(header);
+        out.extend((tris.len() as u32).to_le_bytes());
+        for t in tris {
+            out.extend([0u8; 12]);
+            for v in t {
+                for c in v {
+                    out.extend(c.to_le_bytes());
+                }
+            }
+            out.extend([0u8; 2]);
+        }
+        out
+    }
+
+    const TRI: [[f32; 3]; 3] = [[0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 1.0]];
+
+    #[test]
+    fn binary_with_solid_header_reads_as_binary() {
+        let bytes = binary_stl(&[TRI, TRI], b"solid but binary");
+        assert_eq!(parse_stl(&bytes).unwrap().len(), 2);
+    }
+
+    #[test]
+    fn ascii_with_crlf_reads() {
+        let text = "solid x\r\nfacet normal 0 0 0\r\nouter loop\r\nvertex 0 1 0\r\nvertex 1 1 0\r\nvertex 0 1 1\r\nendloop\r\nendfacet\r\nendsolid x\r\n";
+        assert_eq!(parse_stl(text.as_bytes()).unwrap().len(), 1);
+    }
+
+    #[test]
+    fn truncated_binary_is_refused() {
+        let mut bytes = binary_stl(&[TRI, TRI], b"part");
+        bytes.truncate(bytes.len() - 10);
+        assert!(parse_stl(&bytes).is_err());
+    }
+
+    #[test]
+    fn scale_side_and_degenerates() {
+        let t = TRI.map(|v| v.map(f64::from));
+        let flat = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
+        let part = Part::from_triangles("t", vec![t, flat], 10.0, Side::Right).unwrap();
+        assert_eq!(part.degenerate, 1);
+        assert_eq!(part.triangles[0][0], [0.0, -10.0, 0.0]);
+        let err = Part::from_triangles("t", vec![[[f64::NAN; 3]; 3]], 1.0, Side::Left).unwrap_err();
+        assert!(matches!(err, MeshError::NonFinite { index: 0, .. }));
+        assert!(matches!(
+            Part::from_triangles("t", vec![], 1.0, Side::Left),
+            Err(MeshError::Empty { .. })
+        ));
+    }
+}

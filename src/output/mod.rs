@@ -1,0 +1,1 @@
+//! Result files: CSV, STL and PNG (being written).

@@ -1,0 +1,76 @@
+//! The height grid with `+inf` margins left and right of every row, wide
+//! enough that push and slide can index any footprint offset of any start
+//! (and of the virtual starts past the grid's -x edge) without a bounds
+//! branch in their inner loops. Nodes outside the grid do not exist; `+inf`
+//! is exactly how SPEC's rules treat them (never inside a push minimum,
+//! never colliding, never lowering the face level).
+
+use crate::grid::{GridSpec, HeightGrid};
+use crate::kneeform::GridFootprint;
+
+/// A height grid with padded rows.
+#[derive(Debug)]
+pub struct PaddedGrid {
+    /// The grid's nodes.
+    pub spec: GridSpec,
+    /// Padding columns before column 0.
+    pub pad_lo: usize,
+    /// Length of a padded row.
+    pub stride: usize,
+    /// Heights, `h[j * stride + pad_lo + i]`.
+    pub h: Vec<f64>,
+}
+
+/// The range of start columns, real and virtual, whose first layer (the
+/// first node in front in each footprint row) can fall inside the grid:
+/// from the last virtual start past the -x edge up to the last real start.
+pub fn start_lanes(fp: &GridFootprint, nx: usize) -> std::ops::Range<i64> {
+    let kf_max = fp.rows.iter().map(|r| r.kf).max().unwrap_or(0);
+    (-i64::from(kf_max)).min(0)..nx as i64
+}
+
+impl PaddedGrid {
+    /// Pads `grid` for all of `footprints`.
+    pub fn new(grid: &HeightGrid, footprints: &[GridFootprint]) -> PaddedGrid {
+        let nx = grid.spec.nx;
+        let (mut lo, mut hi) = (0i64, 0i64);
+        for fp in footprints {
+            let (k_lo, k_hi) = fp.k_range();
+            let lanes = start_lanes(fp, nx);
+            lo = lo.min(lanes.start + i64::from(k_lo)).min(i64::from(k_lo));
+            hi = hi.max(i64::from(k_hi));
+        }
+        let pad_lo = (-lo) as usize;
+        let stride = pad_lo + nx + hi as usize + 1;
+        let mut h = vec![f64::INFINITY; stride * grid.spec.nz];
+        for (dst, src) in h.chunks_exact_mut(stride).zip(grid.h.chunks_exact(nx)) {
+            dst[pad_lo..pad_lo + nx].copy_from_slice(src);
+        }
+        PaddedGrid {
+            spec: grid.spec,
+            pad_lo,
+            stride,
+            h,
+        }
+    }
+
+    /// The grid row `j0 + dj`, if it exists.
+    pub fn row_of(&self, j0: usize, dj: i32) -> Option<usize> {
+        let j = j0 as i64 + i64::from(dj);
+        (0..self.spec.nz as i64).contains(&j).then_some(j as usize)
+    }
+
+    /// Index of column offset `k` of row `j` for the start at column 0; add
+    /// the start's column to reach the node.
+    pub fn index(&self, j: usize, k: i32) -> usize {
+        (j * self.stride + self.pad_lo) .wrapping_add_signed(k as isize)
+    }
+}
+
+/// The smaller of two heights; written as a comparison so that loops over
+/// it compile to packed `min` instructions (`f64::min` handles NaN, which
+/// heights never are, and does not vectorise as well).
+#[inline(always)]
+pub fn fmin(a: f64, b: f64) -> f64 {
+    if b < a { b } else { a }
+}

@@ -1,0 +1,1 @@
+//! Synthetic height-field parts (being written).
