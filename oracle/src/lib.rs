@@ -1,1 +1,44 @@
-//! Exact oracle (placeholder).
+//! `kneeform-oracle`: the exact push-and-slide of the UN R21 knee-form, in
+//! continuous geometry on the part's triangle mesh (SPEC, "The exact
+//! oracle"). It shares no geometry code with the grid engine, so it can
+//! catch the engine's mistakes.
+//!
+//! All lengths are mm and all points are in the analysis frame: the knee
+//! slides in -x, the analysed surface faces -y and the knee is pushed in
+//! +y, z is up. Angles are degrees.
+//!
+//! * [`KneeForm`]: the knee-form as a parry3d shape. It is the **exact**
+//!   rounded prism, a custom support-map shape (triangle support + `R` in
+//!   the xz direction of the query + the face or the back along y), not a
+//!   tessellated polyhedron: parry's default dispatcher casts a custom
+//!   [`parry3d_f64::shape::SupportMap`] shape against a
+//!   [`parry3d_f64::shape::TriMesh`] triangle by triangle, and the tests
+//!   check its support points against the analytic rounded triangle and
+//!   its casts against analytic contacts.
+//! * [`Part`]: the mesh, read from STL with the engine's `scale` and
+//!   `side`, or built from triangles.
+//! * [`trace_start`] and [`evaluate`]: push and slide one start, or many
+//!   starts at many angles in parallel; [`OracleOptions`] in,
+//!   [`StartTrace`] with a [`StartStatus`] out.
+
+//!
+//! **Invariant:** a start is never reported clear on a failed query: parry
+//! returns "no hit" when GJK runs out of iterations, so every miss is
+//! confirmed by a contact query between the swept knee-form and the mesh, and
+//! every non-converged cast makes the start [`StartStatus::Failed`].
+
+mod batch;
+mod error;
+mod knee_form;
+mod part;
+
+mod trace;
+
+pub use batch::evaluate;
+pub use error::OracleError;
+pub use knee_form::{KneeForm, KneeFormDims};
+pub use part::{Part, Side};
+
+pub use trace::{
+    ContactPoint, FailureReason, OracleOptions, SlideEnd, StartStatus, StartTrace, trace_start,
+};

@@ -1,0 +1,46 @@
+//! Many starts at many angles, in parallel.
+
+use rayon::prelude::*;
+
+use crate::knee_form::KneeForm;
+use crate::trace::trace_validated;
+use crate::{OracleError, OracleOptions, Part, StartTrace};
+
+/// Pushes and slides every start at every angle, in parallel on rayon's
+/// current thread pool.
+///
+/// `starts` are reference-point positions `(x, z)` in mm, analysis frame;
+/// `angles_deg` are knee-form angles in degrees. The output is in a fixed
+/// order whatever the threads: angle-major, `angles_deg.len() *
+/// starts.len()` traces, the trace of `starts[s]` at `angles_deg[a]` at
+/// index `a * starts.len() + s`.
+pub fn evaluate(
+    part: &Part,
+    starts: &[[f64; 2]],
+    angles_deg: &[f64],
+    options: &OracleOptions,
+) -> Result<Vec<StartTrace>, OracleError> {
+    options.validate()?;
+    if let Some(bad) = angles_deg.iter().find(|a| !a.is_finite()) {
+        return Err(OracleError::InvalidOptions(format!(
+            "angle {bad} is not finite"
+        )));
+    }
+    if let Some(bad) = starts
+        .iter()
+        .find(|s| !(s[0].is_finite() && s[1].is_finite()))
+    {
+        return Err(OracleError::InvalidOptions(format!(
+            "start {bad:?} is not finite"
+        )));
+    }
+    let knees: Vec<KneeForm> = angles_deg
+        .iter()
+        .map(|&angle| KneeForm::new(options.knee_form, angle))
+        .collect();
+    let n = starts.len();
+    Ok((0..knees.len() * n)
+        .into_par_iter()
+        .map(|k| trace_validated(part, &knees[k / n], starts[k % n], options))
+        .collect())
+}

@@ -1,0 +1,37 @@
+//! Errors of the oracle's inputs: the part and the options.
+
+/// Why the oracle refused its inputs. Per-start failures of the geometry
+/// queries are not errors: they are [`crate::StartStatus::Failed`].
+#[derive(Debug, thiserror::Error)]
+pub enum OracleError {
+    /// The STL file could not be opened or parsed.
+    #[error("cannot read STL {path}: {source}")]
+    Io {
+        /// The file, or `<reader>` when read from a stream.
+        path: String,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The mesh has no triangle left after dropping degenerate ones.
+    #[error("the part has no triangles ({dropped} degenerate ones dropped)")]
+    NoTriangles {
+        /// How many degenerate triangles were dropped.
+        dropped: usize,
+    },
+    /// A vertex coordinate is NaN or infinite.
+    #[error("triangle {triangle} has a non-finite coordinate")]
+    NonFinite {
+        /// Index of the triangle in the input.
+        triangle: usize,
+    },
+    /// The scale factor is not a finite positive number.
+    #[error("scale must be finite and > 0, got {0}")]
+    InvalidScale(f64),
+    /// parry3d refused the mesh.
+    #[error("parry3d refused the mesh: {0}")]
+    Mesh(String),
+    /// An option is out of its range.
+    #[error("invalid oracle option: {0}")]
+    InvalidOptions(String),
+}

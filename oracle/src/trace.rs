@@ -1,0 +1,448 @@
+//! Push and slide of one start, by parry3d shape casts (SPEC, "The exact
+//! oracle").
+//!
+//! **Push.** The knee-form starts with its face 1 mm below the whole mesh
+//! and is cast along +y; the time of impact gives `yr*`, the contact point
+//! is the push witness. No hit: the start is not placed.
+//!
+//! **Slide.** The face level as a function of travel `s` is
+//! `f(s) = max{ f <= f0 : the knee-form at level f travels [0, s] without
+//! penetrating the mesh }`. A cast along -x at level `f` gives `s_max(f)`
+//! and its witness point. The trace steps `f` down by
+//! [`OracleOptions::level_step`] and bisects between consecutive levels
+//! whose contacts differ by more than [`OracleOptions::witness_tolerance`]
+//! (witness distance or travel), until the levels are closer than
+//! [`OracleOptions::jump_tolerance`]: a gap still open then is a genuine
+//! jump (the straight run over a depression, or the stop at a peak). It
+//! ends when a cast misses (the knee-form clears the part) or a witness
+//! lies past [`OracleOptions::x_min`] (the grid's -x edge).
+//!
+//! **Contact tolerance.** The slide starts at `f0 = yr* - eps`, not at
+//! `yr*`: the traced motion is the exact motion of a knee-form released
+//! `eps` below its push level. A mesh point is therefore a slide contact
+//! exactly when it sticks out more than `eps` beyond the level the
+//! knee-form has at that point of its travel, which is the grid's rule
+//! `h < f - eps` (SPEC, "Step 2 — slide") for the first contact; after a
+//! contact the grid drops to the node's `h` and asks `h' < h - eps`, the
+//! trace drops to the contact and asks `h' < h`: the two differ by at most
+//! `eps` in level, far below any pitch. The offset also keeps the first
+//! cast off the touching pose, where parry reports a time of impact of 0.
+//! Every reported `face_level` is the level of the cast that touched.
+
+use parry3d_f64::math::{Pose, Vector};
+use parry3d_f64::query::{ShapeCastOptions, ShapeCastStatus, cast_shapes, contact};
+use serde::{Deserialize, Serialize};
+
+use crate::knee_form::{KneeForm, KneeFormDims, SweptKneeForm};
+use crate::{OracleError, Part};
+
+/// How far below the mesh's lowest point the push cast starts, mm. Any
+/// positive value works; 1 mm keeps the time of impact small and exact.
+const PUSH_CLEARANCE: f64 = 1.0;
+
+/// A swept knee-form overlapping the mesh by less than this fraction of
+/// `eps` after a cast reported no hit is a grazing pass, not a failure.
+const GRAZING_FRACTION: f64 = 0.1;
+
+/// How far past the mesh (or `x_min`) a slide cast looks, mm.
+const SLIDE_MARGIN: f64 = 1.0;
+
+/// Options of the exact push-and-slide. Lengths in mm, analysis frame.
+#[derive(Copy, Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OracleOptions {
+    /// The knee-form's `L`, `R`, `W`.
+    pub knee_form: KneeFormDims,
+    /// SPEC's contact tolerance `eps` (mm, > 0): the slide starts this far
+    /// below `yr*`. Default 1e-3 mm, as the grid's.
+    pub eps: f64,
+    /// Consecutive contact points further apart than this (witness
+    /// distance, or difference in travel) are bisected (mm). Default 0.1 mm,
+    /// a tenth of a 1 mm grid pitch: set it to a tenth of the pitch checked.
+    pub witness_tolerance: f64,
+    /// The step of the face level between casts before bisection (mm).
+    /// Default 1 mm; a step larger than a feature's depth could step over
+    /// a contact that leaves and comes back within `witness_tolerance`.
+    pub level_step: f64,
+    /// A gap between contacts whose levels are closer than this is a
+    /// genuine jump, and contacts whose travels differ by less than this
+    /// are at the same travel (mm). Default 1e-6 mm, parry3d-f64's accuracy
+    /// on part-sized coordinates.
+    pub jump_tolerance: f64,
+    /// Shape casts allowed per start (push + slide); a start that needs
+    /// more fails with [`FailureReason::CastBudgetExhausted`].
+    pub max_casts: usize,
+    /// The grid's -x edge (mm): a contact whose witness has `x < x_min`
+    /// ends the trace and is not reported. Default `-inf`.
+    pub x_min: f64,
+}
+
+impl Default for OracleOptions {
+    fn default() -> Self {
+        Self {
+            knee_form: KneeFormDims::default(),
+            eps: 1e-3,
+            witness_tolerance: 0.1,
+            level_step: 1.0,
+            jump_tolerance: 1e-6,
+            max_casts: 100_000,
+            x_min: f64::NEG_INFINITY,
+        }
+    }
+}
+
+impl OracleOptions {
+    /// Checks every option's range.
+    pub fn validate(&self) -> Result<(), OracleError> {
+        let positive = |name: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(OracleError::InvalidOptions(format!(
+                    "{name} must be finite and > 0, got {v}"
+                )))
+            }
+        };
+        if !self.knee_form.is_valid() {
+            return Err(OracleError::InvalidOptions(format!(
+                "knee-form dimensions must be finite and > 0, got {:?}",
+                self.knee_form
+            )));
+        }
+        positive("eps", self.eps)?;
+        positive("witness_tolerance", self.witness_tolerance)?;
+        positive("level_step", self.level_step)?;
+        positive("jump_tolerance", self.jump_tolerance)?;
+        if self.max_casts == 0 {
+            return Err(OracleError::InvalidOptions("max_casts must be > 0".into()));
+        }
+        if self.x_min.is_nan() || self.x_min == f64::INFINITY {
+            return Err(OracleError::InvalidOptions(format!(
+                "x_min must be finite or -inf, got {}",
+                self.x_min
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// One point of the contact curve of a slide.
+#[derive(Copy, Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContactPoint {
+    /// Travel `s` of the reference point along -x from the start (mm).
+    pub travel: f64,
+    /// Face level `f` of the knee-form at this contact (mm, analysis y).
+    pub face_level: f64,
+    /// The touched point of the mesh, `[x, y, z]` (mm, analysis frame).
+    pub witness: [f64; 3],
+}
+
+/// Why a start's trace could not be trusted.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize, thiserror::Error)]
+pub enum FailureReason {
+    /// A shape cast stopped with `ShapeCastStatus::OutOfIterations` or
+    /// `Failed`.
+    #[error("a shape cast did not converge")]
+    CastNotConverged,
+    /// A cast reported no hit, but the swept knee-form overlaps the mesh by
+    /// more than a tenth of `eps`: the cast gave up (parry's GJK returns no hit when it runs out of
+    /// iterations).
+    #[error("a cast reported no hit but the swept knee-form touches the part")]
+    UnconfirmedMiss,
+    /// A slide cast found the knee-form already penetrating at travel 0.
+    #[error("the knee-form penetrates the part at the start of a slide cast")]
+    PenetratingStart,
+    /// More than [`OracleOptions::max_casts`] casts were needed.
+    #[error("the cast budget per start is exhausted")]
+    CastBudgetExhausted,
+    /// parry3d does not support the query (never expected).
+    #[error("parry3d does not support this query")]
+    Unsupported,
+}
+
+/// Outcome of one start.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StartStatus {
+    /// The knee-form touched the part when pushed; `yr*` is known.
+    Placed,
+    /// No point of the mesh lies in the footprint: SPEC's "not placed".
+    NotPlaced,
+    /// A query failed; the contacts found before the failure are kept but
+    /// the trace is incomplete.
+    Failed {
+        /// What went wrong.
+        reason: FailureReason,
+    },
+}
+
+/// Why a slide stopped.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum SlideEnd {
+    /// No slide was run (not placed, or failed before).
+    NotRun,
+    /// A cast missed: the knee-form clears the part (or reaches the grid's
+    /// -x edge without touching anything more).
+    Cleared,
+    /// A contact's witness lay past [`OracleOptions::x_min`].
+    PastXMin,
+}
+
+/// The exact push and slide of one start at one angle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StartTrace {
+    /// The knee-form angle, degrees.
+    pub angle_deg: f64,
+    /// The start: the reference point's `(x, z)`, mm, analysis frame.
+    pub start: [f64; 2],
+    /// Placed, not placed or failed.
+    pub status: StartStatus,
+    /// `yr*`: the face level at push contact (mm), when placed.
+    pub yr_star: Option<f64>,
+    /// The mesh point touched by the push, `[x, y, z]` mm, when placed.
+    pub push_witness: Option<[f64; 3]>,
+    /// The slide's contact points, by increasing travel (decreasing level).
+    pub contacts: Vec<ContactPoint>,
+    /// Why the slide stopped.
+    pub slide_end: SlideEnd,
+    /// Shape casts spent on this start (push + slide).
+    pub casts: usize,
+}
+
+/// Push and slide one start: the reference point at `start = (x, z)` (mm,
+/// analysis frame), the knee-form at `angle_deg` degrees.
+pub fn trace_start(
+    part: &Part,
+    start: [f64; 2],
+    angle_deg: f64,
+    options: &OracleOptions,
+) -> Result<StartTrace, OracleError> {
+    options.validate()?;
+    let knee = KneeForm::new(options.knee_form, angle_deg);
+    Ok(trace_validated(part, &knee, start, options))
+}
+
+/// [`trace_start`] with options already validated and the knee-form built.
+pub(crate) fn trace_validated(
+    part: &Part,
+    knee: &KneeForm,
+    start: [f64; 2],
+    options: &OracleOptions,
+) -> StartTrace {
+    let mut tracer = Tracer {
+        part,
+        knee: *knee,
+        start,
+        options,
+        casts: 0,
+        contacts: Vec::new(),
+        end: None,
+    };
+    let mut trace = StartTrace {
+        angle_deg: knee.angle_deg(),
+        start,
+        status: StartStatus::NotPlaced,
+        yr_star: None,
+        push_witness: None,
+        contacts: Vec::new(),
+        slide_end: SlideEnd::NotRun,
+        casts: 0,
+    };
+    let outcome = tracer.push().and_then(|push| match push {
+        None => Ok(StartStatus::NotPlaced),
+        Some((yr_star, witness)) => {
+            trace.yr_star = Some(yr_star);
+            trace.push_witness = Some(witness.to_array());
+            tracer.slide(yr_star - options.eps)?;
+            Ok(StartStatus::Placed)
+        }
+    });
+    trace.status = outcome.unwrap_or_else(|reason| StartStatus::Failed { reason });
+    if trace.status == StartStatus::Placed {
+        trace.slide_end = tracer.end.unwrap_or(SlideEnd::Cleared);
+    }
+    trace.contacts = tracer.contacts;
+    trace.casts = tracer.casts;
+    trace
+}
+
+/// A slide cast's contact: travel (mm) and mesh witness point.
+#[derive(Copy, Clone, Debug)]
+struct Hit {
+    travel: f64,
+    witness: Vector,
+}
+
+struct Tracer<'a> {
+    part: &'a Part,
+    knee: KneeForm,
+    start: [f64; 2],
+    options: &'a OracleOptions,
+    casts: usize,
+    contacts: Vec<ContactPoint>,
+    end: Option<SlideEnd>,
+}
+
+impl Tracer<'_> {
+    /// One shape cast of the knee-form from `pose` along the unit `dir`, up
+    /// to `max_travel` mm. A miss is confirmed by a contact query between
+    /// the swept knee-form and the mesh before it is believed.
+    fn cast(
+        &mut self,
+        pose: &Pose,
+        dir: Vector,
+        max_travel: f64,
+    ) -> Result<Option<(f64, Vector)>, FailureReason> {
+        if self.casts >= self.options.max_casts {
+            return Err(FailureReason::CastBudgetExhausted);
+        }
+        self.casts += 1;
+        let cast_options = ShapeCastOptions {
+            max_time_of_impact: max_travel,
+            target_distance: 0.0,
+            stop_at_penetration: false,
+            compute_impact_geometry_on_penetration: true,
+        };
+        let mesh = self.part.mesh();
+        let hit = cast_shapes(
+            pose,
+            dir,
+            &self.knee,
+            &Pose::IDENTITY,
+            Vector::ZERO,
+            mesh,
+            cast_options,
+        )
+        .map_err(|_| FailureReason::Unsupported)?;
+        match hit {
+            Some(hit) => match hit.status {
+                ShapeCastStatus::Converged => Ok(Some((hit.time_of_impact, hit.witness2))),
+                ShapeCastStatus::PenetratingOrWithinTargetDist => {
+                    Err(FailureReason::PenetratingStart)
+                }
+                ShapeCastStatus::OutOfIterations | ShapeCastStatus::Failed => {
+                    Err(FailureReason::CastNotConverged)
+                }
+            },
+            None => {
+                let swept = SweptKneeForm {
+                    knee: self.knee,
+                    sweep: dir * max_travel,
+                };
+                let overlap = contact(pose, &swept, &Pose::IDENTITY, mesh, 0.0)
+                    .map_err(|_| FailureReason::Unsupported)?;
+                // GJK also gives up on casts that only graze the mesh. An
+                // overlap shallower than a tenth of eps is below what the
+                // grid's rule `h < f - eps` can see: such a pass counts as
+                // a miss. A deeper one means the cast failed.
+                match overlap {
+                    Some(c) if -c.dist > GRAZING_FRACTION * self.options.eps => {
+                        Err(FailureReason::UnconfirmedMiss)
+                    }
+                    _ => Ok(None),
+                }
+            }
+        }
+    }
+
+    /// The push: `Some((yr*, witness))`, or `None` when not placed.
+    fn push(&mut self) -> Result<Option<(f64, Vector)>, FailureReason> {
+        let (mins, maxs) = self.part.bounds();
+        let from = mins[1] - PUSH_CLEARANCE;
+        let pose = KneeForm::pose(self.start, from);
+        let reach = maxs[1] - from + PUSH_CLEARANCE;
+        Ok(self
+            .cast(&pose, Vector::Y, reach)?
+            .map(|(toi, witness)| (from + toi, witness)))
+    }
+
+    /// The slide cast at face level `level`: travel to first contact along
+    /// -x and its witness, or `None` when the knee-form clears the part
+    /// before its back passes the mesh or `x_min`.
+    fn slide_cast(&mut self, level: f64) -> Result<Option<Hit>, FailureReason> {
+        let (mins, _) = self.part.bounds();
+        let back = self.start[0] + self.knee.x_extent().1;
+        let edge = mins[0].max(self.options.x_min);
+        let reach = (back - edge + SLIDE_MARGIN).max(SLIDE_MARGIN);
+        let pose = KneeForm::pose(self.start, level);
+        Ok(self
+            .cast(&pose, -Vector::X, reach)?
+            .map(|(travel, witness)| Hit { travel, witness }))
+    }
+
+    /// Whether nothing needs bisecting between two consecutive casts.
+    fn resolved(&self, a: Option<Hit>, b: Option<Hit>) -> bool {
+        match (a, b) {
+            (None, None) => true,
+            (Some(a), Some(b)) => {
+                let travel = (b.travel - a.travel).abs();
+                // The knee-form did not move between the two levels: every
+                // level in between stops at the same travel, whatever the
+                // witnesses (a face-to-face contact has no unique witness).
+                travel <= self.options.jump_tolerance
+                    || (travel <= self.options.witness_tolerance
+                        && (b.witness - a.witness).length() <= self.options.witness_tolerance)
+            }
+            _ => false,
+        }
+    }
+
+    /// Records the contact at `level`, or ends the trace past `x_min`.
+    fn emit(&mut self, level: f64, hit: Hit) {
+        if hit.witness.x < self.options.x_min {
+            self.end = Some(SlideEnd::PastXMin);
+            return;
+        }
+        self.contacts.push(ContactPoint {
+            travel: hit.travel,
+            face_level: level,
+            witness: hit.witness.to_array(),
+        });
+    }
+
+    /// Emits the contacts of the levels in `(b, a)` (bisected as needed)
+    /// and then `b`'s, in decreasing level; `a`'s is already emitted.
+    fn refine(
+        &mut self,
+        a: f64,
+        hit_a: Option<Hit>,
+        b: f64,
+        hit_b: Option<Hit>,
+    ) -> Result<(), FailureReason> {
+        if !self.resolved(hit_a, hit_b) && a - b > self.options.jump_tolerance {
+            let mid = 0.5 * (a + b);
+            let hit_mid = self.slide_cast(mid)?;
+            self.refine(a, hit_a, mid, hit_mid)?;
+            if self.end.is_none() {
+                self.refine(mid, hit_mid, b, hit_b)?;
+            }
+            return Ok(());
+        }
+        if let Some(hit) = hit_b {
+            self.emit(b, hit);
+        }
+        Ok(())
+    }
+
+    /// Traces the contact curve from level `top` down.
+    fn slide(&mut self, top: f64) -> Result<(), FailureReason> {
+        let mut level = top;
+        let mut hit = self.slide_cast(level)?;
+        match hit {
+            None => {
+                self.end = Some(SlideEnd::Cleared);
+                return Ok(());
+            }
+            Some(h) => self.emit(level, h),
+        }
+        while self.end.is_none() {
+            let next = level - self.options.level_step;
+            let next_hit = self.slide_cast(next)?;
+            self.refine(level, hit, next, next_hit)?;
+            if next_hit.is_none() && self.end.is_none() {
+                self.end = Some(SlideEnd::Cleared);
+            }
+            level = next;
+            hit = next_hit;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,410 @@
+//! The oracle against parts whose contacts are known in closed form.
+
+mod util;
+
+use kneeform_oracle::{
+    OracleOptions, Part, SlideEnd, StartStatus, StartTrace, evaluate, trace_start,
+};
+use util::{height_field, knots, linspace};
+
+const R: f64 = 60.0;
+
+/// Tolerance on a witness coordinate along which the knee-form and the
+/// mesh are tangent (e.g. z, where the rounded front meets a surface that
+/// is straight in z). A gap error `d` moves such a witness by
+/// `sqrt(2 R d)`: parry's ~1e-6 mm gives ~0.011 mm, seen up to 0.0083 mm.
+const TANGENT_TOL: f64 = 0.03;
+const ANGLES: [f64; 5] = [-30.0, -13.0, 0.0, 21.0, 30.0];
+
+fn placed(trace: &StartTrace) -> f64 {
+    assert_eq!(trace.status, StartStatus::Placed, "{trace:?}");
+    trace.yr_star.unwrap()
+}
+
+#[test]
+fn flat_wall_gives_its_level_and_no_slide_contact() {
+    let c = 37.5;
+    let xs = linspace(-600.0, 600.0, 13);
+    let zs = linspace(-400.0, 400.0, 9);
+    let part = Part::from_triangles(&height_field(&xs, &zs, |_, _| c)).unwrap();
+    let starts = [[-200.0, -100.0], [0.0, 0.0], [150.0, 100.0], [333.3, 17.0]];
+    let traces = evaluate(&part, &starts, &ANGLES, &OracleOptions::default()).unwrap();
+    assert_eq!(traces.len(), ANGLES.len() * starts.len());
+    for trace in &traces {
+        let yr = placed(trace);
+        assert!((yr - c).abs() < 1e-4, "{trace:?}");
+        assert!(trace.contacts.is_empty(), "{trace:?}");
+        assert_eq!(trace.slide_end, SlideEnd::Cleared);
+    }
+    let away = trace_start(&part, [2000.0, 0.0], 0.0, &OracleOptions::default()).unwrap();
+    assert_eq!(away.status, StartStatus::NotPlaced);
+    assert!(away.contacts.is_empty() && away.yr_star.is_none());
+}
+
+/// Default options with a coarser bisection tolerance, so that long
+/// contact curves stay a few hundred casts in tests.
+fn options() -> OracleOptions {
+    OracleOptions {
+        witness_tolerance: 0.5,
+        ..OracleOptions::default()
+    }
+}
+
+/// Checks what every trace must satisfy: contacts ordered by travel with
+/// non-increasing levels, the witness on the knee-form's y-extent, and the
+/// slide level never above `yr* - eps`.
+fn assert_well_formed(trace: &StartTrace, options: &OracleOptions) {
+    let yr = trace.yr_star.unwrap();
+    let mut last = (0.0, yr - options.eps);
+    for c in &trace.contacts {
+        assert!(c.travel >= last.0 - 1e-6, "{c:?} after {last:?}");
+        assert!(c.face_level <= last.1 + 1e-12, "{c:?} after {last:?}");
+        // The witness lies on the knee-form, up to its tangential error.
+        let w = c.witness;
+        assert!(w[1] <= c.face_level + TANGENT_TOL, "{c:?}");
+        assert!(
+            w[1] >= c.face_level - options.knee_form.width - TANGENT_TOL,
+            "{c:?}"
+        );
+        last = (c.travel, c.face_level);
+    }
+}
+
+#[test]
+fn tilted_wall_gives_the_level_under_the_front_of_the_footprint() {
+    // y = c + k (x - x_r): the wall comes closer towards -x, so the push
+    // touches under the footprint's front point (x0 - R, z0) at any angle
+    // within +-30 degrees.
+    let (c, k, x_r) = (10.0, 0.2, 0.0);
+    let xs = linspace(-600.0, 600.0, 25);
+    let zs = linspace(-400.0, 400.0, 9);
+    let part = Part::from_triangles(&height_field(&xs, &zs, |i, _| c + k * (xs[i] - x_r))).unwrap();
+    let starts = [[-100.0, 0.0], [50.0, 35.0], [200.0, -120.0]];
+    let options = OracleOptions {
+        x_min: -300.0,
+        ..options()
+    };
+    for trace in evaluate(&part, &starts, &ANGLES, &options).unwrap() {
+        let [x0, z0] = trace.start;
+        let yr = placed(&trace);
+        assert!((yr - (c + k * (x0 - R - x_r))).abs() < 1e-4, "{trace:?}");
+        let w = trace.push_witness.unwrap();
+        assert!((w[0] - (x0 - R)).abs() < TANGENT_TOL, "{trace:?}");
+        assert!((w[2] - z0).abs() < TANGENT_TOL, "{trace:?}");
+        // Every move in -x collides: contacts start at once and run along
+        // the wall, each at the front point, until the grid's -x edge.
+        assert_well_formed(&trace, &options);
+        assert_eq!(trace.slide_end, SlideEnd::PastXMin, "{trace:?}");
+        let first = trace.contacts[0];
+        assert!((first.travel - options.eps / k).abs() < 1e-4, "{first:?}");
+        for c_pt in &trace.contacts {
+            let w = c_pt.witness;
+            assert!((w[1] - (c + k * (w[0] - x_r))).abs() < 1e-6, "{c_pt:?}");
+            assert!((w[0] - (x0 - R - c_pt.travel)).abs() < 1e-4, "{c_pt:?}");
+            assert!((w[2] - z0).abs() < TANGENT_TOL, "{c_pt:?}");
+            assert!(w[0] >= options.x_min);
+        }
+        let end = trace.contacts.last().unwrap().witness[0];
+        assert!(
+            end < options.x_min + 0.5,
+            "trace stops short of x_min: {end}"
+        );
+        for pair in trace.contacts.windows(2) {
+            let gap = (0..3)
+                .map(|a| (pair[1].witness[a] - pair[0].witness[a]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            assert!(gap <= options.witness_tolerance + 1e-9, "{pair:?}");
+        }
+    }
+}
+
+#[test]
+fn ramp_ahead_gives_the_analytic_first_contact_travel_and_contact_curve() {
+    // Flat at y = c behind x_w, then a ramp that sticks out towards -x:
+    // y = c - k (x_w - x) for x < x_w.
+    let (c, k, x_w) = (0.0, 0.35, -50.0);
+    let xs = knots(&[linspace(-400.0, x_w, 36), linspace(x_w, 600.0, 13)]);
+    let zs = linspace(-400.0, 400.0, 9);
+    let g = |x: f64| if x < x_w { c - k * (x_w - x) } else { c };
+    let part = Part::from_triangles(&height_field(&xs, &zs, |i, _| g(xs[i]))).unwrap();
+    let options = options();
+    let starts = [[100.0, 0.0], [250.0, -40.0]];
+    for trace in evaluate(&part, &starts, &ANGLES, &options).unwrap() {
+        let [x0, z0] = trace.start;
+        assert!((placed(&trace) - c).abs() < 1e-4, "{trace:?}");
+        assert_well_formed(&trace, &options);
+        // The front point (x0 - R - s, z0) at level c - eps meets the ramp
+        // where it reaches c - eps.
+        let first = trace.contacts[0];
+        let want = (x0 - R) - (x_w - options.eps / k);
+        assert!((first.travel - want).abs() < 1e-4, "{first:?} vs {want}");
+        for c_pt in &trace.contacts {
+            let w = c_pt.witness;
+            assert!((w[1] - g(w[0])).abs() < 1e-6, "{c_pt:?}");
+            assert!((w[1] - c_pt.face_level).abs() < 1e-4, "{c_pt:?}");
+            assert!((w[0] - (x0 - R - c_pt.travel)).abs() < 1e-4, "{c_pt:?}");
+            assert!((w[2] - z0).abs() < TANGENT_TOL, "{c_pt:?}");
+        }
+        // The knee-form rides the ramp to its end at x = -400.
+        let last = trace.contacts.last().unwrap();
+        assert!(last.witness[0] < -399.0, "{last:?}");
+        assert_eq!(trace.slide_end, SlideEnd::Cleared);
+    }
+}
+
+/// A cylindrical bump along z: `y = yc - sqrt(r^2 - (x - xc)^2)` for
+/// `|x - xc| < a`, flat `y = c` elsewhere, with `yc = c + sqrt(r^2 - a^2)`.
+#[derive(Copy, Clone)]
+struct Bump {
+    xc: f64,
+    r: f64,
+    a: f64,
+}
+
+impl Bump {
+    fn yc(&self, c: f64) -> f64 {
+        c + (self.r * self.r - self.a * self.a).sqrt()
+    }
+    fn peak(&self, c: f64) -> f64 {
+        self.yc(c) - self.r
+    }
+    fn height(&self, c: f64, x: f64) -> Option<f64> {
+        let u = x - self.xc;
+        (u.abs() < self.a).then(|| self.yc(c) - (self.r * self.r - u * u).sqrt())
+    }
+    fn knots(&self) -> Vec<f64> {
+        // 0.25 mm chords: the sagitta r (1 - cos) stays below 2e-4 mm.
+        linspace(
+            self.xc - self.a,
+            self.xc + self.a,
+            (8.0 * self.a) as usize + 1,
+        )
+    }
+    /// Distance from the witness to the bump's circle in the xy-plane.
+    fn off_circle(&self, c: f64, w: [f64; 3]) -> f64 {
+        ((w[0] - self.xc).hypot(w[1] - self.yc(c)) - self.r).abs()
+    }
+}
+
+fn bumps_part(c: f64, bumps: &[Bump]) -> Part {
+    let mut runs = vec![linspace(-500.0, 500.0, 11)];
+    runs.extend(bumps.iter().map(Bump::knots));
+    let mut xs: Vec<f64> = runs.concat();
+    xs.sort_by(f64::total_cmp);
+    xs.dedup();
+    let zs = linspace(-400.0, 400.0, 9);
+    let g = |x: f64| bumps.iter().find_map(|b| b.height(c, x)).unwrap_or(c);
+    Part::from_triangles(&height_field(&xs, &zs, |i, _| g(xs[i]))).unwrap()
+}
+
+#[test]
+fn cylindrical_bump_is_climbed_along_its_circle_and_left_at_its_peak() {
+    let c = 5.0;
+    let bump = Bump {
+        xc: -100.0,
+        r: 80.0,
+        a: 40.0,
+    };
+    let part = bumps_part(c, &[bump]);
+    let options = OracleOptions {
+        witness_tolerance: 0.1,
+        ..OracleOptions::default()
+    };
+    let starts = [[150.0, 0.0], [200.0, 60.0]];
+    for trace in evaluate(&part, &starts, &ANGLES, &options).unwrap() {
+        let [x0, z0] = trace.start;
+        assert!((placed(&trace) - c).abs() < 1e-4, "{trace:?}");
+        assert_well_formed(&trace, &options);
+        assert!(trace.contacts.len() > 10, "{trace:?}");
+        // The face's front corner (x0 - R - s, f, z0) rides the back of
+        // the circle: witness on the circle, at the face level, at z0.
+        for c_pt in &trace.contacts {
+            let w = c_pt.witness;
+            assert!(bump.off_circle(c, w) < 5e-4, "{c_pt:?}");
+            assert!((w[1] - c_pt.face_level).abs() < 1e-4, "{c_pt:?}");
+            // At the peak the face meets the crest line along z, tangent
+            // in x too: any point of the crest under the face is a witness,
+            // so x and z are only checked where the circle is 0.01 mm or
+            // more below the peak.
+            if c_pt.face_level > bump.peak(c) + 0.01 {
+                assert!((w[0] - (x0 - R - c_pt.travel)).abs() < 1e-4, "{c_pt:?}");
+                assert!((w[2] - z0).abs() < TANGENT_TOL, "{c_pt:?}");
+            }
+            // Only the back half of the bump is ever touched.
+            assert!(w[0] >= bump.xc - 1e-3, "{c_pt:?}");
+        }
+        // First contact where the circle reaches c - eps ...
+        let first = trace.contacts[0];
+        let g = c - options.eps;
+        let x_first = bump.xc + (bump.r.powi(2) - (bump.yc(c) - g).powi(2)).sqrt();
+        assert!(
+            (first.travel - (x0 - R - x_first)).abs() < 2e-3,
+            "{first:?} vs {x_first}"
+        );
+        // ... the last at the peak, then the knee-form clears the part.
+        let last = trace.contacts.last().unwrap();
+        assert!((last.face_level - bump.peak(c)).abs() < 1e-4, "{last:?}");
+        assert_eq!(trace.slide_end, SlideEnd::Cleared);
+    }
+}
+
+#[test]
+fn run_over_a_depression_jumps_from_a_peak_to_the_next_point_that_sticks_out() {
+    // A small bump, then (towards -x) a taller one: after the small peak
+    // the knee-form runs straight at that level to the taller bump.
+    let c = 0.0;
+    let small = Bump {
+        xc: 0.0,
+        r: 60.0,
+        a: 20.0,
+    };
+    let tall = Bump {
+        xc: -250.0,
+        r: 100.0,
+        a: 60.0,
+    };
+    let (small_peak, tall_peak) = (small.peak(c), tall.peak(c));
+    assert!(tall_peak < small_peak);
+    let part = bumps_part(c, &[small, tall]);
+    let options = options();
+    let trace = trace_start(&part, [150.0, 0.0], 0.0, &options).unwrap();
+    placed(&trace);
+    assert_well_formed(&trace, &options);
+    let split = trace
+        .contacts
+        .iter()
+        .position(|c_pt| c_pt.witness[0] < -100.0)
+        .expect("the tall bump is reached");
+    let (on_small, on_tall) = trace.contacts.split_at(split);
+    assert!(
+        on_small
+            .iter()
+            .all(|c_pt| small.off_circle(c, c_pt.witness) < 5e-4)
+    );
+    assert!(
+        on_tall
+            .iter()
+            .all(|c_pt| tall.off_circle(c, c_pt.witness) < 5e-4)
+    );
+    // The jump: the last contact on the small bump is at its peak, the
+    // first on the tall one at the same level, where the tall circle
+    // reaches it.
+    let (before, after) = (on_small.last().unwrap(), on_tall[0]);
+    assert!((before.face_level - small_peak).abs() < 1e-4, "{before:?}");
+    assert!((after.face_level - small_peak).abs() < 1e-4, "{after:?}");
+    let x_hit = tall.xc + (tall.r.powi(2) - (tall.yc(c) - small_peak).powi(2)).sqrt();
+    assert!(
+        (after.witness[0] - x_hit).abs() < 2e-3,
+        "{after:?} vs {x_hit}"
+    );
+    assert!(
+        (after.travel - (150.0 - R - x_hit)).abs() < 2e-3,
+        "{after:?}"
+    );
+    let last = trace.contacts.last().unwrap();
+    assert!((last.face_level - tall_peak).abs() < 1e-4, "{last:?}");
+}
+
+#[test]
+fn step_stops_the_knee_form_at_its_riser_down_to_the_step_level() {
+    // y = c - d for x <= x_e (sticking out), y = c behind, with a vertical
+    // riser at x = x_e (the knot x_e is repeated).
+    let (c, d, x_e) = (20.0, 15.0, -30.0);
+    let xs = knots(&[linspace(-500.0, x_e, 10), linspace(x_e, 500.0, 11)]);
+    let mut xs_riser = xs.clone();
+    let riser = xs.iter().position(|&x| x == x_e).unwrap();
+    xs_riser.insert(riser, x_e);
+    let zs = linspace(-400.0, 400.0, 9);
+    let part = Part::from_triangles(&height_field(&xs_riser, &zs, |i, _| {
+        if i <= riser { c - d } else { c }
+    }))
+    .unwrap();
+    let options = options();
+    let starts = [[100.0, 0.0], [180.0, 90.0]];
+    for trace in evaluate(&part, &starts, &ANGLES, &options).unwrap() {
+        let [x0, z0] = trace.start;
+        assert!((placed(&trace) - c).abs() < 1e-4, "{trace:?}");
+        assert_well_formed(&trace, &options);
+        let s = x0 - R - x_e;
+        for c_pt in &trace.contacts {
+            assert!((c_pt.travel - s).abs() < 1e-4, "{c_pt:?}");
+            assert!((c_pt.witness[0] - x_e).abs() < 1e-4, "{c_pt:?}");
+            assert!((c_pt.witness[2] - z0).abs() < TANGENT_TOL, "{c_pt:?}");
+            assert!(c_pt.witness[1] >= c - d - 1e-4, "{c_pt:?}");
+        }
+        // Contacts from c - eps down to the step's level, then it is run over.
+        let (first, last) = (trace.contacts[0], trace.contacts.last().unwrap());
+        assert!((first.face_level - (c - options.eps)).abs() < 1e-12);
+        assert!((last.face_level - (c - d)).abs() < 1e-4, "{last:?}");
+        assert_eq!(trace.slide_end, SlideEnd::Cleared);
+    }
+}
+
+#[test]
+fn rounded_front_meets_an_edge_along_y_on_the_circle_of_radius_r() {
+    // A block sticking out by d for x <= x_e and z <= z_e, with vertical
+    // walls: its corner is an edge parallel to y at (x_e, z_e). A start at
+    // z0 = z_e + dz, |dz| < R/2, meets it with the rounded front at travel
+    // x0 - x_e - sqrt(R^2 - dz^2), at every angle within +-30 degrees.
+    let (c, d, x_e, z_e) = (0.0, 30.0, -40.0, 0.0);
+    let xs = knots(&[linspace(-500.0, x_e, 10), linspace(x_e, 500.0, 11)]);
+    let zs = knots(&[linspace(-400.0, z_e, 9), linspace(z_e, 400.0, 9)]);
+    let i_e = xs.iter().position(|&x| x == x_e).unwrap();
+    let j_e = zs.iter().position(|&z| z == z_e).unwrap();
+    let mut xs2 = xs.clone();
+    xs2.insert(i_e, x_e);
+    let mut zs2 = zs.clone();
+    zs2.insert(j_e, z_e);
+    let block = |i: usize, j: usize| if i <= i_e && j <= j_e { c - d } else { c };
+    let part = Part::from_triangles(&height_field(&xs2, &zs2, block)).unwrap();
+    let options = options();
+    let x0 = 100.0;
+    for dz in [5.0, 12.0, 20.0, 29.0] {
+        for &angle in &ANGLES {
+            let trace = trace_start(&part, [x0, z_e + dz], angle, &options).unwrap();
+            assert!((placed(&trace) - c).abs() < 1e-4, "{trace:?}");
+            assert_well_formed(&trace, &options);
+            let first = trace.contacts[0];
+            let want = x0 - x_e - (R * R - dz * dz).sqrt();
+            assert!(
+                (first.travel - want).abs() < 1e-4,
+                "dz {dz} angle {angle}: {first:?} vs {want}"
+            );
+            assert!((first.witness[0] - x_e).abs() < 1e-4, "{first:?}");
+            assert!((first.witness[2] - z_e).abs() < 1e-4, "{first:?}");
+        }
+    }
+}
+
+#[test]
+fn batch_output_is_deterministic_and_equals_single_starts() {
+    let c = 0.0;
+    let part = bumps_part(
+        c,
+        &[Bump {
+            xc: 0.0,
+            r: 60.0,
+            a: 20.0,
+        }],
+    );
+    let options = options();
+    let starts: Vec<[f64; 2]> = (0..6)
+        .map(|i| [60.0 + 30.0 * i as f64, -50.0 + 20.0 * i as f64])
+        .collect();
+    let angles = [-30.0, 0.0, 30.0];
+    let one = evaluate(&part, &starts, &angles, &options).unwrap();
+    let two = evaluate(&part, &starts, &angles, &options).unwrap();
+    assert_eq!(one, two);
+    for (a, &angle) in angles.iter().enumerate() {
+        for (s, &start) in starts.iter().enumerate() {
+            let single = trace_start(&part, start, angle, &options).unwrap();
+            assert_eq!(one[a * starts.len() + s], single);
+        }
+    }
+    let bad = OracleOptions {
+        eps: 0.0,
+        ..options
+    };
+    assert!(evaluate(&part, &starts, &angles, &bad).is_err());
+}
