@@ -28,6 +28,14 @@
 //! `eps` in level, far below any pitch. The offset also keeps the first
 //! cast off the touching pose, where parry reports a time of impact of 0.
 //! Every reported `face_level` is the level of the cast that touched.
+//!
+//! **Monotone travel.** A lower level normally travels at least as far as a
+//! higher one (lowering the knee-form only moves it away from a part that
+//! bounds a solid). Where it does not (a broken mesh, a floating sheet, or
+//! a grazing contact whose travel carries the cast's gap error divided by
+//! the grazing slope), the lower level's contact is not on `f(s)` (the
+//! knee-form is already past it) and is skipped, so reported travels never
+//! decrease by more than `jump_tolerance`.
 
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query::{ShapeCastOptions, ShapeCastStatus, cast_shapes, contact};
@@ -389,6 +397,13 @@ impl Tracer<'_> {
     fn emit(&mut self, level: f64, hit: Hit) {
         if hit.witness.x < self.options.x_min {
             self.end = Some(SlideEnd::PastXMin);
+            return;
+        }
+        // `f(s)` takes the highest level that can still travel `s`: a lower
+        // level that stops earlier than one already traced is never
+        // reached, so its contact is not on the curve.
+        let reached = self.contacts.last().map_or(f64::NEG_INFINITY, |c| c.travel);
+        if hit.travel < reached - self.options.jump_tolerance {
             return;
         }
         self.contacts.push(ContactPoint {
