@@ -18,7 +18,7 @@ use crate::push::{WindowMin, push_row};
 use crate::slide::{SlideScratch, slide_row};
 
 /// Which implementation of push and slide to run. Both give identical masks.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum Algorithm {
     /// The paper's sections 3 and 4, literally: the reference and baseline.

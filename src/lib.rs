@@ -13,6 +13,7 @@
 //!
 //! All lengths are mm and all angles degrees.
 
+pub mod console;
 pub mod engine;
 pub mod grid;
 pub mod kneeform;
@@ -23,6 +24,7 @@ pub mod paper;
 pub mod push;
 pub mod scenario;
 pub mod slide;
+pub mod summary;
 
 pub use engine::{Algorithm, AngleMask, EngineOptions, colliding_masks, composite};
 pub use grid::{GridSpec, HeightGrid};

@@ -11,7 +11,7 @@ use std::path::Path;
 pub type Triangle = [[f64; 3]; 3];
 
 /// Which side of the vehicle the analysed surface is on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum Side {
     /// The analysed surface faces -y (SPEC's canonical frame).
@@ -104,11 +104,16 @@ impl Part {
             path: name.clone(),
             source,
         })?;
-        let triangles = parse_stl(&bytes).map_err(|reason| MeshError::Format {
-            path: name.clone(),
+        Part::from_stl_bytes(&name, &bytes, scale, side)
+    }
+
+    /// Parses the bytes of an STL file named `name` (for messages).
+    pub fn from_stl_bytes(name: &str, bytes: &[u8], scale: f64, side: Side) -> Result<Part, MeshError> {
+        let triangles = parse_stl(bytes).map_err(|reason| MeshError::Format {
+            path: name.into(),
             reason,
         })?;
-        Part::from_triangles(&name, triangles, scale, side)
+        Part::from_triangles(name, triangles, scale, side)
     }
 
     /// Builds a part from triangles in the part's own frame and units.

@@ -1,0 +1,135 @@
+//! `kneeform bench`: the paper-sized workload, built here so that anyone can
+//! rerun it: the console part at 369,408+ triangles, a 1538 x 801 grid at
+//! 1.24 mm, 61 angles. It times sampling and push-and-slide (median of
+//! several runs), and the paper algorithm against the fast one on the same
+//! sample of start rows and angles in the same run (the paper algorithm
+//! scans every slide to the grid's end, so the full run is extrapolated and
+//! labelled so).
+
+use std::fmt::Write as _;
+use std::time::Instant;
+
+use anyhow::ensure;
+use kneeform::console::{CONSOLE_SIZE, console_triangles};
+use kneeform::grid::GridSpec;
+use kneeform::{Algorithm, EngineOptions, Footprint, GridFootprint, HeightGrid, KneeForm, colliding_masks};
+
+use super::args::BenchArgs;
+
+/// The paper's workload (Inui, Gunji and Umezu): triangles, grid, pitch.
+const PAPER_TRIANGLES: usize = 369_408;
+const PAPER_GRID: [usize; 2] = [1538, 801];
+const PAPER_PITCH: f64 = 1.24;
+/// The paper's reported time for one console (s).
+const PAPER_SECONDS: f64 = 2519.92;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Peak resident memory of this process (MiB), from /proc.
+fn peak_rss_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
+pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
+    ensure!(args.runs >= 1, "--runs must be at least 1");
+    ensure!(args.paper_rows >= 1 && args.paper_angles >= 1, "--paper-rows and --paper-angles must be at least 1");
+    let knee = KneeForm::default();
+    let angles: Vec<f64> = (-30..=30).map(f64::from).collect();
+    let t = Instant::now();
+    let triangles = console_triangles(PAPER_TRIANGLES);
+    let build_s = t.elapsed().as_secs_f64();
+    // The grid centred on the console.
+    let [lx, lz] = CONSOLE_SIZE;
+    let [nx, nz] = PAPER_GRID;
+    let origin = [(lx - (nx - 1) as f64 * PAPER_PITCH) / 2.0, (lz - (nz - 1) as f64 * PAPER_PITCH) / 2.0];
+    let spec = GridSpec::explicit(origin[0], origin[1], nx, nz, PAPER_PITCH);
+    let footprints: Vec<GridFootprint> = angles
+        .iter()
+        .map(|&a| GridFootprint::new(&Footprint::new(&knee, a), a, PAPER_PITCH))
+        .collect();
+    let fast = EngineOptions::default();
+
+    let mut sample_s = Vec::new();
+    let mut slide_s = Vec::new();
+    let mut grid = None;
+    let mut composite_nodes = 0;
+    for run in 0..args.runs {
+        let t = Instant::now();
+        let g = HeightGrid::sample(&triangles, spec);
+        sample_s.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        let masks = colliding_masks(&g, &footprints, &fast, &|| {});
+        slide_s.push(t.elapsed().as_secs_f64());
+        composite_nodes = kneeform::composite(&masks).iter().filter(|&&c| c > 0).count();
+        eprintln!("run {}/{}: sample {:.3} s, push+slide {:.3} s", run + 1, args.runs, sample_s[run], slide_s[run]);
+        grid = Some(g);
+    }
+    let grid = grid.expect("at least one run");
+    let (sample, slide) = (median(sample_s), median(slide_s));
+    let total = sample + slide;
+
+    // The paper algorithm on a sample of start rows through the part and a
+    // sample of angles, against the fast one on exactly the same sample.
+    let rows: Vec<usize> = (0..args.paper_rows).map(|k| (nz / 4) + k * (nz / 2) / args.paper_rows).collect();
+    let sampled: Vec<GridFootprint> = (0..args.paper_angles)
+        .map(|k| footprints[k * (footprints.len() - 1) / (args.paper_angles - 1).max(1)].clone())
+        .collect();
+    let on_rows = |algorithm| EngineOptions {
+        algorithm,
+        start_rows: Some(rows.clone()),
+        ..EngineOptions::default()
+    };
+    let t = Instant::now();
+    let paper_masks = colliding_masks(&grid, &sampled, &on_rows(Algorithm::Paper), &|| {});
+    let paper_sample_s = t.elapsed().as_secs_f64();
+    let mut fast_runs = Vec::new();
+    let mut fast_masks = Vec::new();
+    for _ in 0..args.runs {
+        let t = Instant::now();
+        fast_masks = colliding_masks(&grid, &sampled, &on_rows(Algorithm::Fast), &|| {});
+        fast_runs.push(t.elapsed().as_secs_f64());
+    }
+    let fast_sample_s = median(fast_runs);
+    let identical = paper_masks == fast_masks;
+    let scale_up = (nz as f64 / rows.len() as f64) * (footprints.len() as f64 / sampled.len() as f64);
+    let paper_full_s = paper_sample_s * scale_up;
+
+    let mut md = String::new();
+    let threads = rayon::current_num_threads();
+    writeln!(md, "| quantity | value |")?;
+    writeln!(md, "| --- | --- |")?;
+    writeln!(md, "| part | console, {} triangles (built in {build_s:.2} s) |", triangles.len())?;
+    writeln!(md, "| grid | {nx} x {nz} at {PAPER_PITCH} mm, {} nodes sampled |", grid.finite_count())?;
+    writeln!(md, "| angles | {} (-30..30 by 1) |", footprints.len())?;
+    writeln!(md, "| threads | {threads} |")?;
+    writeln!(md, "| sampling (median of {}) | {sample:.3} s |", args.runs)?;
+    writeln!(md, "| push + slide, 61 angles (median) | {slide:.3} s |")?;
+    writeln!(md, "| per angle | {:.1} ms |", slide / footprints.len() as f64 * 1e3)?;
+    writeln!(md, "| **total (sample + 61 angles)** | **{total:.3} s** |")?;
+    writeln!(md, "| composite colliding nodes | {composite_nodes} |")?;
+    if let Some(mib) = peak_rss_mib() {
+        writeln!(md, "| peak memory (RSS) | {mib:.0} MiB |")?;
+    }
+    writeln!(
+        md,
+        "| paper algorithm, {} start rows x {} angles | {paper_sample_s:.3} s (fast on the same: {fast_sample_s:.4} s) |",
+        rows.len(),
+        sampled.len()
+    )?;
+    writeln!(md, "| paper / fast on that sample | **{:.0}x** |", paper_sample_s / fast_sample_s)?;
+    writeln!(md, "| masks identical on that sample | {identical} |")?;
+    writeln!(md, "| paper algorithm, full run (EXTRAPOLATED x{scale_up:.0}) | {paper_full_s:.0} s |")?;
+    writeln!(md, "| the paper's reported time (GPU + CPU) | {PAPER_SECONDS} s, {:.0}x ours |", PAPER_SECONDS / total)?;
+    print!("{md}");
+    if let Some(path) = &args.markdown {
+        std::fs::write(path, &md)?;
+    }
+    ensure!(identical, "the paper and fast algorithms disagree on the sampled rows");
+    Ok(())
+}

@@ -1,0 +1,96 @@
+//! The benchmark part: a console side the size of the paper's (about
+//! 1500 x 600 mm), built as a height field with the features R21 worries
+//! about: a global bulge, waves, a ridge with a wavy top, switch-like bosses
+//! and a shallow depression behind a protrusion. Tessellated to any triangle
+//! count, the paper's 369,408 included.
+//!
+//! Analysis frame: the surface faces -y, so a feature standing proud
+//! towards the knee has a *smaller* y.
+
+use crate::mesh::Triangle;
+
+/// The console's extent in x and z (mm).
+pub const CONSOLE_SIZE: [f64; 2] = [1500.0, 600.0];
+
+/// A smooth bump of unit height and radius `r` at `(cx, cz)`: `cos^2`
+/// falloff, zero outside.
+fn bump(x: f64, z: f64, cx: f64, cz: f64, r: f64) -> f64 {
+    let d = (x - cx).hypot(z - cz) / r;
+    if d >= 1.0 { 0.0 } else { (d * std::f64::consts::FRAC_PI_2).cos().powi(2) }
+}
+
+/// A smoothed box of unit height: flat top over `half` half-widths, `cos^2`
+/// shoulders of width `edge`.
+fn boss(x: f64, z: f64, c: [f64; 2], half: [f64; 2], edge: f64) -> f64 {
+    let axis = |u: f64, c: f64, h: f64| {
+        let d = ((u - c).abs() - h).max(0.0) / edge;
+        if d >= 1.0 { 0.0 } else { (d * std::f64::consts::FRAC_PI_2).cos().powi(2) }
+    };
+    axis(x, c[0], half[0]) * axis(z, c[1], half[1])
+}
+
+/// The console's surface y(x, z) in mm, for x in [0, 1500], z in [0, 600].
+pub fn console_height(x: f64, z: f64) -> f64 {
+    use std::f64::consts::TAU;
+    let [lx, lz] = CONSOLE_SIZE;
+    // A bulge towards the knee in the middle of the panel.
+    let u = (x / lx - 0.5) * 2.0;
+    let v = (z / lz - 0.5) * 2.0;
+    let mut y = 25.0 * (u * u + 0.5 * v * v);
+    // Waves along x, growing towards the front.
+    y += (2.0 + 3.0 * (1.0 - x / lx)) * (TAU * x / 160.0).sin() * bump(x, z, 400.0, 150.0, 260.0);
+    // A narrow ridge with a wavy top (the paper's Fig. 6).
+    let ridge = boss(x, z, [900.0, 420.0], [350.0, 8.0], 10.0);
+    y -= ridge * (12.0 + 3.0 * (TAU * x / 90.0).sin());
+    // Switch-like bosses standing 5-10 mm proud.
+    for (k, cx) in [1150.0, 1220.0, 1290.0].into_iter().enumerate() {
+        y -= (5.0 + 2.5 * k as f64) * boss(x, z, [cx, 200.0], [20.0, 12.0], 3.0);
+    }
+    // A protrusion with a shallow depression behind it (the paper's Fig. 2b).
+    y -= 10.0 * bump(x, z, 600.0, 450.0, 70.0);
+    y += 5.0 * bump(x, z, 760.0, 450.0, 80.0);
+    y
+}
+
+/// Tessellates the console into at least `min_triangles` triangles: a
+/// regular lattice, two triangles per cell, cells as square as possible.
+pub fn console_triangles(min_triangles: usize) -> Vec<Triangle> {
+    let [lx, lz] = CONSOLE_SIZE;
+    let cells = min_triangles.div_ceil(2).max(1) as f64;
+    let nz = (cells * lz / lx).sqrt().ceil().max(1.0) as usize;
+    let nx = (cells / nz as f64).ceil() as usize;
+    let vertex = |i: usize, k: usize| {
+        let (x, z) = (lx * i as f64 / nx as f64, lz * k as f64 / nz as f64);
+        [x, console_height(x, z), z]
+    };
+    let mut triangles = Vec::with_capacity(2 * nx * nz);
+    for k in 0..nz {
+        for i in 0..nx {
+            let (a, b, c, d) = (vertex(i, k), vertex(i + 1, k), vertex(i + 1, k + 1), vertex(i, k + 1));
+            triangles.push([a, b, c]);
+            triangles.push([a, c, d]);
+        }
+    }
+    triangles
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tessellates_to_at_least_the_paper_count() {
+        let t = console_triangles(369_408);
+        assert!(t.len() >= 369_408 && t.len() < 369_408 + 2000, "{}", t.len());
+        for v in t.iter().flatten() {
+            assert_eq!(v[1], console_height(v[0], v[2]));
+        }
+    }
+
+    #[test]
+    fn features_stand_proud_towards_the_knee() {
+        // The ridge and the bosses have a smaller y than their surroundings.
+        assert!(console_height(900.0, 420.0) < console_height(900.0, 380.0) - 5.0);
+        assert!(console_height(1290.0, 200.0) < console_height(1290.0, 250.0) - 9.0);
+    }
+}

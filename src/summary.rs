@@ -1,0 +1,90 @@
+//! `summary.json`: every parameter, input identity, count and timing of a
+//! run, so that a result can be audited and reproduced from it alone.
+
+use serde::{Deserialize, Serialize};
+
+/// The colliding area at one angle.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AngleSummary {
+    /// Knee-form angle (degrees).
+    pub angle_deg: f64,
+    /// Starts where the knee-form touched the part.
+    pub placed_starts: usize,
+    /// Grid nodes in the colliding mask.
+    pub colliding_nodes: usize,
+    /// Their area, `colliding_nodes * pitch^2` (mm^2).
+    pub colliding_area_mm2: f64,
+}
+
+/// Wall-clock time per stage (seconds).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Timings {
+    /// Reading and hashing the STL.
+    pub read_s: f64,
+    /// Sampling the height grid.
+    pub sample_s: f64,
+    /// Push and slide over every angle.
+    pub push_slide_s: f64,
+    /// Writing the output files.
+    pub write_s: f64,
+    /// Everything.
+    pub total_s: f64,
+}
+
+/// The whole run. Keys are snake_case; lengths mm, angles degrees, the
+/// bounding box in the part's own frame (after `scale`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// Version of kneeform that produced the run.
+    pub kneeform_version: String,
+    /// When the run finished (seconds since the Unix epoch, UTC).
+    pub run_unix_time: u64,
+    /// The part file as given.
+    pub input_file: String,
+    /// SHA-256 of the part file's bytes (hex).
+    pub sha256: String,
+    /// Triangles in the file.
+    pub triangles: usize,
+    /// Triangles skipped for zero area.
+    pub degenerate_triangles: usize,
+    /// Part bounding box, smallest x, y, z (mm, part frame).
+    pub bbox_min: [f64; 3],
+    /// Part bounding box, largest x, y, z (mm, part frame).
+    pub bbox_max: [f64; 3],
+    /// Factor from the file's units to mm.
+    pub scale: f64,
+    /// `left` or `right`.
+    pub side: crate::Side,
+    /// Knee-form triangle side L (mm).
+    pub triangle_side_mm: f64,
+    /// True when L is the assumed default of 200 mm.
+    pub triangle_side_assumed: bool,
+    /// Knee-form radius R (mm).
+    pub radius_mm: f64,
+    /// Knee-form thickness W (mm).
+    pub thickness_mm: f64,
+    /// Grid pitch (mm).
+    pub pitch_mm: f64,
+    /// x, z of grid node (0, 0) (mm).
+    pub grid_origin: [f64; 2],
+    /// Nodes along x, z.
+    pub grid_size: [usize; 2],
+    /// Nodes with a finite height.
+    pub sampled_nodes: usize,
+    /// Angles analysed (degrees).
+    pub angles_deg: Vec<f64>,
+    /// Contact tolerance eps (mm).
+    pub eps_mm: f64,
+    /// `fast` or `paper`.
+    pub algorithm: crate::Algorithm,
+    /// Worker threads.
+    pub threads: usize,
+    /// Per angle, in the order of `angles_deg`.
+    pub per_angle: Vec<AngleSummary>,
+    /// Nodes colliding at some angle.
+    pub composite_nodes: usize,
+    /// Their area (mm^2).
+    pub composite_area_mm2: f64,
+    /// Time per stage.
+    pub timings: Timings,
+}

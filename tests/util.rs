@@ -1,0 +1,190 @@
+//! Helpers shared by the integration tests: seeded random height grids and a
+//! brute-force transcription of SPEC's push and slide that shares no code
+//! with the engine (its own footprint geometry, its own ordering).
+
+use kneeform::{GridSpec, HeightGrid, KneeForm};
+
+/// The fixed seeds of every randomised test, in one place.
+pub const SEEDS: [u64; 4] = [0x5eed_0001, 0x5eed_0002, 0xdead_beef, 42];
+
+/// SplitMix64: tiny, seedable, good enough to draw test grids.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Rng {
+        Rng(seed)
+    }
+
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1).
+    pub fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// A random height grid: a tilt, a smooth undulation plus noise, heights quantised
+/// to 0.5 mm so that exact ties (and exact-eps differences) occur, with
+/// holes (`+inf`) and a few blocks that stand proud.
+pub fn random_grid(seed: u64, nx: usize, nz: usize, pitch: f64) -> HeightGrid {
+    let mut rng = Rng::new(seed);
+    let spec = GridSpec {
+        pitch,
+        i_origin: (rng.next_u64() % 7) as i64 - 3,
+        j_origin: (rng.next_u64() % 7) as i64 - 3,
+        nx,
+        nz,
+    };
+    let (fx, fz, amp) = (rng.unit() * 0.2, rng.unit() * 0.2, 2.0 + 10.0 * rng.unit());
+    let hole = 0.03 + 0.1 * rng.unit();
+    // A tilt towards the knee-form as it slides (-x): nodes in front stick
+    // out further than the footprint's, so slides strike them.
+    let tilt = 0.05 + 0.25 * rng.unit();
+    let mut h = Vec::with_capacity(nx * nz);
+    for j in 0..nz {
+        for i in 0..nx {
+            let (x, z) = (spec.x(i), spec.z(j));
+            let v = amp * (fx * x).sin() * (fz * z).cos() + 3.0 * rng.unit() + tilt * x;
+            let v = if rng.unit() < 0.02 { v - 8.0 } else { v };
+            h.push(if rng.unit() < hole { f64::INFINITY } else { (v * 2.0).round() / 2.0 });
+        }
+    }
+    HeightGrid { spec, h }
+}
+
+/// The rotated triangle of SPEC at `angle_deg`, as (x, z).
+fn triangle(knee: &KneeForm, angle_deg: f64) -> [[f64; 2]; 3] {
+    let t = angle_deg.to_radians();
+    let l = knee.triangle_side;
+    [[0.0, 0.0], [l * 3f64.sqrt() / 2.0, l / 2.0], [l * 3f64.sqrt() / 2.0, -l / 2.0]]
+        .map(|[x, z]| [x * t.cos() - z * t.sin(), x * t.sin() + z * t.cos()])
+}
+
+/// Distance from (x, z) to the filled triangle.
+fn distance_to_triangle(v: &[[f64; 2]; 3], x: f64, z: f64) -> f64 {
+    let cross = |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]) * (z - a[1]) - (b[1] - a[1]) * (x - a[0]);
+    let s = [cross(v[0], v[1]), cross(v[1], v[2]), cross(v[2], v[0])];
+    if s.iter().all(|&c| c >= 0.0) || s.iter().all(|&c| c <= 0.0) {
+        return 0.0;
+    }
+    (0..3)
+        .map(|k| {
+            let (a, b) = (v[k], v[(k + 1) % 3]);
+            let (ex, ez) = (b[0] - a[0], b[1] - a[1]);
+            let t = (((x - a[0]) * ex + (z - a[1]) * ez) / (ex * ex + ez * ez)).clamp(0.0, 1.0);
+            (x - a[0] - t * ex).hypot(z - a[1] - t * ez)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// SPEC's closed-set tolerance (mm).
+const TOL: f64 = 1e-9;
+
+/// The left end `a(dz)` of the footprint's row, by bisection on the
+/// distance function (independent of the engine's closed form), or `None`
+/// when the row misses the footprint.
+fn row_start(v: &[[f64; 2]; 3], r: f64, dz: f64) -> Option<f64> {
+    // The distance along the row is convex; its minimum is near the
+    // triangle's x-range.
+    let xs = v.map(|p| p[0]);
+    let (mut lo, mut hi) = (xs.iter().copied().fold(f64::INFINITY, f64::min), xs.iter().copied().fold(f64::NEG_INFINITY, f64::max));
+    // Ternary search for the closest point of the row.
+    for _ in 0..200 {
+        let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
+        if distance_to_triangle(v, m1, dz) <= distance_to_triangle(v, m2, dz) {
+            hi = m2;
+        } else {
+            lo = m1;
+        }
+    }
+    let centre = (lo + hi) / 2.0;
+    if distance_to_triangle(v, centre, dz) > r + TOL {
+        return None;
+    }
+    let (mut out, mut inn) = (centre - 4.0 * r - 1000.0, centre);
+    for _ in 0..200 {
+        let mid = (out + inn) / 2.0;
+        if distance_to_triangle(v, mid, dz) <= r { inn = mid } else { out = mid }
+    }
+    Some(inn)
+}
+
+/// SPEC's push and slide, transcribed per start: every node's membership
+/// from the distance to the footprint, every slide sorted in full. Returns
+/// the colliding mask and the number of placed starts.
+pub fn brute_force(grid: &HeightGrid, knee: &KneeForm, angle_deg: f64, eps: f64) -> (Vec<u8>, usize) {
+    let GridSpec { nx, nz, pitch: p, .. } = grid.spec;
+    let v = triangle(knee, angle_deg);
+    let r = knee.radius;
+    let mut mask = vec![0u8; nx * nz];
+    let mut placed = 0;
+    for j0 in 0..nz {
+        // Row starts per row offset, shared by the starts of this row.
+        let rows: Vec<(usize, f64)> = (0..nz)
+            .filter_map(|j| {
+                let dz = (j as f64 - j0 as f64) * p;
+                row_start(&v, r, dz).map(|a| (j, a))
+            })
+            .collect();
+        for i0 in 0..nx {
+            let mut yr = f64::INFINITY;
+            let mut front: Vec<(f64, usize)> = Vec::new();
+            for &(j, a) in &rows {
+                let dz = (j as f64 - j0 as f64) * p;
+                for i in 0..nx {
+                    let dx = (i as f64 - i0 as f64) * p;
+                    let node = j * nx + i;
+                    if distance_to_triangle(&v, dx, dz) <= r + TOL {
+                        yr = yr.min(grid.h[node]);
+                    } else if dx < a {
+                        front.push((a - dx, node));
+                    }
+                }
+            }
+            if yr == f64::INFINITY {
+                continue;
+            }
+            placed += 1;
+            front.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let mut f = yr;
+            let mut k = 0;
+            while k < front.len() {
+                let mut end = k + 1;
+                while end < front.len() && front[end].0 - front[end - 1].0 <= TOL {
+                    end += 1;
+                }
+                let mut gmin = f64::INFINITY;
+                for &(_, node) in &front[k..end] {
+                    let h = grid.h[node];
+                    if h < f - eps {
+                        mask[node] = 1;
+                    }
+                    gmin = gmin.min(h);
+                }
+                f = f.min(gmin);
+                k = end;
+            }
+        }
+    }
+    (mask, placed)
+}
+
+/// Renders a mask difference for an assertion message.
+pub fn mask_diff(grid: &HeightGrid, got: &[u8], want: &[u8]) -> String {
+    let nx = grid.spec.nx;
+    let diffs: Vec<String> = got
+        .iter()
+        .zip(want)
+        .enumerate()
+        .filter(|(_, (g, w))| g != w)
+        .take(10)
+        .map(|(n, (g, w))| format!("(i={}, j={}): got {g} want {w}", n % nx, n / nx))
+        .collect();
+    format!("{} differing nodes, first: {}", got.iter().zip(want).filter(|(g, w)| g != w).count(), diffs.join("; "))
+}
