@@ -1,1 +1,206 @@
-//! Result files: CSV, STL and PNG (being written).
+//! Result files: the colliding points and the composite as CSV, the
+//! colliding area as a binary STL surface, and the height grid and the
+//! composite as PNG images.
+//!
+//! * [`write_colliding_points`], [`write_composite`]: CSV tables, one row
+//!   per node, in the part's own coordinates (mm);
+//! * [`write_colliding_area`]: the composite area as a triangle surface in
+//!   the part's coordinates (mm), facing the knee;
+//! * [`write_depth_png`], [`write_composite_png`]: images with mm axes, the
+//!   vehicle front (-x) on the left and z up;
+//! * [`OutputDir`]: every file of a run is written into a staging directory
+//!   and moved under its final name only when the run succeeds, so a reader
+//!   never sees a half-written result.
+//!
+//! **Invariant:** nothing here changes a result; writers only format what
+//! the engine computed, mapping y back to the part with [`Side::to_part`].
+//!
+//! [`Side::to_part`]: crate::mesh::Side::to_part
+
+use std::io;
+use std::path::{Path, PathBuf};
+
+mod csv;
+mod png;
+mod stl;
+
+pub use self::csv::{write_colliding_points, write_composite};
+pub use self::png::{PngError, write_composite_png, write_depth_png};
+pub(crate) use self::stl::to_stl_triangle;
+pub use self::stl::write_colliding_area;
+
+/// A result directory written atomically: files go into a hidden sibling
+/// staging directory (`<parent>/.<name>.partial-<pid>`) and are renamed
+/// into the final directory by [`OutputDir::commit`]. Dropped without a
+/// commit, the staging directory and everything in it are removed.
+///
+/// Renames within one file system are atomic, and the staging directory is
+/// a sibling of the final one, so each file appears complete or not at all.
+#[derive(Debug)]
+pub struct OutputDir {
+    final_dir: PathBuf,
+    staging: PathBuf,
+    committed: bool,
+}
+
+impl OutputDir {
+    /// Creates the staging directory next to `final_dir` (which need not
+    /// exist yet). A stale staging directory of the same name, left by a
+    /// crashed process that had the same id, is cleared first.
+    pub fn stage(final_dir: &Path) -> io::Result<OutputDir> {
+        let name = final_dir.file_name().ok_or_else(|| {
+            io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!("{} does not name a directory", final_dir.display()),
+            )
+        })?;
+        let parent = match final_dir.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        std::fs::create_dir_all(&parent)?;
+        let mut staged_name = std::ffi::OsString::from(".");
+        staged_name.push(name);
+        staged_name.push(format!(".partial-{}", std::process::id()));
+        let staging = parent.join(staged_name);
+        if staging.exists() {
+            std::fs::remove_dir_all(&staging)?;
+        }
+        std::fs::create_dir(&staging)?;
+        Ok(OutputDir {
+            final_dir: final_dir.to_path_buf(),
+            staging,
+            committed: false,
+        })
+    }
+
+    /// Where to write the file `file_name`: inside the staging directory.
+    pub fn path(&self, file_name: impl AsRef<Path>) -> PathBuf {
+        self.staging.join(file_name)
+    }
+
+    /// The directory the files will be in after [`OutputDir::commit`].
+    pub fn final_dir(&self) -> &Path {
+        &self.final_dir
+    }
+
+    /// Moves every staged entry into the final directory (created if
+    /// missing; files of the same name are replaced), then removes the
+    /// staging directory. Entries are moved in name order, so a failure
+    /// part way leaves a predictable prefix.
+    pub fn commit(mut self) -> io::Result<()> {
+        std::fs::create_dir_all(&self.final_dir)?;
+        let mut names: Vec<_> = std::fs::read_dir(&self.staging)?
+            .map(|entry| entry.map(|e| e.file_name()))
+            .collect::<io::Result<_>>()?;
+        names.sort();
+        for name in names {
+            std::fs::rename(self.staging.join(&name), self.final_dir.join(&name))?;
+        }
+        std::fs::remove_dir(&self.staging)?;
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for OutputDir {
+    fn drop(&mut self) {
+        if !self.committed {
+            // Best effort: a failure to clean up must not hide the error
+            // that caused the drop.
+            let _ = std::fs::remove_dir_all(&self.staging);
+        }
+    }
+}
+
+#[cfg(test)]
+pub(crate) fn temp_dir(tag: &str) -> PathBuf {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static NEXT: AtomicUsize = AtomicUsize::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "kneeform-test-{}-{tag}-{}",
+        std::process::id(),
+        NEXT.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn entries(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn commit_moves_files_under_their_final_names() {
+        let root = temp_dir("commit");
+        let final_dir = root.join("run");
+        let out = OutputDir::stage(&final_dir).unwrap();
+        std::fs::write(out.path("a.csv"), "angle_deg\n").unwrap();
+        std::fs::write(out.path("b.stl"), [1u8, 2, 3]).unwrap();
+        // Nothing is visible under the final name before the commit.
+        assert!(!final_dir.exists());
+        assert_eq!(
+            entries(&root),
+            [".run.partial-".to_string() + &std::process::id().to_string()]
+        );
+        out.commit().unwrap();
+        assert_eq!(entries(&final_dir), ["a.csv", "b.stl"]);
+        assert_eq!(
+            std::fs::read_to_string(final_dir.join("a.csv")).unwrap(),
+            "angle_deg\n"
+        );
+        // The staging directory is gone.
+        assert_eq!(entries(&root), ["run"]);
+        std::fs::remove_dir_all(root).unwrap();
+    }
+
+    #[test]
+    fn commit_replaces_files_of_an_earlier_run() {
+        let root = temp_dir("replace");
+        let final_dir = root.join("run");
+        std::fs::create_dir(&final_dir).unwrap();
+        std::fs::write(final_dir.join("a.csv"), "old").unwrap();
+        std::fs::write(final_dir.join("keep.txt"), "kept").unwrap();
+        let out = OutputDir::stage(&final_dir).unwrap();
+        std::fs::write(out.path("a.csv"), "new").unwrap();
+        out.commit().unwrap();
+        assert_eq!(
+            std::fs::read_to_string(final_dir.join("a.csv")).unwrap(),
+            "new"
+        );
+        assert_eq!(entries(&final_dir), ["a.csv", "keep.txt"]);
+        std::fs::remove_dir_all(root).unwrap();
+    }
+
+    #[test]
+    fn drop_without_commit_leaves_nothing() {
+        let root = temp_dir("drop");
+        let final_dir = root.join("run");
+        {
+            let out = OutputDir::stage(&final_dir).unwrap();
+            std::fs::write(out.path("half.csv"), "angle_deg,i").unwrap();
+            assert!(out.path("half.csv").exists());
+        }
+        assert!(entries(&root).is_empty());
+        std::fs::remove_dir_all(root).unwrap();
+    }
+
+    #[test]
+    fn a_bare_name_stages_in_the_current_directory() {
+        let out = OutputDir::stage(Path::new("kneeform-unit-test-out")).unwrap();
+        assert_eq!(
+            out.path("x").parent().unwrap().parent().unwrap(),
+            Path::new(".")
+        );
+        assert!(OutputDir::stage(Path::new("/")).is_err());
+    }
+}

@@ -1,0 +1,215 @@
+//! CSV tables of the result: the colliding points of every angle, and the
+//! composite count per node.
+//!
+//! Coordinates are the part's own (mm): x and z are the node's, y is its
+//! height mapped back with [`Side::to_part`]. Rows come in a fixed order
+//! (angle, then row j, then column i) and numbers in Rust's shortest
+//! round-trip form, so the same result always gives the same bytes.
+
+use std::fmt::Write as _;
+use std::io::{self, Write};
+
+use crate::engine::AngleMask;
+use crate::grid::HeightGrid;
+use crate::mesh::Side;
+
+/// Writes `angle_deg,i,j,x,y,z`: one row per colliding node per angle, in
+/// increasing angle (degrees), then j, then i. x and z are the node's (mm),
+/// y its height in the part's frame (mm).
+///
+/// Fails with [`io::ErrorKind::InvalidInput`] when a mask does not have one
+/// entry per grid node.
+pub fn write_colliding_points<W: Write>(
+    w: W,
+    grid: &HeightGrid,
+    masks: &[AngleMask],
+    side: Side,
+) -> csv::Result<()> {
+    for m in masks {
+        check_len("colliding mask", m.mask.len(), grid)?;
+    }
+    let mut order: Vec<&AngleMask> = masks.iter().collect();
+    order.sort_by(|a, b| a.angle_deg.total_cmp(&b.angle_deg));
+    let mut out = csv::Writer::from_writer(w);
+    out.write_record(["angle_deg", "i", "j", "x", "y", "z"])?;
+    let mut row = Row::default();
+    for m in order {
+        for (k, _) in m.mask.iter().enumerate().filter(|&(_, &v)| v != 0) {
+            row.start();
+            row.num(m.angle_deg);
+            row.node(grid, k, side);
+            out.write_record(row.fields())?;
+        }
+    }
+    out.flush()?;
+    Ok(())
+}
+
+/// Writes `i,j,x,y,z,angles`: one row per node that at least one angle
+/// marks colliding, in increasing j, then i; `angles` is the composite
+/// count. Coordinates as in [`write_colliding_points`].
+///
+/// Fails with [`io::ErrorKind::InvalidInput`] when `composite` does not have
+/// one entry per grid node.
+pub fn write_composite<W: Write>(
+    w: W,
+    grid: &HeightGrid,
+    composite: &[u16],
+    side: Side,
+) -> csv::Result<()> {
+    check_len("composite", composite.len(), grid)?;
+    let mut out = csv::Writer::from_writer(w);
+    out.write_record(["i", "j", "x", "y", "z", "angles"])?;
+    let mut row = Row::default();
+    for (k, &count) in composite.iter().enumerate().filter(|&(_, &c)| c > 0) {
+        row.start();
+        row.node(grid, k, side);
+        row.int(usize::from(count));
+        out.write_record(row.fields())?;
+    }
+    out.flush()?;
+    Ok(())
+}
+
+fn check_len(what: &str, len: usize, grid: &HeightGrid) -> csv::Result<()> {
+    if len == grid.spec.len() {
+        return Ok(());
+    }
+    Err(io::Error::new(
+        io::ErrorKind::InvalidInput,
+        format!(
+            "{what} has {len} entries but the grid has {} x {} = {} nodes",
+            grid.spec.nx,
+            grid.spec.nz,
+            grid.spec.len()
+        ),
+    )
+    .into())
+}
+
+/// One record's fields, formatted into one reused buffer.
+#[derive(Default)]
+struct Row {
+    text: String,
+    ends: Vec<usize>,
+}
+
+impl Row {
+    fn start(&mut self) {
+        self.text.clear();
+        self.ends.clear();
+    }
+
+    /// Shortest round-trip decimal; -0 is written as 0 (mirroring a zero
+    /// height for the right side must not change the file).
+    fn num(&mut self, v: f64) {
+        let v = if v == 0.0 { 0.0 } else { v };
+        write!(self.text, "{v}").expect("writing to a String cannot fail");
+        self.ends.push(self.text.len());
+    }
+
+    fn int(&mut self, v: usize) {
+        write!(self.text, "{v}").expect("writing to a String cannot fail");
+        self.ends.push(self.text.len());
+    }
+
+    /// `i, j, x, y, z` of node `k` (row-major index) in the part's frame.
+    fn node(&mut self, grid: &HeightGrid, k: usize, side: Side) {
+        let (i, j) = (k % grid.spec.nx, k / grid.spec.nx);
+        self.int(i);
+        self.int(j);
+        self.num(grid.spec.x(i));
+        self.num(side.to_part(grid.h[k]));
+        self.num(grid.spec.z(j));
+    }
+
+    fn fields(&self) -> impl Iterator<Item = &str> {
+        let starts = std::iter::once(0).chain(self.ends.iter().copied());
+        starts.zip(&self.ends).map(|(a, &b)| &self.text[a..b])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::GridSpec;
+
+    /// A 3 x 2 grid at pitch 0.5 starting at x = -1, z = 2.
+    fn grid() -> HeightGrid {
+        HeightGrid {
+            spec: GridSpec {
+                pitch: 0.5,
+                i_origin: -2,
+                j_origin: 4,
+                nx: 3,
+                nz: 2,
+            },
+            h: vec![0.0, 1.25, -3.0, 0.1, f64::INFINITY, 7.0],
+        }
+    }
+
+    fn mask(angle_deg: f64, mask: Vec<u8>) -> AngleMask {
+        AngleMask {
+            angle_deg,
+            colliding: mask.iter().filter(|&&m| m != 0).count(),
+            mask,
+            placed: 1,
+        }
+    }
+
+    fn text(write: impl FnOnce(&mut Vec<u8>)) -> String {
+        let mut buf = Vec::new();
+        write(&mut buf);
+        String::from_utf8(buf).unwrap()
+    }
+
+    #[test]
+    fn colliding_points_sorted_by_angle_then_row_then_column() {
+        let g = grid();
+        let masks = [
+            mask(5.0, vec![0, 0, 1, 1, 0, 0]),
+            mask(-30.0, vec![1, 1, 0, 0, 0, 1]),
+        ];
+        let out = text(|buf| write_colliding_points(buf, &g, &masks, Side::Left).unwrap());
+        assert_eq!(
+            out,
+            "angle_deg,i,j,x,y,z\n\
+             -30,0,0,-1,0,2\n\
+             -30,1,0,-0.5,1.25,2\n\
+             -30,2,1,0,7,2.5\n\
+             5,2,0,0,-3,2\n\
+             5,0,1,-1,0.1,2.5\n"
+        );
+    }
+
+    #[test]
+    fn right_side_mirrors_y_back_to_the_part() {
+        let g = grid();
+        let masks = [mask(0.0, vec![1, 0, 1, 0, 0, 0])];
+        let out = text(|buf| write_colliding_points(buf, &g, &masks, Side::Right).unwrap());
+        // h = 0 stays "0", not "-0"; h = -3 becomes +3.
+        assert_eq!(out, "angle_deg,i,j,x,y,z\n0,0,0,-1,0,2\n0,2,0,0,3,2\n");
+    }
+
+    #[test]
+    fn composite_lists_counted_nodes_only() {
+        let g = grid();
+        let out = text(|buf| write_composite(buf, &g, &[0, 3, 0, 61, 0, 1], Side::Left).unwrap());
+        assert_eq!(
+            out,
+            "i,j,x,y,z,angles\n\
+             1,0,-0.5,1.25,2,3\n\
+             0,1,-1,0.1,2.5,61\n\
+             2,1,0,7,2.5,1\n"
+        );
+    }
+
+    #[test]
+    fn wrong_length_is_refused() {
+        let g = grid();
+        let err = write_composite(Vec::new(), &g, &[1, 2], Side::Left).unwrap_err();
+        assert!(err.to_string().contains("2 entries"), "{err}");
+        let err = write_colliding_points(Vec::new(), &g, &[mask(0.0, vec![1])], Side::Left);
+        assert!(err.is_err());
+    }
+}

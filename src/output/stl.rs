@@ -1,0 +1,244 @@
+//! The colliding area as a binary STL surface, for viewing over the part in
+//! a CAD tool.
+//!
+//! The surface is polyhedral over the grid: adjacent colliding nodes are
+//! joined (a cell with four colliding corners gives two triangles, one with
+//! exactly three gives the triangle of those three), and a colliding node
+//! that ends up in no triangle, isolated or only on a line of nodes, gets a
+//! small flat square so that it is still visible. Vertices sit at the nodes'
+//! heights, so the surface lies on the part.
+//!
+//! Triangles face the knee: -y in the analysis frame. For the right side y
+//! is mirrored back to the part, and a mirror reverses the sense of
+//! rotation, so the vertex order is reversed too; normal and winding then
+//! agree (right-hand rule) and the normal faces +y, the knee's side there.
+
+use std::io::{self, Write};
+
+use crate::grid::HeightGrid;
+use crate::mesh::{Side, Triangle};
+
+/// Side of the square patch drawn on an otherwise unconnected colliding
+/// node, as a fraction of the pitch: small enough not to be mistaken for a
+/// cell, large enough to see.
+const PATCH_FRACTION: f64 = 0.25;
+
+/// Writes the composite area (nodes with `composite > 0`) as a binary STL
+/// in the part's coordinates (mm; vertex `(x, side.to_part(h), z)`), facing
+/// the knee. Returns the number of triangles written.
+///
+/// Fails with [`io::ErrorKind::InvalidInput`] when `composite` does not have
+/// one entry per grid node.
+pub fn write_colliding_area<W: Write>(
+    mut w: W,
+    grid: &HeightGrid,
+    composite: &[u16],
+    side: Side,
+) -> io::Result<usize> {
+    if composite.len() != grid.spec.len() {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "composite has {} entries but the grid has {} nodes",
+                composite.len(),
+                grid.spec.len()
+            ),
+        ));
+    }
+    let triangles: Vec<stl_io::Triangle> = colliding_area(grid, composite)
+        .iter()
+        .map(|t| to_stl_triangle(&to_part(t, side)))
+        .collect();
+    stl_io::write_stl(&mut w, triangles.iter())?;
+    Ok(triangles.len())
+}
+
+/// The area's triangles in the analysis frame, wound counter-clockwise in
+/// (x, z) so that their normals face -y.
+fn colliding_area(grid: &HeightGrid, composite: &[u16]) -> Vec<Triangle> {
+    let (nx, nz) = (grid.spec.nx, grid.spec.nz);
+    let hit = |i: usize, j: usize| composite[j * nx + i] > 0;
+    let vertex = |i: usize, j: usize| [grid.spec.x(i), grid.h[j * nx + i], grid.spec.z(j)];
+    let mut used = vec![false; composite.len()];
+    let mut out = Vec::new();
+    for j in 0..nz.saturating_sub(1) {
+        for i in 0..nx.saturating_sub(1) {
+            // Corners counter-clockwise in (x, z): x to the right, z up.
+            let corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
+            let on: Vec<(usize, usize)> = corners.into_iter().filter(|&(a, b)| hit(a, b)).collect();
+            let tris: &[[usize; 3]] = match on.len() {
+                4 => &[[0, 1, 2], [0, 2, 3]],
+                // Dropping one corner keeps the others' cyclic order.
+                3 => &[[0, 1, 2]],
+                _ => &[],
+            };
+            for t in tris {
+                out.push(t.map(|k| vertex(on[k].0, on[k].1)));
+            }
+            if !tris.is_empty() {
+                for &(a, b) in &on {
+                    used[b * nx + a] = true;
+                }
+            }
+        }
+    }
+    let half = 0.5 * PATCH_FRACTION * grid.spec.pitch;
+    for (k, _) in composite
+        .iter()
+        .enumerate()
+        .filter(|&(k, &c)| c > 0 && !used[k])
+    {
+        let [x, y, z] = vertex(k % nx, k / nx);
+        let c = [
+            [x - half, y, z - half],
+            [x + half, y, z - half],
+            [x + half, y, z + half],
+            [x - half, y, z + half],
+        ];
+        out.push([c[0], c[1], c[2]]);
+        out.push([c[0], c[2], c[3]]);
+    }
+    out
+}
+
+/// Maps an analysis-frame triangle to the part: y mirrored for the right
+/// side, with two vertices swapped so the winding still gives the normal.
+fn to_part(t: &Triangle, side: Side) -> Triangle {
+    let [a, b, c] = t.map(|[x, y, z]| [x, side.to_part(y), z]);
+    match side {
+        Side::Left => [a, b, c],
+        Side::Right => [a, c, b],
+    }
+}
+
+/// An STL triangle with its unit normal from the winding (right-hand rule);
+/// zero for a degenerate triangle.
+pub(crate) fn to_stl_triangle(t: &Triangle) -> stl_io::Triangle {
+    let [a, b, c] = *t;
+    let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let n = [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ];
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    let unit = if len > 0.0 {
+        n.map(|v| v / len)
+    } else {
+        [0.0; 3]
+    };
+    stl_io::Triangle {
+        normal: stl_io::Normal::new(unit.map(|v| v as f32)),
+        vertices: t.map(|v| stl_io::Vertex::new(v.map(|c| c as f32))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::GridSpec;
+
+    /// A 4 x 4 grid at pitch 2 with heights `h = i + 10 j` (finite).
+    fn grid() -> HeightGrid {
+        let spec = GridSpec {
+            pitch: 2.0,
+            i_origin: 0,
+            j_origin: 0,
+            nx: 4,
+            nz: 4,
+        };
+        let h = (0..16)
+            .map(|k| (k % 4) as f64 + 10.0 * (k / 4) as f64)
+            .collect();
+        HeightGrid { spec, h }
+    }
+
+    fn composite_of(nodes: &[(usize, usize)]) -> Vec<u16> {
+        let mut c = vec![0u16; 16];
+        for &(i, j) in nodes {
+            c[j * 4 + i] = 1;
+        }
+        c
+    }
+
+    fn read_back(bytes: &[u8]) -> Vec<stl_io::Triangle> {
+        let mut cursor = io::Cursor::new(bytes);
+        stl_io::create_stl_reader(&mut cursor)
+            .unwrap()
+            .map(Result::unwrap)
+            .collect()
+    }
+
+    fn cross_y(t: &stl_io::Triangle) -> f32 {
+        let [a, b, c] = t.vertices;
+        (b[2] - a[2]) * (c[0] - a[0]) - (b[0] - a[0]) * (c[2] - a[2])
+    }
+
+    fn write(composite: &[u16], side: Side) -> (usize, Vec<stl_io::Triangle>) {
+        let mut buf = Vec::new();
+        let n = write_colliding_area(&mut buf, &grid(), composite, side).unwrap();
+        assert_eq!(buf.len(), 84 + 50 * n);
+        (n, read_back(&buf))
+    }
+
+    #[test]
+    fn a_two_by_two_block_is_two_triangles_on_the_nodes() {
+        let (n, tris) = write(&composite_of(&[(1, 1), (2, 1), (1, 2), (2, 2)]), Side::Left);
+        assert_eq!(n, 2);
+        for t in &tris {
+            for v in t.vertices {
+                // Each vertex is a node (x = 2 i, z = 2 j) at its height.
+                let (i, j) = ((v[0] / 2.0) as usize, (v[2] / 2.0) as usize);
+                assert!((1..=2).contains(&i) && (1..=2).contains(&j));
+                assert_eq!(v[1], (i + 10 * j) as f32);
+            }
+        }
+    }
+
+    #[test]
+    fn three_corners_give_one_triangle_and_a_line_gives_patches() {
+        let (n, _) = write(&composite_of(&[(0, 0), (1, 0), (0, 1)]), Side::Left);
+        assert_eq!(n, 1);
+        // Two nodes side by side form no cell: each gets its own patch.
+        let (n, _) = write(&composite_of(&[(0, 3), (1, 3)]), Side::Left);
+        assert_eq!(n, 4);
+    }
+
+    #[test]
+    fn an_isolated_node_is_a_small_flat_patch_centred_on_it() {
+        let (n, tris) = write(&composite_of(&[(2, 1)]), Side::Left);
+        assert_eq!(n, 2);
+        let vs: Vec<_> = tris.iter().flat_map(|t| t.vertices).collect();
+        let (xs, zs): (Vec<f32>, Vec<f32>) = vs.iter().map(|v| (v[0], v[2])).unzip();
+        let span = |v: &[f32]| {
+            let lo = v.iter().copied().fold(f32::INFINITY, f32::min);
+            let hi = v.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+            (lo, hi)
+        };
+        // Side pitch / 4 = 0.5 around the node (x, z) = (4, 2).
+        assert_eq!(span(&xs), (3.75, 4.25));
+        assert_eq!(span(&zs), (1.75, 2.25));
+        assert!(vs.iter().all(|v| v[1] == 12.0));
+    }
+
+    #[test]
+    fn normals_face_the_knee_and_agree_with_the_winding_on_both_sides() {
+        let nodes = composite_of(&[(0, 0), (1, 0), (0, 1), (1, 1), (2, 1), (3, 3)]);
+        let (_, left) = write(&nodes, Side::Left);
+        let (_, right) = write(&nodes, Side::Right);
+        assert_eq!(left.len(), right.len());
+        for (l, r) in left.iter().zip(&right) {
+            // Knee side: -y on the left, +y (mirrored) on the right.
+            assert!(l.normal[1] < 0.0 && r.normal[1] > 0.0, "{l:?} {r:?}");
+            assert!(cross_y(l) * l.normal[1] > 0.0);
+            // Mirroring maps y to -y and reverses the winding.
+            assert!(cross_y(r) * r.normal[1] > 0.0);
+            assert_eq!(r.normal[0], l.normal[0]);
+            assert_eq!(r.normal[1], -l.normal[1]);
+            let mirrored: Vec<[f32; 3]> = l.vertices.iter().map(|v| [v[0], -v[1], v[2]]).collect();
+            let got: Vec<[f32; 3]> = r.vertices.iter().map(|v| [v[0], v[1], v[2]]).collect();
+            assert_eq!(got, [mirrored[0], mirrored[2], mirrored[1]]);
+        }
+    }
+}
