@@ -14,15 +14,16 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
 use crate::grid::HeightGrid;
 
 /// Largest plot area width (pixels); the whole image stays under 1600.
-pub const MAX_PLOT_W: usize = 1300;
+const MAX_PLOT_W: usize = 1300;
 /// Largest plot area height (pixels).
-pub const MAX_PLOT_H: usize = 900;
+const MAX_PLOT_H: usize = 900;
 /// Small grids are enlarged until the longer side reaches this (pixels).
 const MIN_PLOT: usize = 480;
 
@@ -95,18 +96,12 @@ pub fn write_depth_png(path: &Path, grid: &HeightGrid) -> Result<(), PngError> {
     };
     let pixels: Vec<RGBColor> = heights.into_iter().map(colour).collect();
     draw_plot(path, grid, &raster, &pixels, &title, |area| {
-        let mut bar = ChartBuilder::on(area)
-            .margin_top(TITLE_H as u32)
-            .margin_bottom((MARGIN + X_LABELS) as u32)
-            .margin_left(20)
-            .set_label_area_size(LabelAreaPosition::Right, 90)
-            .build_cartesian_2d(0.0..1.0, h_lo..h_hi)?;
+        let mut bar = colour_bar(area, "y (mm)", h_lo..h_hi)?;
         bar.configure_mesh()
             .disable_mesh()
             .disable_x_axis()
-            .y_desc("y (mm, analysis frame)")
+            .y_label_formatter(&tick)
             .label_style((FONT, 13))
-            .axis_desc_style((FONT, 14))
             .draw()?;
         // A smooth bar: enough bands that neighbours differ by under one
         // colour step.
@@ -154,12 +149,7 @@ pub fn write_composite_png(
         .collect();
     draw_plot(path, grid, &raster, &pixels, title, |area| {
         let top = n as f64 + 0.5;
-        let mut bar = ChartBuilder::on(area)
-            .margin_top(TITLE_H as u32)
-            .margin_bottom((MARGIN + X_LABELS) as u32)
-            .margin_left(20)
-            .set_label_area_size(LabelAreaPosition::Right, 90)
-            .build_cartesian_2d(0.0..1.0, 0.5..top)?;
+        let mut bar = colour_bar(area, "angles", 0.5..top)?;
         let whole = |v: &f64| {
             if (v - v.round()).abs() < 1e-9 {
                 format!("{}", v.round())
@@ -172,9 +162,7 @@ pub fn write_composite_png(
             .disable_x_axis()
             .y_labels(n.min(12))
             .y_label_formatter(&whole)
-            .y_desc("angles colliding")
             .label_style((FONT, 13))
-            .axis_desc_style((FONT, 14))
             .draw()?;
         bar.draw_series((1..=n).map(|c| {
             let y = c as f64;
@@ -284,8 +272,8 @@ impl Raster {
 }
 
 type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
-type DrawResult =
-    Result<(), DrawingAreaErrorKind<<BitMapBackend<'static> as DrawingBackend>::ErrorType>>;
+type DrawError = DrawingAreaErrorKind<<BitMapBackend<'static> as DrawingBackend>::ErrorType>;
+type DrawResult = Result<(), DrawError>;
 
 /// Draws the title, the pixels (row-major from the top) in a plot with mm
 /// axes, and, through `legend`, the colour bar on the right; then encodes.
@@ -340,6 +328,8 @@ fn draw_plot(
         chart
             .configure_mesh()
             .disable_mesh()
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
             .x_desc("x (mm), vehicle front \u{2190}")
             .y_desc("z (mm), up")
             .label_style((FONT, 13))
@@ -349,6 +339,37 @@ fn draw_plot(
         root.present()
     };
     draw().map_err(|e| failed(&e))
+}
+
+/// The colour bar's frame in `area` (the image's right strip): a bar with
+/// value labels on its right, `label` above it, spanning the plot's height.
+fn colour_bar<'a, 'b>(
+    area: &'a Area<'b>,
+    label: &str,
+    values: Range<f64>,
+) -> Result<
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    DrawError,
+> {
+    area.draw_text(
+        label,
+        &(FONT, 14).into_text_style(area),
+        (20, TITLE_H as i32 - 20),
+    )?;
+    ChartBuilder::on(area)
+        .margin_top(TITLE_H as u32)
+        .margin_bottom((MARGIN + X_LABELS) as u32)
+        .margin_left(20)
+        .margin_right(MARGIN as u32)
+        .set_label_area_size(LabelAreaPosition::Right, 70)
+        .build_cartesian_2d(0.0..1.0, values)
+}
+
+/// An axis tick in mm: rounded to 1e-6 to hide the float noise of tick
+/// arithmetic, with no trailing zeros (`300`, `12.5`).
+fn tick(v: &f64) -> String {
+    let r = (v * 1e6).round() / 1e6;
+    format!("{}", if r == 0.0 { 0.0 } else { r })
 }
 
 /// Registers DejaVu Sans as plotters' `sans-serif` once per process.
@@ -523,5 +544,8 @@ mod tests {
         assert_eq!(count_colour(1, 61), RGBColor(68, 1, 84));
         assert_eq!(count_colour(61, 61), RGBColor(253, 231, 37));
         assert_eq!(finite_range(&[f64::INFINITY, 2.0, 2.0]), (1.5, 2.5));
+        assert_eq!(tick(&300.0), "300");
+        assert_eq!(tick(&(0.1 + 0.2)), "0.3");
+        assert_eq!(tick(&-1e-12), "0");
     }
 }
