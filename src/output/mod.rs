@@ -19,6 +19,7 @@
 
 use std::io;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 mod csv;
 mod png;
@@ -30,7 +31,7 @@ pub(crate) use self::stl::to_stl_triangle;
 pub use self::stl::write_colliding_area;
 
 /// A result directory written atomically: files go into a hidden sibling
-/// staging directory (`<parent>/.<name>.partial-<pid>`) and are renamed
+/// staging directory (`<parent>/.<name>.partial-<pid>-<n>`) and are renamed
 /// into the final directory by [`OutputDir::commit`]. Dropped without a
 /// commit, the staging directory and everything in it are removed.
 ///
@@ -45,8 +46,9 @@ pub struct OutputDir {
 
 impl OutputDir {
     /// Creates the staging directory next to `final_dir` (which need not
-    /// exist yet). A stale staging directory of the same name, left by a
-    /// crashed process that had the same id, is cleared first.
+    /// exist yet). `<n>` counts the stagings of this process, so two of them
+    /// never share a staging directory; a stale one of the same name, left
+    /// by a crashed process that had the same id, is cleared first.
     pub fn stage(final_dir: &Path) -> io::Result<OutputDir> {
         let name = final_dir.file_name().ok_or_else(|| {
             io::Error::new(
@@ -61,7 +63,9 @@ impl OutputDir {
         std::fs::create_dir_all(&parent)?;
         let mut staged_name = std::ffi::OsString::from(".");
         staged_name.push(name);
-        staged_name.push(format!(".partial-{}", std::process::id()));
+        static STAGED: AtomicUsize = AtomicUsize::new(0);
+        let n = STAGED.fetch_add(1, Ordering::Relaxed);
+        staged_name.push(format!(".partial-{}-{n}", std::process::id()));
         let staging = parent.join(staged_name);
         if staging.exists() {
             std::fs::remove_dir_all(&staging)?;
@@ -113,9 +117,9 @@ impl Drop for OutputDir {
     }
 }
 
+/// A fresh, empty directory under the system's temporary directory.
 #[cfg(test)]
 pub(crate) fn temp_dir(tag: &str) -> PathBuf {
-    use std::sync::atomic::{AtomicUsize, Ordering};
     static NEXT: AtomicUsize = AtomicUsize::new(0);
     let dir = std::env::temp_dir().join(format!(
         "kneeform-test-{}-{tag}-{}",
@@ -148,9 +152,11 @@ mod tests {
         std::fs::write(out.path("b.stl"), [1u8, 2, 3]).unwrap();
         // Nothing is visible under the final name before the commit.
         assert!(!final_dir.exists());
-        assert_eq!(
-            entries(&root),
-            [".run.partial-".to_string() + &std::process::id().to_string()]
+        let staged = entries(&root);
+        let prefix = format!(".run.partial-{}-", std::process::id());
+        assert!(
+            staged.len() == 1 && staged[0].starts_with(&prefix),
+            "{staged:?}"
         );
         out.commit().unwrap();
         assert_eq!(entries(&final_dir), ["a.csv", "b.stl"]);
@@ -178,6 +184,20 @@ mod tests {
             "new"
         );
         assert_eq!(entries(&final_dir), ["a.csv", "keep.txt"]);
+        std::fs::remove_dir_all(root).unwrap();
+    }
+
+    #[test]
+    fn two_stagings_of_one_directory_do_not_collide() {
+        let root = temp_dir("twice");
+        let final_dir = root.join("run");
+        let first = OutputDir::stage(&final_dir).unwrap();
+        let second = OutputDir::stage(&final_dir).unwrap();
+        std::fs::write(first.path("a.csv"), "first").unwrap();
+        std::fs::write(second.path("b.csv"), "second").unwrap();
+        first.commit().unwrap();
+        second.commit().unwrap();
+        assert_eq!(entries(&final_dir), ["a.csv", "b.csv"]);
         std::fs::remove_dir_all(root).unwrap();
     }
 

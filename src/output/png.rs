@@ -82,7 +82,7 @@ pub enum PngError {
 pub fn write_depth_png(path: &Path, grid: &HeightGrid) -> Result<(), PngError> {
     let (h_lo, h_hi) = finite_range(&grid.h);
     let title = format!(
-        "Height grid: {} x {} nodes at {} mm pitch",
+        "Height grid (y in the analysis frame): {} x {} nodes at {} mm pitch",
         grid.spec.nx, grid.spec.nz, grid.spec.pitch
     );
     let raster = Raster::plan(grid.spec.nx, grid.spec.nz)?;
