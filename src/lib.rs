@@ -23,6 +23,7 @@ pub mod padded;
 pub mod paper;
 pub mod push;
 pub mod scenario;
+mod simd;
 pub mod slide;
 pub mod summary;
 

@@ -19,6 +19,8 @@ pub struct PaddedGrid {
     pub stride: usize,
     /// Heights, `h[j * stride + pad_lo + i]`.
     pub h: Vec<f64>,
+    /// Per grid row, the first and last column with a finite height.
+    pub finite_span: Vec<Option<(i32, i32)>>,
 }
 
 /// The range of start columns, real and virtual, whose first layer (the
@@ -46,12 +48,42 @@ impl PaddedGrid {
         for (dst, src) in h.chunks_exact_mut(stride).zip(grid.h.chunks_exact(nx)) {
             dst[pad_lo..pad_lo + nx].copy_from_slice(src);
         }
+        let finite_span = grid
+            .h
+            .chunks_exact(nx)
+            .map(|row| {
+                let first = row.iter().position(|h| h.is_finite())?;
+                let last = row.iter().rposition(|h| h.is_finite())?;
+                Some((first as i32, last as i32))
+            })
+            .collect();
         PaddedGrid {
             spec: grid.spec,
             pad_lo,
             stride,
             h,
+            finite_span,
         }
+    }
+
+    /// The start columns of start row `j0` that can do anything at all:
+    /// outside it, no start is placed (no finite height inside its
+    /// footprint), and no first layer holds a finite height, so on its -x
+    /// side a carried slide strikes nothing and on its +x side no slide has
+    /// begun. Conservative: it may be wider than needed, never narrower.
+    pub fn active_starts(&self, j0: usize, fp: &GridFootprint) -> std::ops::Range<i64> {
+        let (mut lo, mut hi) = (i64::MAX, i64::MIN);
+        for row in &fp.rows {
+            let Some(j) = self.row_of(j0, row.dj) else { continue };
+            if let Some((first, last)) = self.finite_span[j] {
+                // khi >= kf, so a start left of `first - khi` has even its
+                // first layer left of the row's first finite node.
+                lo = lo.min(i64::from(first) - i64::from(row.khi));
+                hi = hi.max(i64::from(last) - i64::from(row.klo));
+            }
+        }
+        let lanes = start_lanes(fp, self.spec.nx);
+        lo.max(lanes.start)..(hi + 1).min(lanes.end).max(lo.max(lanes.start))
     }
 
     /// The grid row `j0 + dj`, if it exists.

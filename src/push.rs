@@ -11,6 +11,7 @@
 
 use crate::kneeform::GridFootprint;
 use crate::padded::{PaddedGrid, fmin};
+use crate::simd::dispatch;
 
 /// Row window minima of a padded height grid, for every power-of-two width.
 #[derive(Debug)]
@@ -48,12 +49,19 @@ impl WindowMin {
     }
 }
 
-/// Face levels `yr[i0]` for every start `i0` of start row `j0`: the minimum
-/// height over the nodes inside the footprint, `+inf` where none is finite
-/// (the start is not placed).
-pub fn push_row(grid: &PaddedGrid, table: &WindowMin, fp: &GridFootprint, j0: usize, yr: &mut [f64]) {
-    let nx = grid.spec.nx;
-    yr[..nx].fill(f64::INFINITY);
+dispatch! {
+    /// Face levels `yr[n]` of the starts `lanes.start + n` of start row
+    /// `j0` (all real: `lanes.start >= 0`): the minimum height over the
+    /// nodes inside the footprint, `+inf` where none is finite (the start
+    /// is not placed).
+    pub fn push_lanes(grid: &PaddedGrid, table: &WindowMin, fp: &GridFootprint, j0: usize, lanes: std::ops::Range<i64>, yr: &mut [f64]) => push_lanes_impl
+}
+
+#[inline(always)]
+fn push_lanes_impl(grid: &PaddedGrid, table: &WindowMin, fp: &GridFootprint, j0: usize, lanes: std::ops::Range<i64>, yr: &mut [f64]) {
+    debug_assert!(lanes.start >= 0 && yr.len() == (lanes.end - lanes.start) as usize);
+    yr.fill(f64::INFINITY);
+    let from = lanes.start as usize;
     for row in &fp.rows {
         if row.khi < row.klo {
             continue;
@@ -63,10 +71,10 @@ pub fn push_row(grid: &PaddedGrid, table: &WindowMin, fp: &GridFootprint, j0: us
         let level = width.ilog2() as usize;
         let second = width - (1 << level);
         let t = &table.levels[level];
-        let start = grid.index(j, row.klo);
-        let first = &t[start..start + nx];
-        let last = &t[start + second..start + second + nx];
-        for ((y, &u), &v) in yr[..nx].iter_mut().zip(first).zip(last) {
+        let start = grid.index(j, row.klo) + from;
+        let first = &t[start..start + yr.len()];
+        let last = &t[start + second..start + second + yr.len()];
+        for ((y, &u), &v) in yr.iter_mut().zip(first).zip(last) {
             *y = fmin(*y, fmin(u, v));
         }
     }

@@ -15,7 +15,8 @@
 //! the starts that are not placed but carry a level.
 
 use crate::kneeform::GridFootprint;
-use crate::padded::{PaddedGrid, fmin, start_lanes};
+use crate::padded::{PaddedGrid, fmin};
+use crate::simd::dispatch;
 
 /// Scratch space for [`slide_row`], reused across start rows.
 #[derive(Debug, Default)]
@@ -49,22 +50,45 @@ fn layer_rows(grid: &PaddedGrid, fp: &GridFootprint, j0: usize, scratch: &mut Sl
     }
 }
 
-/// Slides every start of start row `j0` at one angle and ORs the colliding
-/// nodes into `mask` (padded like `grid`). `yr` holds the starts' push
-/// levels (`+inf`: not placed); `eps` is SPEC's contact tolerance (mm).
-pub fn slide_row(
+dispatch! {
+    /// Slides the starts `lanes` of start row `j0` at one angle (lanes below
+    /// column 0 are the virtual starts past the grid's -x edge) and ORs the
+    /// colliding nodes into `mask` (padded like `grid`). `yr[n]` is the push
+    /// level of start `lanes.start + n` (`+inf`: not placed; ignored for
+    /// virtual starts). `carry` is the level carried in from the start just
+    /// right of the lanes (`-inf`: none); the level carried out of the
+    /// lowest lane is returned. `eps` is SPEC's contact tolerance (mm).
+    #[allow(clippy::too_many_arguments)]
+    pub fn slide_lanes(
+        grid: &PaddedGrid,
+        fp: &GridFootprint,
+        j0: usize,
+        lanes: std::ops::Range<i64>,
+        yr: &[f64],
+        carry: f64,
+        eps: f64,
+        mask: &mut [u8],
+        scratch: &mut SlideScratch,
+    ) -> f64 => slide_lanes_impl
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn slide_lanes_impl(
     grid: &PaddedGrid,
     fp: &GridFootprint,
     j0: usize,
+    lanes: std::ops::Range<i64>,
     yr: &[f64],
+    mut carry: f64,
     eps: f64,
     mask: &mut [u8],
     scratch: &mut SlideScratch,
-) {
-    let nx = grid.spec.nx;
-    let lanes = start_lanes(fp, nx);
+) -> f64 {
     let n = (lanes.end - lanes.start) as usize;
-    // Lane `l` is start column `lanes.start + l`.
+    if n == 0 {
+        return carry;
+    }
     let shift = lanes.start as isize;
     layer_rows(grid, fp, j0, scratch);
     let SlideScratch {
@@ -75,13 +99,7 @@ pub fn slide_row(
         groups,
     } = scratch;
     level.clear();
-    level.resize(n, f64::NEG_INFINITY);
-    let virtual_lanes = (-lanes.start) as usize;
-    for (m, &y) in level[virtual_lanes..].iter_mut().zip(&yr[..nx]) {
-        if y.is_finite() {
-            *m = y;
-        }
-    }
+    level.extend(yr.iter().zip(lanes.clone()).map(|(&y, i0)| if i0 >= 0 && y.is_finite() { y } else { f64::NEG_INFINITY }));
     layer_min.clear();
     layer_min.resize(n, f64::INFINITY);
     group_min.resize(n, f64::INFINITY);
@@ -91,9 +109,9 @@ pub fn slide_row(
     // their layer holds any finite height.
     for g in groups.iter() {
         if g.len() == 1 {
-            let idx = rows[g.start];
-            let h = &grid.h[idx.wrapping_add_signed(shift)..][..n];
-            let out = &mut mask[idx.wrapping_add_signed(shift)..][..n];
+            let idx = rows[g.start].wrapping_add_signed(shift);
+            let h = &grid.h[idx..idx + n];
+            let out = &mut mask[idx..idx + n];
             for (((&hv, m), lm), o) in h.iter().zip(level.iter_mut()).zip(layer_min.iter_mut()).zip(out) {
                 *o |= u8::from(hv < *m - eps);
                 *m = fmin(*m, hv);
@@ -102,8 +120,9 @@ pub fn slide_row(
         } else {
             group_min[..n].fill(f64::INFINITY);
             for &idx in &rows[g.clone()] {
-                let h = &grid.h[idx.wrapping_add_signed(shift)..][..n];
-                let out = &mut mask[idx.wrapping_add_signed(shift)..][..n];
+                let idx = idx.wrapping_add_signed(shift);
+                let h = &grid.h[idx..idx + n];
+                let out = &mut mask[idx..idx + n];
                 for (((&hv, &m), gm), o) in h.iter().zip(level.iter()).zip(group_min.iter_mut()).zip(out) {
                     *o |= u8::from(hv < m - eps);
                     *gm = fmin(*gm, hv);
@@ -118,27 +137,27 @@ pub fn slide_row(
 
     // Scalar fix-up, from +x to -x: a start that is not placed continues
     // the slide of the start on its +x side with that start's level.
-    let mut carry = f64::NEG_INFINITY;
     for lane in (0..n).rev() {
-        let placed = lane >= virtual_lanes && yr[lane - virtual_lanes].is_finite();
-        if placed {
+        let i0 = lanes.start + lane as i64;
+        if i0 >= 0 && yr[lane].is_finite() {
             carry = level[lane];
             continue;
         }
         if carry == f64::NEG_INFINITY || layer_min[lane] == f64::INFINITY {
             continue;
         }
-        let node = |idx: usize| idx.wrapping_add_signed(shift) + lane;
         for g in groups.iter() {
             let mut gmin = f64::INFINITY;
             for &idx in &rows[g.clone()] {
-                let hv = grid.h[node(idx)];
+                let node = idx.wrapping_add_signed(shift) + lane;
+                let hv = grid.h[node];
                 if hv < carry - eps {
-                    mask[node(idx)] = 1;
+                    mask[node] = 1;
                 }
                 gmin = fmin(gmin, hv);
             }
             carry = fmin(carry, gmin);
         }
     }
+    carry
 }

@@ -116,6 +116,10 @@ pub struct ScenarioArgs {
 /// `kneeform bench`.
 #[derive(Debug, Args)]
 pub struct BenchArgs {
+    /// Knee-form angles (degrees) for the fast engine's timing, as for
+    /// `analyze`; the paper's workload is all 61.
+    #[arg(long, default_value = "-30:30:1", allow_hyphen_values = true, value_name = "ANGLES")]
+    pub angles: String,
     /// Timed runs of the fast engine; the median is reported.
     #[arg(long, default_value_t = 5, value_name = "N")]
     pub runs: usize,

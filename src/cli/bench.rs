@@ -40,7 +40,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     ensure!(args.runs >= 1, "--runs must be at least 1");
     ensure!(args.paper_rows >= 1 && args.paper_angles >= 1, "--paper-rows and --paper-angles must be at least 1");
     let knee = KneeForm::default();
-    let angles: Vec<f64> = (-30..=30).map(f64::from).collect();
+    let angles = super::args::parse_angles(&args.angles)?;
     let t = Instant::now();
     let triangles = console_triangles(PAPER_TRIANGLES);
     let build_s = t.elapsed().as_secs_f64();
@@ -106,12 +106,12 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     writeln!(md, "| --- | --- |")?;
     writeln!(md, "| part | console, {} triangles (built in {build_s:.2} s) |", triangles.len())?;
     writeln!(md, "| grid | {nx} x {nz} at {PAPER_PITCH} mm, {} nodes sampled |", grid.finite_count())?;
-    writeln!(md, "| angles | {} (-30..30 by 1) |", footprints.len())?;
+    writeln!(md, "| angles | {} ({}) |", footprints.len(), args.angles)?;
     writeln!(md, "| threads | {threads} |")?;
     writeln!(md, "| sampling (median of {}) | {sample:.3} s |", args.runs)?;
-    writeln!(md, "| push + slide, 61 angles (median) | {slide:.3} s |")?;
+    writeln!(md, "| push + slide, {} angles (median) | {slide:.3} s |", footprints.len())?;
     writeln!(md, "| per angle | {:.1} ms |", slide / footprints.len() as f64 * 1e3)?;
-    writeln!(md, "| **total (sample + 61 angles)** | **{total:.3} s** |")?;
+    writeln!(md, "| **total (sample + {} angles)** | **{total:.3} s** |", footprints.len())?;
     writeln!(md, "| composite colliding nodes | {composite_nodes} |")?;
     if let Some(mib) = peak_rss_mib() {
         writeln!(md, "| peak memory (RSS) | {mib:.0} MiB |")?;
