@@ -21,7 +21,8 @@ pub enum Scenario {
     /// `y = 0`: a flat wall; nothing collides.
     FlatWall,
     /// `y = 0.2 x`: tilted so that the surface comes closer to the knee as
-    /// it slides to -x; every node in front of a placed start collides.
+    /// it slides to -x, which never lifts it off: every node of the part
+    /// but the rearmost column (the largest x) is colliding at every angle.
     Ramp,
     /// `y = 5 sin(2 pi x / 100)`: crests 5 mm towards the knee every 100 mm.
     Wave,
