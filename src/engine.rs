@@ -14,11 +14,14 @@ use crate::grid::HeightGrid;
 use crate::kneeform::GridFootprint;
 use crate::padded::PaddedGrid;
 use crate::paper::{PaperCounts, PaperScratch, paper_row};
-use crate::push::{WindowMin, push_lanes};
-use crate::slide::{SlideScratch, slide_lanes};
+use crate::push::{PushRows, WindowMin, push_block};
+use crate::simd::dispatch;
+use crate::slide::{LayerRows, slide_block, slide_carried};
 
 /// Which implementation of push and slide to run. Both give identical masks.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum Algorithm {
     /// The paper's sections 3 and 4, literally: the reference and baseline.
@@ -63,13 +66,11 @@ pub struct AngleMask {
     pub colliding: usize,
 }
 
-/// Starts per block of the fast path. A block of starts is swept over
-/// every start row before the next block: the heights it reads (the
-/// footprint's rows at the block's columns, about `(BLOCK + 240) x 260`
-/// values at 1.24 mm) then stay in a 2 MiB L2 cache, each loaded once and
-/// used by some 260 start rows. Without blocking the engine is bound by
-/// memory bandwidth (measured 3x slower on the benchmark).
-const BLOCK: i64 = 256;
+/// Starts per block of the fast path: two AVX-512 registers of levels, or
+/// four AVX2 ones. A block is swept over every start row before the next,
+/// so the heights it reads (the footprint's rows at the block's columns)
+/// stay in cache from one start row to the next.
+const LANES: usize = 16;
 
 /// Runs push and slide for every footprint (one per angle) on `grid`.
 /// `on_angle` is called once per finished angle (for a progress bar).
@@ -98,20 +99,34 @@ pub fn colliding_masks(
     // Enough independent tasks to keep every thread busy: whole angles when
     // there are many, bands of start rows when there are few. Start rows
     // are independent, so any split gives the same masks.
-    let bands = rayon::current_num_threads().div_ceil(footprints.len().max(1)).max(1) * 2 - 1;
+    let bands = rayon::current_num_threads()
+        .div_ceil(footprints.len().max(1))
+        .max(1)
+        * 2
+        - 1;
     let band_len = rows.len().div_ceil(bands).max(1);
     footprints
         .par_iter()
         .map(|fp| {
             let (padded_mask, placed) = rows
                 .par_chunks(band_len)
-                .map(|band| {
-                    let mut mask = vec![0u8; padded.h.len()];
-                    let placed = match &table {
-                        Some(table) => fast_band(&padded, table, fp, band, options.eps, &mut mask),
-                        None => paper_band(&padded, fp, band, options.eps, &mut mask),
-                    };
-                    (mask, placed)
+                .map(|band| match &table {
+                    Some(table) => {
+                        let mut reach = vec![f64::NEG_INFINITY; padded.h.len()];
+                        let placed = fast_band(&padded, table, fp, band, &mut reach);
+                        let mask = padded
+                            .h
+                            .iter()
+                            .zip(&reach)
+                            .map(|(&h, &r)| u8::from(h < r - options.eps))
+                            .collect();
+                        (mask, placed)
+                    }
+                    None => {
+                        let mut mask = vec![0u8; padded.h.len()];
+                        let placed = paper_band(&padded, fp, band, options.eps, &mut mask);
+                        (mask, placed)
+                    }
                 })
                 .reduce(
                     || (vec![0u8; padded.h.len()], 0),
@@ -120,7 +135,7 @@ pub fn colliding_masks(
                         (a, pa + pb)
                     },
                 );
-            let mask = unpad(&padded, &padded_mask);
+            let mask = padded.unpad(&padded_mask);
             on_angle();
             AngleMask {
                 angle_deg: fp.angle_deg,
@@ -132,59 +147,94 @@ pub fn colliding_masks(
         .collect()
 }
 
-/// The fast path over a band of start rows: blocks of [`BLOCK`] starts from
-/// +x to -x, each swept over every start row of the band, carrying each
-/// row's slide level from one block into the next. Returns the number of
-/// placed starts.
-fn fast_band(padded: &PaddedGrid, table: &WindowMin, fp: &GridFootprint, band: &[usize], eps: f64, mask: &mut [u8]) -> usize {
-    let active: Vec<std::ops::Range<i64>> = band.iter().map(|&j0| padded.active_starts(j0, fp)).collect();
-    let lo = active.iter().filter(|r| !r.is_empty()).map(|r| r.start).min();
+dispatch! {
+    /// The fast path over a band of start rows: blocks of [`LANES`] starts
+    /// from +x to -x, each swept over every start row of the band, carrying
+    /// each row's slide level from one block into the next. Records each
+    /// node's reach (see [`crate::slide`]) and returns the number of placed
+    /// starts.
+    fn fast_band(padded: &PaddedGrid, table: &WindowMin, fp: &GridFootprint, band: &[usize], reach: &mut [f64]) -> usize => fast_band_impl
+}
+
+#[inline(always)]
+fn fast_band_impl(
+    padded: &PaddedGrid,
+    table: &WindowMin,
+    fp: &GridFootprint,
+    band: &[usize],
+    reach: &mut [f64],
+) -> usize {
+    let push_rows = PushRows::new(padded, fp);
+    let layer = LayerRows::new(padded, fp);
+    let active: Vec<std::ops::Range<i64>> = band
+        .iter()
+        .map(|&j0| padded.active_starts(j0, fp))
+        .collect();
+    let lo = active
+        .iter()
+        .filter(|r| !r.is_empty())
+        .map(|r| r.start)
+        .min();
     let hi = active.iter().filter(|r| !r.is_empty()).map(|r| r.end).max();
-    let (Some(lo), Some(hi)) = (lo, hi) else { return 0 };
+    let (Some(lo), Some(hi)) = (lo, hi) else {
+        return 0;
+    };
+    let nx = padded.spec.nx as i64;
     let mut carry = vec![f64::NEG_INFINITY; band.len()];
-    let mut yr = Vec::with_capacity(BLOCK as usize);
-    let mut scratch = SlideScratch::default();
     let mut placed = 0;
     let mut block_end = hi;
     while block_end > lo {
-        let block = (block_end - BLOCK).max(lo)..block_end;
+        // The block may reach below `lo`: those starts do nothing, and the
+        // padding's slack keeps them inside the array.
+        let block = block_end - LANES as i64;
         for (k, &j0) in band.iter().enumerate() {
-            let lanes = block.start.max(active[k].start)..block.end.min(active[k].end);
-            if lanes.is_empty() {
+            if active[k].is_empty() || block >= active[k].end || block_end <= active[k].start {
                 continue;
             }
-            // Virtual starts (left of column 0) are never placed.
-            let real = lanes.start.max(0)..lanes.end.max(0);
-            let virtual_lanes = (real.start - lanes.start) as usize;
-            yr.clear();
-            yr.resize((lanes.end - lanes.start) as usize, f64::INFINITY);
-            if !real.is_empty() {
-                push_lanes(padded, table, fp, j0, real, &mut yr[virtual_lanes..]);
-                placed += yr.iter().filter(|y| y.is_finite()).count();
+            let base = padded
+                .index(j0 as i64, 0)
+                .wrapping_add_signed(block as isize);
+            let yr: [f64; LANES] = push_block(table, &push_rows, base);
+            // Only real starts are placed.
+            let mut level = [f64::NEG_INFINITY; LANES];
+            for w in 0..LANES {
+                let i0 = block + w as i64;
+                if (0..nx).contains(&i0) && yr[w].is_finite() {
+                    level[w] = yr[w];
+                    placed += 1;
+                }
             }
-            carry[k] = slide_lanes(padded, fp, j0, lanes, &yr, carry[k], eps, mask, &mut scratch);
+            let (after, layer_min) = slide_block(&padded.h, reach, &layer, base, level);
+            // Starts that are not placed continue the slide of the start on
+            // their +x side, from +x to -x.
+            let mut c = carry[k];
+            for w in (0..LANES).rev() {
+                if level[w] != f64::NEG_INFINITY {
+                    c = after[w];
+                } else if c != f64::NEG_INFINITY && layer_min[w] != f64::INFINITY {
+                    c = slide_carried(&padded.h, reach, &layer, base + w, c);
+                }
+            }
+            carry[k] = c;
         }
-        block_end = block.start;
+        block_end = block;
     }
     placed
 }
 
 /// The paper algorithm over a band of start rows.
-fn paper_band(padded: &PaddedGrid, fp: &GridFootprint, band: &[usize], eps: f64, mask: &mut [u8]) -> usize {
+fn paper_band(
+    padded: &PaddedGrid,
+    fp: &GridFootprint,
+    band: &[usize],
+    eps: f64,
+    mask: &mut [u8],
+) -> usize {
     let mut scratch = PaperScratch::default();
     let mut counts = PaperCounts::default();
     band.iter()
         .map(|&j0| paper_row(padded, fp, j0, eps, mask, &mut scratch, &mut counts))
         .sum()
-}
-
-/// Drops the padding columns of a padded mask.
-fn unpad(padded: &PaddedGrid, mask: &[u8]) -> Vec<u8> {
-    let nx = padded.spec.nx;
-    mask.chunks_exact(padded.stride)
-        .flat_map(|row| &row[padded.pad_lo..padded.pad_lo + nx])
-        .copied()
-        .collect()
 }
 
 /// SPEC's composite: for every node, the number of angles whose mask holds it.

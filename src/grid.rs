@@ -174,7 +174,10 @@ impl HeightGrid {
             if j_hi < 0 || j_lo >= spec.nz as i64 || j_lo > j_hi {
                 continue;
             }
-            let (b_lo, b_hi) = (j_lo.max(0) as usize / BAND_ROWS, j_hi.min(spec.nz as i64 - 1) as usize / BAND_ROWS);
+            let (b_lo, b_hi) = (
+                j_lo.max(0) as usize / BAND_ROWS,
+                j_hi.min(spec.nz as i64 - 1) as usize / BAND_ROWS,
+            );
             for bin in &mut binned[b_lo..=b_hi] {
                 bin.push(k as u32);
             }
@@ -234,7 +237,8 @@ fn rasterize(t: &Triangle, spec: &GridSpec, band: std::ops::Range<usize>, rows: 
         let row = &mut rows[(j as usize - band.start) * spec.nx..][..spec.nx];
         for i in i_lo..=i_hi {
             let x = spec.x(i as usize);
-            let w = edges.map(|(u, v)| ((v[0] - u[0]) * (z - u[1]) - (v[1] - u[1]) * (x - u[0])) / area2);
+            let w = edges
+                .map(|(u, v)| ((v[0] - u[0]) * (z - u[1]) - (v[1] - u[1]) * (x - u[0])) / area2);
             if w[0] >= slack[0] && w[1] >= slack[1] && w[2] >= slack[2] {
                 let y = w[0] * ys[0] + w[1] * ys[1] + w[2] * ys[2];
                 let cell = &mut row[i as usize];
@@ -274,7 +278,11 @@ mod tests {
         for j in 0..11 {
             for i in 0..11 {
                 let want = y(i as f64, j as f64);
-                assert!((g.at(i, j) - want).abs() < 1e-12, "({i},{j}): {} vs {want}", g.at(i, j));
+                assert!(
+                    (g.at(i, j) - want).abs() < 1e-12,
+                    "({i},{j}): {} vs {want}",
+                    g.at(i, j)
+                );
             }
         }
     }
@@ -310,6 +318,9 @@ mod tests {
         assert!(coarse.x(0) <= -10.0 - fp[0].x_range().1);
         assert!(coarse.x(coarse.nx - 1) >= 30.0 - fp[0].x_range().0);
         assert!(coarse.check_fits(1e12).is_ok());
-        assert!(matches!(coarse.check_fits(10.0), Err(GridError::TooLarge { .. })));
+        assert!(matches!(
+            coarse.check_fits(10.0),
+            Err(GridError::TooLarge { .. })
+        ));
     }
 }

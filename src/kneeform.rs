@@ -237,7 +237,8 @@ mod tests {
     /// force over its edges: an independent check of the row intervals.
     fn distance_to_triangle(fp: &Footprint, x: f64, z: f64) -> f64 {
         let v = fp.vertices;
-        let side = |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]) * (z - a[1]) - (b[1] - a[1]) * (x - a[0]);
+        let side =
+            |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]) * (z - a[1]) - (b[1] - a[1]) * (x - a[0]);
         let inside = (0..3).all(|k| side(v[k], v[(k + 1) % 3]) >= 0.0);
         if inside {
             return 0.0;

@@ -25,10 +25,7 @@ fn main() -> ExitCode {
 
 fn run(cli: &Cli) -> anyhow::Result<ExitCode> {
     match &cli.command {
-        Command::Analyze(args) => {
-            cli::set_threads(args.setup.threads)?;
-            cli::analyze::run(args)?;
-        }
+        Command::Analyze(args) => cli::analyze::run(args)?,
         Command::Scenario(args) => cli::scenario::run(args)?,
         Command::Bench(args) => {
             cli::set_threads(args.threads)?;

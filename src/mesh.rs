@@ -11,7 +11,9 @@ use std::path::Path;
 pub type Triangle = [[f64; 3]; 3];
 
 /// Which side of the vehicle the analysed surface is on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum Side {
     /// The analysed surface faces -y (SPEC's canonical frame).
@@ -108,7 +110,12 @@ impl Part {
     }
 
     /// Parses the bytes of an STL file named `name` (for messages).
-    pub fn from_stl_bytes(name: &str, bytes: &[u8], scale: f64, side: Side) -> Result<Part, MeshError> {
+    pub fn from_stl_bytes(
+        name: &str,
+        bytes: &[u8],
+        scale: f64,
+        side: Side,
+    ) -> Result<Part, MeshError> {
         let triangles = parse_stl(bytes).map_err(|reason| MeshError::Format {
             path: name.into(),
             reason,
@@ -126,7 +133,10 @@ impl Part {
         if triangles.is_empty() {
             return Err(MeshError::Empty { path: name.into() });
         }
-        if let Some(index) = triangles.iter().position(|t| t.iter().flatten().any(|c| !c.is_finite())) {
+        if let Some(index) = triangles
+            .iter()
+            .position(|t| t.iter().flatten().any(|c| !c.is_finite()))
+        {
             return Err(MeshError::NonFinite {
                 path: name.into(),
                 index,
@@ -158,9 +168,9 @@ impl Part {
             max: [f64::NEG_INFINITY; 3],
         };
         for v in self.triangles.iter().flatten() {
-            for k in 0..3 {
-                b.min[k] = b.min[k].min(v[k]);
-                b.max[k] = b.max[k].max(v[k]);
+            for ((lo, hi), &c) in b.min.iter_mut().zip(b.max.iter_mut()).zip(v) {
+                *lo = lo.min(c);
+                *hi = hi.max(c);
             }
         }
         b
@@ -203,7 +213,10 @@ fn parse_stl(bytes: &[u8]) -> Result<Vec<Triangle>, String> {
         copy.extend_from_slice(&text[5..]);
         copy
     } else if bytes.len() < 84 {
-        return Err(format!("{} bytes, too short for a binary STL header", bytes.len()));
+        return Err(format!(
+            "{} bytes, too short for a binary STL header",
+            bytes.len()
+        ));
     } else {
         return Err("binary triangle count does not match the file size (truncated?)".into());
     };
@@ -213,7 +226,10 @@ fn parse_stl(bytes: &[u8]) -> Result<Vec<Triangle>, String> {
         .map_err(|e| e.to_string())?;
     Ok(stl
         .into_iter()
-        .map(|t| t.vertices.map(|v| [f64::from(v[0]), f64::from(v[1]), f64::from(v[2])]))
+        .map(|t| {
+            t.vertices
+                .map(|v| [f64::from(v[0]), f64::from(v[1]), f64::from(v[2])])
+        })
         .collect())
 }
 

@@ -1,23 +1,29 @@
-//! The height grid with `+inf` margins left and right of every row, wide
-//! enough that push and slide can index any footprint offset of any start
-//! (and of the virtual starts past the grid's -x edge) without a bounds
-//! branch in their inner loops. Nodes outside the grid do not exist; `+inf`
-//! is exactly how SPEC's rules treat them (never inside a push minimum,
-//! never colliding, never lowering the face level).
+//! The height grid with `+inf` margins around it, wide enough that push and
+//! slide can index any footprint offset of any start (and of the virtual
+//! starts past the grid's -x edge) without a bounds branch in their inner
+//! loops. Nodes outside the grid do not exist; `+inf` is exactly how SPEC's
+//! rules treat them (never inside a push minimum, never colliding, never
+//! lowering the face level).
 
 use crate::grid::{GridSpec, HeightGrid};
 use crate::kneeform::GridFootprint;
 
-/// A height grid with padded rows.
+/// Extra margin columns on each side, so that a whole block of starts may
+/// run past the active range without leaving the padding.
+pub const LANE_SLACK: usize = 64;
+
+/// A height grid with padded rows and columns.
 #[derive(Debug)]
 pub struct PaddedGrid {
     /// The grid's nodes.
     pub spec: GridSpec,
     /// Padding columns before column 0.
     pub pad_lo: usize,
+    /// Padding rows before row 0.
+    pub pad_rows: usize,
     /// Length of a padded row.
     pub stride: usize,
-    /// Heights, `h[j * stride + pad_lo + i]`.
+    /// Heights, `h[(j + pad_rows) * stride + pad_lo + i]`.
     pub h: Vec<f64>,
     /// Per grid row, the first and last column with a finite height.
     pub finite_span: Vec<Option<(i32, i32)>>,
@@ -34,18 +40,26 @@ pub fn start_lanes(fp: &GridFootprint, nx: usize) -> std::ops::Range<i64> {
 impl PaddedGrid {
     /// Pads `grid` for all of `footprints`.
     pub fn new(grid: &HeightGrid, footprints: &[GridFootprint]) -> PaddedGrid {
-        let nx = grid.spec.nx;
-        let (mut lo, mut hi) = (0i64, 0i64);
+        let GridSpec { nx, nz, .. } = grid.spec;
+        let (mut lo, mut hi, mut dj_max) = (0i64, 0i64, 0i64);
         for fp in footprints {
             let (k_lo, k_hi) = fp.k_range();
             let lanes = start_lanes(fp, nx);
             lo = lo.min(lanes.start + i64::from(k_lo)).min(i64::from(k_lo));
             hi = hi.max(i64::from(k_hi));
+            let (dj_lo, dj_hi) = fp.dj_range();
+            dj_max = dj_max
+                .max(i64::from(dj_lo).abs())
+                .max(i64::from(dj_hi).abs());
         }
-        let pad_lo = (-lo) as usize;
-        let stride = pad_lo + nx + hi as usize + 1;
-        let mut h = vec![f64::INFINITY; stride * grid.spec.nz];
-        for (dst, src) in h.chunks_exact_mut(stride).zip(grid.h.chunks_exact(nx)) {
+        let pad_lo = (-lo) as usize + LANE_SLACK;
+        let stride = pad_lo + nx + hi as usize + 1 + LANE_SLACK;
+        let pad_rows = dj_max as usize;
+        let mut h = vec![f64::INFINITY; stride * (nz + 2 * pad_rows)];
+        for (dst, src) in h[pad_rows * stride..]
+            .chunks_exact_mut(stride)
+            .zip(grid.h.chunks_exact(nx))
+        {
             dst[pad_lo..pad_lo + nx].copy_from_slice(src);
         }
         let finite_span = grid
@@ -60,10 +74,30 @@ impl PaddedGrid {
         PaddedGrid {
             spec: grid.spec,
             pad_lo,
+            pad_rows,
             stride,
             h,
             finite_span,
         }
+    }
+
+    /// The grid row `j0 + dj`, if it exists.
+    pub fn row_of(&self, j0: usize, dj: i32) -> Option<usize> {
+        let j = j0 as i64 + i64::from(dj);
+        (0..self.spec.nz as i64).contains(&j).then_some(j as usize)
+    }
+
+    /// Index of column offset `k` of row `j` for the start at column 0; add
+    /// the start's column to reach the node. `j` may be a padding row
+    /// (negative, or `nz` and beyond) within the footprint's reach.
+    pub fn index(&self, j: i64, k: i32) -> usize {
+        let row = (j + self.pad_rows as i64) as usize;
+        (row * self.stride + self.pad_lo).wrapping_add_signed(k as isize)
+    }
+
+    /// Offset from a start's node index to the node `(dj, k)` away from it.
+    pub fn offset(&self, dj: i32, k: i32) -> isize {
+        dj as isize * self.stride as isize + k as isize
     }
 
     /// The start columns of start row `j0` that can do anything at all:
@@ -74,7 +108,9 @@ impl PaddedGrid {
     pub fn active_starts(&self, j0: usize, fp: &GridFootprint) -> std::ops::Range<i64> {
         let (mut lo, mut hi) = (i64::MAX, i64::MIN);
         for row in &fp.rows {
-            let Some(j) = self.row_of(j0, row.dj) else { continue };
+            let Some(j) = self.row_of(j0, row.dj) else {
+                continue;
+            };
             if let Some((first, last)) = self.finite_span[j] {
                 // khi >= kf, so a start left of `first - khi` has even its
                 // first layer left of the row's first finite node.
@@ -83,19 +119,19 @@ impl PaddedGrid {
             }
         }
         let lanes = start_lanes(fp, self.spec.nx);
-        lo.max(lanes.start)..(hi + 1).min(lanes.end).max(lo.max(lanes.start))
+        let lo = lo.max(lanes.start);
+        lo..(hi + 1).min(lanes.end).max(lo)
     }
 
-    /// The grid row `j0 + dj`, if it exists.
-    pub fn row_of(&self, j0: usize, dj: i32) -> Option<usize> {
-        let j = j0 as i64 + i64::from(dj);
-        (0..self.spec.nz as i64).contains(&j).then_some(j as usize)
-    }
-
-    /// Index of column offset `k` of row `j` for the start at column 0; add
-    /// the start's column to reach the node.
-    pub fn index(&self, j: usize, k: i32) -> usize {
-        (j * self.stride + self.pad_lo) .wrapping_add_signed(k as isize)
+    /// Drops the padding of a padded per-node array.
+    pub fn unpad<T: Copy>(&self, padded: &[T]) -> Vec<T> {
+        let GridSpec { nx, nz, .. } = self.spec;
+        padded[self.pad_rows * self.stride..]
+            .chunks_exact(self.stride)
+            .take(nz)
+            .flat_map(|row| &row[self.pad_lo..self.pad_lo + nx])
+            .copied()
+            .collect()
     }
 }
 
@@ -105,4 +141,10 @@ impl PaddedGrid {
 #[inline(always)]
 pub fn fmin(a: f64, b: f64) -> f64 {
     if b < a { b } else { a }
+}
+
+/// The larger of two levels, as [`fmin`].
+#[inline(always)]
+pub fn fmax(a: f64, b: f64) -> f64 {
+    if b > a { b } else { a }
 }

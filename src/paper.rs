@@ -94,7 +94,7 @@ pub fn paper_row(
             }
             last_d = d;
             scratch.list.push(Entry {
-                node: grid.index(j, 0) + i as usize,
+                node: grid.index(j as i64, 0) + i as usize,
                 layer,
                 group,
             });

@@ -6,12 +6,11 @@
 //! window minima. [`WindowMin`] is a sparse table per grid row (levels of
 //! `2^l`-wide minima, built once for all angles): any window is the minimum
 //! of two overlapping power-of-two windows, so each (start, footprint row)
-//! costs two loads and two comparisons, and the loop over the starts of a
-//! row is contiguous and vectorises.
+//! costs two loads and two comparisons. [`push_block`] does a block of
+//! consecutive starts at once, their levels held in vector registers.
 
 use crate::kneeform::GridFootprint;
 use crate::padded::{PaddedGrid, fmin};
-use crate::simd::dispatch;
 
 /// Row window minima of a padded height grid, for every power-of-two width.
 #[derive(Debug)]
@@ -49,35 +48,48 @@ impl WindowMin {
     }
 }
 
-dispatch! {
-    /// Face levels `yr[n]` of the starts `lanes.start + n` of start row
-    /// `j0` (all real: `lanes.start >= 0`): the minimum height over the
-    /// nodes inside the footprint, `+inf` where none is finite (the start
-    /// is not placed).
-    pub fn push_lanes(grid: &PaddedGrid, table: &WindowMin, fp: &GridFootprint, j0: usize, lanes: std::ops::Range<i64>, yr: &mut [f64]) => push_lanes_impl
+/// The push rows of one footprint, ready for [`push_block`]: for each row
+/// with nodes inside, the offset from a start to its first inside node,
+/// and the table level and second-window shift covering its width.
+#[derive(Debug, Clone)]
+pub struct PushRows {
+    rows: Vec<(isize, u32, u32)>,
 }
 
+impl PushRows {
+    /// Lays out `fp`'s rows on `grid`.
+    pub fn new(grid: &PaddedGrid, fp: &GridFootprint) -> PushRows {
+        let rows = fp
+            .rows
+            .iter()
+            .filter(|r| r.khi >= r.klo)
+            .map(|r| {
+                let width = (r.khi - r.klo + 1) as u32;
+                let level = width.ilog2();
+                (grid.offset(r.dj, r.klo), level, width - (1 << level))
+            })
+            .collect();
+        PushRows { rows }
+    }
+}
+
+/// Face levels of `W` consecutive starts whose node index (in the padded
+/// grid) begins at `base`: the minimum height over the nodes inside each
+/// footprint, `+inf` where none is finite.
 #[inline(always)]
-fn push_lanes_impl(grid: &PaddedGrid, table: &WindowMin, fp: &GridFootprint, j0: usize, lanes: std::ops::Range<i64>, yr: &mut [f64]) {
-    debug_assert!(lanes.start >= 0 && yr.len() == (lanes.end - lanes.start) as usize);
-    yr.fill(f64::INFINITY);
-    let from = lanes.start as usize;
-    for row in &fp.rows {
-        if row.khi < row.klo {
-            continue;
-        }
-        let Some(j) = grid.row_of(j0, row.dj) else { continue };
-        let width = (row.khi - row.klo + 1) as usize;
-        let level = width.ilog2() as usize;
-        let second = width - (1 << level);
-        let t = &table.levels[level];
-        let start = grid.index(j, row.klo) + from;
-        let first = &t[start..start + yr.len()];
-        let last = &t[start + second..start + second + yr.len()];
-        for ((y, &u), &v) in yr.iter_mut().zip(first).zip(last) {
-            *y = fmin(*y, fmin(u, v));
+pub fn push_block<const W: usize>(table: &WindowMin, rows: &PushRows, base: usize) -> [f64; W] {
+    let mut yr = [f64::INFINITY; W];
+    for &(offset, level, second) in &rows.rows {
+        let t = &table.levels[level as usize];
+        let a = base.wrapping_add_signed(offset);
+        let first: &[f64; W] = t[a..a + W].try_into().expect("W values");
+        let b = a + second as usize;
+        let last: &[f64; W] = t[b..b + W].try_into().expect("W values");
+        for w in 0..W {
+            yr[w] = fmin(yr[w], fmin(first[w], last[w]));
         }
     }
+    yr
 }
 
 /// The paper's push for one start, literally: the minimum over every node
@@ -85,9 +97,11 @@ fn push_lanes_impl(grid: &PaddedGrid, table: &WindowMin, fp: &GridFootprint, j0:
 pub fn push_start_literal(grid: &PaddedGrid, fp: &GridFootprint, i0: usize, j0: usize) -> f64 {
     let mut yr = f64::INFINITY;
     for row in &fp.rows {
-        let Some(j) = grid.row_of(j0, row.dj) else { continue };
+        let Some(j) = grid.row_of(j0, row.dj) else {
+            continue;
+        };
         for k in row.klo..=row.khi {
-            yr = fmin(yr, grid.h[grid.index(j, k) + i0]);
+            yr = fmin(yr, grid.h[grid.index(j as i64, k) + i0]);
         }
     }
     yr

@@ -10,153 +10,94 @@
 //! and on past the grid's -x edge through virtual starts.
 //!
 //! So the work is one pass over the first layers of all starts of the row,
-//! done for all placed starts at once (vectorised across starts: each
-//! footprint row is a contiguous run of heights), then a scalar fix-up for
-//! the starts that are not placed but carry a level.
+//! done for a block of starts at once (vectorised across starts: each
+//! footprint row is a contiguous run of heights, the levels stay in vector
+//! registers), then a scalar pass for the starts that are not placed but
+//! carry a level.
+//!
+//! Rather than test `h < M - eps` at every visit, each node keeps its
+//! **reach**, the highest level that met it; the test is monotone in the
+//! level, so `h < reach - eps` at the end gives the same mask with a
+//! `max` per visit instead of a compare-and-store.
 
 use crate::kneeform::GridFootprint;
-use crate::padded::{PaddedGrid, fmin};
-use crate::simd::dispatch;
+use crate::padded::{PaddedGrid, fmax, fmin};
 
-/// Scratch space for [`slide_row`], reused across start rows.
-#[derive(Debug, Default)]
-pub struct SlideScratch {
-    level: Vec<f64>,
-    layer_min: Vec<f64>,
-    group_min: Vec<f64>,
-    rows: Vec<usize>,
+/// The first layer of one footprint, ready for [`slide_block`]: the offset
+/// from a start's node to the first node in front in each footprint row, in
+/// slide order, and the tie groups (ranges of that order whose distances
+/// agree within [`NODE_TOL`](crate::kneeform::NODE_TOL)).
+#[derive(Debug, Clone)]
+pub struct LayerRows {
+    offsets: Vec<isize>,
     groups: Vec<std::ops::Range<usize>>,
 }
 
-/// The rows of the footprint that exist for start row `j0`, in slide order,
-/// as the padded index of start 0's first-layer node (heights and mask share
-/// the layout), and their tie groups.
-fn layer_rows(grid: &PaddedGrid, fp: &GridFootprint, j0: usize, scratch: &mut SlideScratch) {
-    scratch.rows.clear();
-    scratch.groups.clear();
-    let mut last_d = f64::NAN;
-    for &r in &fp.slide_order {
-        let row = &fp.rows[r as usize];
-        let Some(j) = grid.row_of(j0, row.dj) else { continue };
-        let idx = grid.index(j, row.kf);
-        let n = scratch.rows.len();
-        if n == 0 || row.d0 - last_d > crate::kneeform::NODE_TOL {
-            scratch.groups.push(n..n + 1);
-        } else {
-            scratch.groups.last_mut().expect("a group is open").end = n + 1;
+impl LayerRows {
+    /// Lays out `fp`'s first layer on `grid`.
+    pub fn new(grid: &PaddedGrid, fp: &GridFootprint) -> LayerRows {
+        LayerRows {
+            offsets: fp
+                .slide_order
+                .iter()
+                .map(|&r| {
+                    let row = &fp.rows[r as usize];
+                    grid.offset(row.dj, row.kf)
+                })
+                .collect(),
+            groups: fp.groups.clone(),
         }
-        last_d = row.d0;
-        scratch.rows.push(idx);
     }
 }
 
-dispatch! {
-    /// Slides the starts `lanes` of start row `j0` at one angle (lanes below
-    /// column 0 are the virtual starts past the grid's -x edge) and ORs the
-    /// colliding nodes into `mask` (padded like `grid`). `yr[n]` is the push
-    /// level of start `lanes.start + n` (`+inf`: not placed; ignored for
-    /// virtual starts). `carry` is the level carried in from the start just
-    /// right of the lanes (`-inf`: none); the level carried out of the
-    /// lowest lane is returned. `eps` is SPEC's contact tolerance (mm).
-    #[allow(clippy::too_many_arguments)]
-    pub fn slide_lanes(
-        grid: &PaddedGrid,
-        fp: &GridFootprint,
-        j0: usize,
-        lanes: std::ops::Range<i64>,
-        yr: &[f64],
-        carry: f64,
-        eps: f64,
-        mask: &mut [u8],
-        scratch: &mut SlideScratch,
-    ) -> f64 => slide_lanes_impl
-}
-
-#[allow(clippy::too_many_arguments)]
+/// Slides `W` consecutive starts over their first layers. `base` is the
+/// padded node index of the first start, `level[w]` the level it enters
+/// with (`yr` if placed, `-inf` if not). Every node of the layer records in
+/// `reach` the highest face level that met it; a node is colliding where
+/// its height is below its reach by more than `eps` (SPEC's test, applied
+/// once at the end: it is monotone in the level). Returns the levels after
+/// the layer and the lowest height of each layer.
 #[inline(always)]
-fn slide_lanes_impl(
-    grid: &PaddedGrid,
-    fp: &GridFootprint,
-    j0: usize,
-    lanes: std::ops::Range<i64>,
-    yr: &[f64],
+pub fn slide_block<const W: usize>(
+    h: &[f64],
+    reach: &mut [f64],
+    layer: &LayerRows,
+    base: usize,
+    mut level: [f64; W],
+) -> ([f64; W], [f64; W]) {
+    let mut layer_min = [f64::INFINITY; W];
+    for g in &layer.groups {
+        let before = level;
+        for &offset in &layer.offsets[g.clone()] {
+            let a = base.wrapping_add_signed(offset);
+            let hv: &[f64; W] = h[a..a + W].try_into().expect("W values");
+            let r: &mut [f64; W] = (&mut reach[a..a + W]).try_into().expect("W values");
+            for w in 0..W {
+                r[w] = fmax(r[w], before[w]);
+                level[w] = fmin(level[w], hv[w]);
+                layer_min[w] = fmin(layer_min[w], hv[w]);
+            }
+        }
+    }
+    (level, layer_min)
+}
+
+/// The scalar slide of one start that is not placed but carries the level
+/// `carry` of the start on its +x side, over its first layer; returns the
+/// level it carries on.
+pub fn slide_carried(
+    h: &[f64],
+    reach: &mut [f64],
+    layer: &LayerRows,
+    node: usize,
     mut carry: f64,
-    eps: f64,
-    mask: &mut [u8],
-    scratch: &mut SlideScratch,
 ) -> f64 {
-    let n = (lanes.end - lanes.start) as usize;
-    if n == 0 {
-        return carry;
-    }
-    let shift = lanes.start as isize;
-    layer_rows(grid, fp, j0, scratch);
-    let SlideScratch {
-        level,
-        layer_min,
-        group_min,
-        rows,
-        groups,
-    } = scratch;
-    level.clear();
-    level.extend(yr.iter().zip(lanes.clone()).map(|(&y, i0)| if i0 >= 0 && y.is_finite() { y } else { f64::NEG_INFINITY }));
-    layer_min.clear();
-    layer_min.resize(n, f64::INFINITY);
-    group_min.resize(n, f64::INFINITY);
-
-    // Vectorised pass: every placed start judges its first layer from
-    // M = yr; the others (level -inf) collide nothing but record whether
-    // their layer holds any finite height.
-    for g in groups.iter() {
-        if g.len() == 1 {
-            let idx = rows[g.start].wrapping_add_signed(shift);
-            let h = &grid.h[idx..idx + n];
-            let out = &mut mask[idx..idx + n];
-            for (((&hv, m), lm), o) in h.iter().zip(level.iter_mut()).zip(layer_min.iter_mut()).zip(out) {
-                *o |= u8::from(hv < *m - eps);
-                *m = fmin(*m, hv);
-                *lm = fmin(*lm, hv);
-            }
-        } else {
-            group_min[..n].fill(f64::INFINITY);
-            for &idx in &rows[g.clone()] {
-                let idx = idx.wrapping_add_signed(shift);
-                let h = &grid.h[idx..idx + n];
-                let out = &mut mask[idx..idx + n];
-                for (((&hv, &m), gm), o) in h.iter().zip(level.iter()).zip(group_min.iter_mut()).zip(out) {
-                    *o |= u8::from(hv < m - eps);
-                    *gm = fmin(*gm, hv);
-                }
-            }
-            for ((m, lm), &gm) in level.iter_mut().zip(layer_min.iter_mut()).zip(group_min.iter()) {
-                *m = fmin(*m, gm);
-                *lm = fmin(*lm, gm);
-            }
-        }
-    }
-
-    // Scalar fix-up, from +x to -x: a start that is not placed continues
-    // the slide of the start on its +x side with that start's level.
-    for lane in (0..n).rev() {
-        let i0 = lanes.start + lane as i64;
-        if i0 >= 0 && yr[lane].is_finite() {
-            carry = level[lane];
-            continue;
-        }
-        if carry == f64::NEG_INFINITY || layer_min[lane] == f64::INFINITY {
-            continue;
-        }
-        for g in groups.iter() {
-            let mut gmin = f64::INFINITY;
-            for &idx in &rows[g.clone()] {
-                let node = idx.wrapping_add_signed(shift) + lane;
-                let hv = grid.h[node];
-                if hv < carry - eps {
-                    mask[node] = 1;
-                }
-                gmin = fmin(gmin, hv);
-            }
-            carry = fmin(carry, gmin);
+    for g in &layer.groups {
+        let before = carry;
+        for &offset in &layer.offsets[g.clone()] {
+            let a = node.wrapping_add_signed(offset);
+            reach[a] = fmax(reach[a], before);
+            carry = fmin(carry, h[a]);
         }
     }
     carry

@@ -1,7 +1,9 @@
 //! The fast path and the paper-literal path against a brute-force
 //! transcription of SPEC, on seeded random grids.
 
-use kneeform::{Algorithm, EngineOptions, Footprint, GridFootprint, HeightGrid, KneeForm, colliding_masks};
+use kneeform::{
+    Algorithm, EngineOptions, Footprint, GridFootprint, HeightGrid, KneeForm, colliding_masks,
+};
 
 use crate::util::{SEEDS, brute_force, mask_diff, random_grid};
 
@@ -14,7 +16,13 @@ const SMALL: KneeForm = KneeForm {
 
 const ANGLES: [f64; 5] = [-30.0, -7.0, 0.0, 12.0, 30.0];
 
-fn run(grid: &HeightGrid, knee: &KneeForm, angles: &[f64], algorithm: Algorithm, eps: f64) -> Vec<kneeform::AngleMask> {
+fn run(
+    grid: &HeightGrid,
+    knee: &KneeForm,
+    angles: &[f64],
+    algorithm: Algorithm,
+    eps: f64,
+) -> Vec<kneeform::AngleMask> {
     let footprints: Vec<GridFootprint> = angles
         .iter()
         .map(|&a| GridFootprint::new(&Footprint::new(knee, a), a, grid.spec.pitch))
@@ -38,8 +46,18 @@ fn check_against_brute_force(nx: usize, nz: usize, pitch: f64, knee: &KneeForm, 
         for (k, &angle) in ANGLES.iter().enumerate() {
             let (want, placed) = brute_force(&grid, knee, angle, eps);
             let what = format!("seed #{s}, {nx}x{nz} at p={pitch}, angle {angle}, eps {eps}");
-            assert_eq!(fast[k].mask, want, "fast vs brute force, {what}: {}", mask_diff(&grid, &fast[k].mask, &want));
-            assert_eq!(paper[k].mask, want, "paper vs brute force, {what}: {}", mask_diff(&grid, &paper[k].mask, &want));
+            assert_eq!(
+                fast[k].mask,
+                want,
+                "fast vs brute force, {what}: {}",
+                mask_diff(&grid, &fast[k].mask, &want)
+            );
+            assert_eq!(
+                paper[k].mask,
+                want,
+                "paper vs brute force, {what}: {}",
+                mask_diff(&grid, &paper[k].mask, &want)
+            );
             assert_eq!(fast[k].placed, placed, "{what}");
             assert_eq!(paper[k].placed, placed, "{what}");
             collisions += fast[k].colliding;
@@ -47,7 +65,10 @@ fn check_against_brute_force(nx: usize, nz: usize, pitch: f64, knee: &KneeForm, 
         }
     }
     // The grids are built to make the knee-form strike things.
-    assert!(collisions > 0, "no collision at all: the comparison proved nothing");
+    assert!(
+        collisions > 0,
+        "no collision at all: the comparison proved nothing"
+    );
 }
 
 #[test]

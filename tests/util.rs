@@ -52,7 +52,11 @@ pub fn random_grid(seed: u64, nx: usize, nz: usize, pitch: f64) -> HeightGrid {
             let (x, z) = (spec.x(i), spec.z(j));
             let v = amp * (fx * x).sin() * (fz * z).cos() + 3.0 * rng.unit() + tilt * x;
             let v = if rng.unit() < 0.02 { v - 8.0 } else { v };
-            h.push(if rng.unit() < hole { f64::INFINITY } else { (v * 2.0).round() / 2.0 });
+            h.push(if rng.unit() < hole {
+                f64::INFINITY
+            } else {
+                (v * 2.0).round() / 2.0
+            });
         }
     }
     HeightGrid { spec, h }
@@ -62,8 +66,12 @@ pub fn random_grid(seed: u64, nx: usize, nz: usize, pitch: f64) -> HeightGrid {
 fn triangle(knee: &KneeForm, angle_deg: f64) -> [[f64; 2]; 3] {
     let t = angle_deg.to_radians();
     let l = knee.triangle_side;
-    [[0.0, 0.0], [l * 3f64.sqrt() / 2.0, l / 2.0], [l * 3f64.sqrt() / 2.0, -l / 2.0]]
-        .map(|[x, z]| [x * t.cos() - z * t.sin(), x * t.sin() + z * t.cos()])
+    [
+        [0.0, 0.0],
+        [l * 3f64.sqrt() / 2.0, l / 2.0],
+        [l * 3f64.sqrt() / 2.0, -l / 2.0],
+    ]
+    .map(|[x, z]| [x * t.cos() - z * t.sin(), x * t.sin() + z * t.cos()])
 }
 
 /// Distance from (x, z) to the filled triangle.
@@ -93,7 +101,10 @@ fn row_start(v: &[[f64; 2]; 3], r: f64, dz: f64) -> Option<f64> {
     // The distance along the row is convex; its minimum is near the
     // triangle's x-range.
     let xs = v.map(|p| p[0]);
-    let (mut lo, mut hi) = (xs.iter().copied().fold(f64::INFINITY, f64::min), xs.iter().copied().fold(f64::NEG_INFINITY, f64::max));
+    let (mut lo, mut hi) = (
+        xs.iter().copied().fold(f64::INFINITY, f64::min),
+        xs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+    );
     // Ternary search for the closest point of the row.
     for _ in 0..200 {
         let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
@@ -110,7 +121,11 @@ fn row_start(v: &[[f64; 2]; 3], r: f64, dz: f64) -> Option<f64> {
     let (mut out, mut inn) = (centre - 4.0 * r - 1000.0, centre);
     for _ in 0..200 {
         let mid = (out + inn) / 2.0;
-        if distance_to_triangle(v, mid, dz) <= r { inn = mid } else { out = mid }
+        if distance_to_triangle(v, mid, dz) <= r {
+            inn = mid
+        } else {
+            out = mid
+        }
     }
     Some(inn)
 }
@@ -118,8 +133,15 @@ fn row_start(v: &[[f64; 2]; 3], r: f64, dz: f64) -> Option<f64> {
 /// SPEC's push and slide, transcribed per start: every node's membership
 /// from the distance to the footprint, every slide sorted in full. Returns
 /// the colliding mask and the number of placed starts.
-pub fn brute_force(grid: &HeightGrid, knee: &KneeForm, angle_deg: f64, eps: f64) -> (Vec<u8>, usize) {
-    let GridSpec { nx, nz, pitch: p, .. } = grid.spec;
+pub fn brute_force(
+    grid: &HeightGrid,
+    knee: &KneeForm,
+    angle_deg: f64,
+    eps: f64,
+) -> (Vec<u8>, usize) {
+    let GridSpec {
+        nx, nz, pitch: p, ..
+    } = grid.spec;
     let v = triangle(knee, angle_deg);
     let r = knee.radius;
     let mut mask = vec![0u8; nx * nz];
@@ -186,5 +208,9 @@ pub fn mask_diff(grid: &HeightGrid, got: &[u8], want: &[u8]) -> String {
         .take(10)
         .map(|(n, (g, w))| format!("(i={}, j={}): got {g} want {w}", n % nx, n / nx))
         .collect();
-    format!("{} differing nodes, first: {}", got.iter().zip(want).filter(|(g, w)| g != w).count(), diffs.join("; "))
+    format!(
+        "{} differing nodes, first: {}",
+        got.iter().zip(want).filter(|(g, w)| g != w).count(),
+        diffs.join("; ")
+    )
 }

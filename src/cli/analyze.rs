@@ -11,7 +11,10 @@ use indicatif::{ProgressBar, ProgressStyle};
 use kneeform::grid::GridSpec;
 use kneeform::output::{self, OutputDir};
 use kneeform::summary::{AngleSummary, Summary, Timings};
-use kneeform::{AngleMask, EngineOptions, Footprint, GridFootprint, HeightGrid, KneeForm, Part, Side, colliding_masks, composite};
+use kneeform::{
+    AngleMask, EngineOptions, Footprint, GridFootprint, HeightGrid, KneeForm, Part, Side,
+    colliding_masks, composite,
+};
 use sha2::Digest;
 
 use super::args::{AnalyzeArgs, GridPlacement, Setup};
@@ -36,7 +39,11 @@ pub fn prepare(path: &Path, scale: f64, side: Side, setup: &Setup) -> anyhow::Re
     let read_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let footprints: Vec<Footprint> = setup.angles.iter().map(|&a| Footprint::new(&setup.knee, a)).collect();
+    let footprints: Vec<Footprint> = setup
+        .angles
+        .iter()
+        .map(|&a| Footprint::new(&setup.knee, a))
+        .collect();
     let spec = grid_spec(&part, &setup.knee, setup)?;
     spec.check_fits(setup.max_memory_bytes)?;
     let grid = HeightGrid::sample(&part.triangles, spec);
@@ -67,16 +74,20 @@ fn grid_spec(part: &Part, knee: &KneeForm, setup: &Setup) -> anyhow::Result<Grid
                 .collect();
             GridSpec::around(&part.bbox(), &extents, setup.pitch)
         }
-        GridPlacement::Explicit { origin, size } => GridSpec::explicit(origin[0], origin[1], size[0], size[1], setup.pitch),
+        GridPlacement::Explicit { origin, size } => {
+            GridSpec::explicit(origin[0], origin[1], size[0], size[1], setup.pitch)
+        }
     })
 }
 
 /// Runs push and slide with a progress bar over angles.
 pub fn run_engine(prepared: &Prepared, setup: &Setup) -> Vec<AngleMask> {
     let bar = ProgressBar::new(prepared.footprints.len() as u64).with_style(
-        ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} angles, {elapsed} ({eta} left)")
-            .expect("static template")
-            .progress_chars("=> "),
+        ProgressStyle::with_template(
+            "{prefix} [{bar:30}] {pos}/{len} angles, {elapsed} ({eta} left)",
+        )
+        .expect("static template")
+        .progress_chars("=> "),
     );
     bar.set_prefix("push and slide");
     let options = EngineOptions {
@@ -84,7 +95,9 @@ pub fn run_engine(prepared: &Prepared, setup: &Setup) -> Vec<AngleMask> {
         algorithm: setup.algorithm,
         start_rows: None,
     };
-    let masks = colliding_masks(&prepared.grid, &prepared.footprints, &options, &|| bar.inc(1));
+    let masks = colliding_masks(&prepared.grid, &prepared.footprints, &options, &|| {
+        bar.inc(1)
+    });
     bar.finish_and_clear();
     masks
 }
@@ -92,6 +105,7 @@ pub fn run_engine(prepared: &Prepared, setup: &Setup) -> Vec<AngleMask> {
 pub fn run(args: &AnalyzeArgs) -> anyhow::Result<()> {
     args.part.validate()?;
     let setup = args.setup.validate()?;
+    super::set_threads(setup.threads)?;
     let started = Instant::now();
     let prepared = prepare(&args.part.part, args.part.scale, args.part.side, &setup)?;
     let t = Instant::now();
@@ -102,7 +116,8 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<()> {
     let counts = composite(&masks);
     let side = args.part.side;
     let grid = &prepared.grid;
-    let out = OutputDir::stage(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    let out = OutputDir::stage(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
     let create = |name: &str| -> anyhow::Result<BufWriter<std::fs::File>> {
         Ok(BufWriter::new(std::fs::File::create(out.path(name))?))
     };
@@ -110,8 +125,18 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<()> {
     output::write_composite(create("composite.csv")?, grid, &counts, side)?;
     output::write_colliding_area(create("colliding_area.stl")?, grid, &counts, side)?;
     output::write_depth_png(&out.path("depth.png"), grid)?;
-    let title = format!("Composite colliding area, {} angles (L = {} mm)", masks.len(), setup.knee.triangle_side);
-    output::write_composite_png(&out.path("composite.png"), grid, &counts, masks.len(), &title)?;
+    let title = format!(
+        "Composite colliding area, {} angles (L = {} mm)",
+        masks.len(),
+        setup.knee.triangle_side
+    );
+    output::write_composite_png(
+        &out.path("composite.png"),
+        grid,
+        &counts,
+        masks.len(),
+        &title,
+    )?;
     let mut summary = summarize(args, &setup, &prepared, &masks, &counts);
     summary.timings = Timings {
         read_s: prepared.read_s,
@@ -120,22 +145,36 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<()> {
         write_s: t.elapsed().as_secs_f64(),
         total_s: started.elapsed().as_secs_f64(),
     };
-    std::fs::write(out.path("summary.json"), serde_json::to_string_pretty(&summary)? + "\n")?;
-    out.commit().with_context(|| format!("cannot move results into {}", args.out.display()))?;
+    std::fs::write(
+        out.path("summary.json"),
+        serde_json::to_string_pretty(&summary)? + "\n",
+    )?;
+    out.commit()
+        .with_context(|| format!("cannot move results into {}", args.out.display()))?;
     eprintln!(
         "kneeform: {} angles, composite {} nodes ({:.0} mm^2); knee-form L = {} mm{}, R = {} mm; results in {}",
         masks.len(),
         summary.composite_nodes,
         summary.composite_area_mm2,
         setup.knee.triangle_side,
-        if summary.triangle_side_assumed { " (assumed)" } else { "" },
+        if summary.triangle_side_assumed {
+            " (assumed)"
+        } else {
+            ""
+        },
         setup.knee.radius,
         args.out.display()
     );
     Ok(())
 }
 
-fn summarize(args: &AnalyzeArgs, setup: &Setup, prepared: &Prepared, masks: &[AngleMask], counts: &[u16]) -> Summary {
+fn summarize(
+    args: &AnalyzeArgs,
+    setup: &Setup,
+    prepared: &Prepared,
+    masks: &[AngleMask],
+    counts: &[u16],
+) -> Summary {
     let spec = prepared.grid.spec;
     let area = spec.pitch * spec.pitch;
     let bbox = prepared.part.bbox();

@@ -63,7 +63,12 @@ pub struct SetupArgs {
     pub thickness: f64,
     /// Knee-form angles (degrees, positive raises its back): FROM:TO:STEP,
     /// or a comma-separated list (e.g. --angles=-30,-13,0,7,30).
-    #[arg(long, default_value = "-30:30:1", allow_hyphen_values = true, value_name = "ANGLES")]
+    #[arg(
+        long,
+        default_value = "-30:30:1",
+        allow_hyphen_values = true,
+        value_name = "ANGLES"
+    )]
     pub angles: String,
     /// Contact tolerance eps (mm): a grid point collides when it stands
     /// more than this above the knee-form's face; it absorbs the rounding of
@@ -72,7 +77,12 @@ pub struct SetupArgs {
     pub eps: f64,
     /// Grid origin X,Z (mm), snapped to multiples of the pitch. Default: the
     /// part's xz bounding box grown by the knee-form's extent.
-    #[arg(long, value_name = "X,Z", allow_hyphen_values = true, requires = "grid_size")]
+    #[arg(
+        long,
+        value_name = "X,Z",
+        allow_hyphen_values = true,
+        requires = "grid_size"
+    )]
     pub grid_origin: Option<String>,
     /// Grid size NX,NZ (nodes), with --grid-origin.
     #[arg(long, value_name = "NX,NZ", requires = "grid_origin")]
@@ -118,7 +128,12 @@ pub struct ScenarioArgs {
 pub struct BenchArgs {
     /// Knee-form angles (degrees) for the fast engine's timing, as for
     /// `analyze`; the paper's workload is all 61.
-    #[arg(long, default_value = "-30:30:1", allow_hyphen_values = true, value_name = "ANGLES")]
+    #[arg(
+        long,
+        default_value = "-30:30:1",
+        allow_hyphen_values = true,
+        value_name = "ANGLES"
+    )]
     pub angles: String,
     /// Timed runs of the fast engine; the median is reported.
     #[arg(long, default_value_t = 5, value_name = "N")]
@@ -172,15 +187,24 @@ impl SetupArgs {
         positive("--radius", self.radius)?;
         positive("--thickness", self.thickness)?;
         positive("--max-memory", self.max_memory)?;
-        ensure!(self.eps.is_finite() && self.eps >= 0.0, "--eps must be a finite number >= 0, got {}", self.eps);
+        ensure!(
+            self.eps.is_finite() && self.eps >= 0.0,
+            "--eps must be a finite number >= 0, got {}",
+            self.eps
+        );
         if let Some(n) = self.threads {
             ensure!(n >= 1, "--threads must be at least 1");
         }
         let grid = match (&self.grid_origin, &self.grid_size) {
             (Some(origin), Some(size)) => {
-                let [x, z] = pair::<f64>(origin).with_context(|| format!("--grid-origin {origin:?}: expected X,Z in mm"))?;
-                ensure!(x.is_finite() && z.is_finite(), "--grid-origin must be finite");
-                let [nx, nz] = pair::<usize>(size).with_context(|| format!("--grid-size {size:?}: expected NX,NZ node counts"))?;
+                let [x, z] = pair::<f64>(origin)
+                    .with_context(|| format!("--grid-origin {origin:?}: expected X,Z in mm"))?;
+                ensure!(
+                    x.is_finite() && z.is_finite(),
+                    "--grid-origin must be finite"
+                );
+                let [nx, nz] = pair::<usize>(size)
+                    .with_context(|| format!("--grid-size {size:?}: expected NX,NZ node counts"))?;
                 ensure!(nx > 0 && nz > 0, "--grid-size must be at least 1,1");
                 GridPlacement::Explicit {
                     origin: [x, z],
@@ -214,7 +238,10 @@ impl PartArgs {
 }
 
 fn positive(flag: &str, v: f64) -> anyhow::Result<()> {
-    ensure!(v.is_finite() && v > 0.0, "{flag} must be a finite number > 0, got {v}");
+    ensure!(
+        v.is_finite() && v > 0.0,
+        "{flag} must be a finite number > 0, got {v}"
+    );
     Ok(())
 }
 
@@ -230,8 +257,14 @@ where
 /// Parses `FROM:TO:STEP` (inclusive) or a comma-separated list of angles.
 pub fn parse_angles(s: &str) -> anyhow::Result<Vec<f64>> {
     let number = |t: &str| -> anyhow::Result<f64> {
-        let v: f64 = t.trim().parse().with_context(|| format!("--angles: {t:?} is not a number"))?;
-        ensure!(v.is_finite() && v.abs() <= 90.0, "--angles: {v} is outside -90..90 degrees");
+        let v: f64 = t
+            .trim()
+            .parse()
+            .with_context(|| format!("--angles: {t:?} is not a number"))?;
+        ensure!(
+            v.is_finite() && v.abs() <= 90.0,
+            "--angles: {v} is outside -90..90 degrees"
+        );
         Ok(v)
     };
     let angles = if s.contains(':') {
@@ -242,9 +275,13 @@ pub fn parse_angles(s: &str) -> anyhow::Result<Vec<f64>> {
         ensure!(to >= from, "--angles {s:?}: TO must be >= FROM");
         let n = ((to - from) / step + 1e-9).floor() as usize + 1;
         // Rounded to 1e-9 degree so that 0.1-degree steps print cleanly.
-        (0..n).map(|k| ((from + k as f64 * step) * 1e9).round() / 1e9).collect()
+        (0..n)
+            .map(|k| ((from + k as f64 * step) * 1e9).round() / 1e9)
+            .collect()
     } else {
-        s.split(',').map(number).collect::<anyhow::Result<Vec<f64>>>()?
+        s.split(',')
+            .map(number)
+            .collect::<anyhow::Result<Vec<f64>>>()?
     };
     let mut sorted = angles.clone();
     sorted.sort_by(f64::total_cmp);
@@ -262,7 +299,10 @@ mod tests {
     #[test]
     fn angle_ranges_and_lists() {
         assert_eq!(parse_angles("-30:30:1").unwrap().len(), 61);
-        assert_eq!(parse_angles("-30,-13,0,7,30").unwrap(), vec![-30.0, -13.0, 0.0, 7.0, 30.0]);
+        assert_eq!(
+            parse_angles("-30,-13,0,7,30").unwrap(),
+            vec![-30.0, -13.0, 0.0, 7.0, 30.0]
+        );
         assert_eq!(parse_angles("0:1:0.1").unwrap()[3], 0.3);
         assert!(parse_angles("1,1").is_err());
         assert!(parse_angles("0:1").is_err());
@@ -272,8 +312,11 @@ mod tests {
 
     #[test]
     fn negative_angle_lists_parse_as_values() {
-        let cli = Cli::try_parse_from(["kneeform", "analyze", "p.stl", "--angles", "-30,-13"]).unwrap();
-        let Command::Analyze(a) = cli.command else { panic!("not analyze") };
+        let cli =
+            Cli::try_parse_from(["kneeform", "analyze", "p.stl", "--angles", "-30,-13"]).unwrap();
+        let Command::Analyze(a) = cli.command else {
+            panic!("not analyze")
+        };
         assert_eq!(a.setup.validate().unwrap().angles, vec![-30.0, -13.0]);
     }
 }

@@ -12,7 +12,9 @@ use std::time::Instant;
 use anyhow::ensure;
 use kneeform::console::{CONSOLE_SIZE, console_triangles};
 use kneeform::grid::GridSpec;
-use kneeform::{Algorithm, EngineOptions, Footprint, GridFootprint, HeightGrid, KneeForm, colliding_masks};
+use kneeform::{
+    Algorithm, EngineOptions, Footprint, GridFootprint, HeightGrid, KneeForm, colliding_masks,
+};
 
 use super::args::BenchArgs;
 
@@ -38,7 +40,10 @@ fn peak_rss_mib() -> Option<f64> {
 
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     ensure!(args.runs >= 1, "--runs must be at least 1");
-    ensure!(args.paper_rows >= 1 && args.paper_angles >= 1, "--paper-rows and --paper-angles must be at least 1");
+    ensure!(
+        args.paper_rows >= 1 && args.paper_angles >= 1,
+        "--paper-rows and --paper-angles must be at least 1"
+    );
     let knee = KneeForm::default();
     let angles = super::args::parse_angles(&args.angles)?;
     let t = Instant::now();
@@ -47,7 +52,10 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     // The grid centred on the console.
     let [lx, lz] = CONSOLE_SIZE;
     let [nx, nz] = PAPER_GRID;
-    let origin = [(lx - (nx - 1) as f64 * PAPER_PITCH) / 2.0, (lz - (nz - 1) as f64 * PAPER_PITCH) / 2.0];
+    let origin = [
+        (lx - (nx - 1) as f64 * PAPER_PITCH) / 2.0,
+        (lz - (nz - 1) as f64 * PAPER_PITCH) / 2.0,
+    ];
     let spec = GridSpec::explicit(origin[0], origin[1], nx, nz, PAPER_PITCH);
     let footprints: Vec<GridFootprint> = angles
         .iter()
@@ -66,8 +74,17 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         let t = Instant::now();
         let masks = colliding_masks(&g, &footprints, &fast, &|| {});
         slide_s.push(t.elapsed().as_secs_f64());
-        composite_nodes = kneeform::composite(&masks).iter().filter(|&&c| c > 0).count();
-        eprintln!("run {}/{}: sample {:.3} s, push+slide {:.3} s", run + 1, args.runs, sample_s[run], slide_s[run]);
+        composite_nodes = kneeform::composite(&masks)
+            .iter()
+            .filter(|&&c| c > 0)
+            .count();
+        eprintln!(
+            "run {}/{}: sample {:.3} s, push+slide {:.3} s",
+            run + 1,
+            args.runs,
+            sample_s[run],
+            slide_s[run]
+        );
         grid = Some(g);
     }
     let grid = grid.expect("at least one run");
@@ -76,7 +93,9 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
 
     // The paper algorithm on a sample of start rows through the part and a
     // sample of angles, against the fast one on exactly the same sample.
-    let rows: Vec<usize> = (0..args.paper_rows).map(|k| (nz / 4) + k * (nz / 2) / args.paper_rows).collect();
+    let rows: Vec<usize> = (0..args.paper_rows)
+        .map(|k| (nz / 4) + k * (nz / 2) / args.paper_rows)
+        .collect();
     let sampled: Vec<GridFootprint> = (0..args.paper_angles)
         .map(|k| footprints[k * (footprints.len() - 1) / (args.paper_angles - 1).max(1)].clone())
         .collect();
@@ -97,21 +116,42 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     }
     let fast_sample_s = median(fast_runs);
     let identical = paper_masks == fast_masks;
-    let scale_up = (nz as f64 / rows.len() as f64) * (footprints.len() as f64 / sampled.len() as f64);
+    let scale_up =
+        (nz as f64 / rows.len() as f64) * (footprints.len() as f64 / sampled.len() as f64);
     let paper_full_s = paper_sample_s * scale_up;
 
     let mut md = String::new();
     let threads = rayon::current_num_threads();
     writeln!(md, "| quantity | value |")?;
     writeln!(md, "| --- | --- |")?;
-    writeln!(md, "| part | console, {} triangles (built in {build_s:.2} s) |", triangles.len())?;
-    writeln!(md, "| grid | {nx} x {nz} at {PAPER_PITCH} mm, {} nodes sampled |", grid.finite_count())?;
+    writeln!(
+        md,
+        "| part | console, {} triangles (built in {build_s:.2} s) |",
+        triangles.len()
+    )?;
+    writeln!(
+        md,
+        "| grid | {nx} x {nz} at {PAPER_PITCH} mm, {} nodes sampled |",
+        grid.finite_count()
+    )?;
     writeln!(md, "| angles | {} ({}) |", footprints.len(), args.angles)?;
     writeln!(md, "| threads | {threads} |")?;
     writeln!(md, "| sampling (median of {}) | {sample:.3} s |", args.runs)?;
-    writeln!(md, "| push + slide, {} angles (median) | {slide:.3} s |", footprints.len())?;
-    writeln!(md, "| per angle | {:.1} ms |", slide / footprints.len() as f64 * 1e3)?;
-    writeln!(md, "| **total (sample + {} angles)** | **{total:.3} s** |", footprints.len())?;
+    writeln!(
+        md,
+        "| push + slide, {} angles (median) | {slide:.3} s |",
+        footprints.len()
+    )?;
+    writeln!(
+        md,
+        "| per angle | {:.1} ms |",
+        slide / footprints.len() as f64 * 1e3
+    )?;
+    writeln!(
+        md,
+        "| **total (sample + {} angles)** | **{total:.3} s** |",
+        footprints.len()
+    )?;
     writeln!(md, "| composite colliding nodes | {composite_nodes} |")?;
     if let Some(mib) = peak_rss_mib() {
         writeln!(md, "| peak memory (RSS) | {mib:.0} MiB |")?;
@@ -122,14 +162,28 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         rows.len(),
         sampled.len()
     )?;
-    writeln!(md, "| paper / fast on that sample | **{:.0}x** |", paper_sample_s / fast_sample_s)?;
+    writeln!(
+        md,
+        "| paper / fast on that sample | **{:.0}x** |",
+        paper_sample_s / fast_sample_s
+    )?;
     writeln!(md, "| masks identical on that sample | {identical} |")?;
-    writeln!(md, "| paper algorithm, full run (EXTRAPOLATED x{scale_up:.0}) | {paper_full_s:.0} s |")?;
-    writeln!(md, "| the paper's reported time (GPU + CPU) | {PAPER_SECONDS} s, {:.0}x ours |", PAPER_SECONDS / total)?;
+    writeln!(
+        md,
+        "| paper algorithm, full run (EXTRAPOLATED x{scale_up:.0}) | {paper_full_s:.0} s |"
+    )?;
+    writeln!(
+        md,
+        "| the paper's reported time (GPU + CPU) | {PAPER_SECONDS} s, {:.0}x ours |",
+        PAPER_SECONDS / total
+    )?;
     print!("{md}");
     if let Some(path) = &args.markdown {
         std::fs::write(path, &md)?;
     }
-    ensure!(identical, "the paper and fast algorithms disagree on the sampled rows");
+    ensure!(
+        identical,
+        "the paper and fast algorithms disagree on the sampled rows"
+    );
     Ok(())
 }
