@@ -152,6 +152,91 @@ impl KneeForm {
     }
 }
 
+/// Which end of a horizontal line through the footprint.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub(crate) enum End {
+    /// The -x end (the leading edge of a slide).
+    Left,
+    /// The +x end.
+    Right,
+}
+
+impl KneeForm {
+    /// The footprint's z-range relative to the reference point, mm.
+    pub(crate) fn z_range(&self) -> (f64, f64) {
+        let (min, max) = self.xz_extent();
+        (min[1], max[1])
+    }
+
+    /// Where the line at height `z` (relative to the reference point)
+    /// leaves the footprint at `end`, or `None` outside its z-range.
+    ///
+    /// `T (+) D_R` is the union of the three capsules `edge (+) D_R`; a
+    /// capsule's end on the line lies on one of its two offset segments
+    /// or on one of its end discs, so the extreme of those candidates is
+    /// exact.
+    pub(crate) fn x_at(&self, z: f64, end: End) -> Option<f64> {
+        let sign = match end {
+            End::Left => 1.0,
+            End::Right => -1.0,
+        };
+        let r = self.dims.radius;
+        // Work on the shape mirrored in x for the right end: its left end.
+        let t = self.triangle.map(|[x, zz]| [sign * x, zz]);
+        let mut best = f64::INFINITY;
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            for v in [a, b] {
+                let dz = z - v[1];
+                if dz.abs() <= r {
+                    best = best.min(v[0] - (r * r - dz * dz).sqrt());
+                }
+            }
+            let e = [b[0] - a[0], b[1] - a[1]];
+            let len = e[0].hypot(e[1]);
+            for side in [1.0, -1.0] {
+                let n = [side * e[1] / len, -side * e[0] / len];
+                let (a_off, b_off) = (
+                    [a[0] + r * n[0], a[1] + r * n[1]],
+                    [b[0] + r * n[0], b[1] + r * n[1]],
+                );
+                let dz = b_off[1] - a_off[1];
+                if dz != 0.0 {
+                    let u = (z - a_off[1]) / dz;
+                    if (0.0..=1.0).contains(&u) {
+                        best = best.min(a_off[0] + u * (b_off[0] - a_off[0]));
+                    }
+                }
+            }
+        }
+        best.is_finite().then_some(sign * best)
+    }
+
+    /// The extreme of [`KneeForm::x_at`] over the heights `[za, zb]`
+    /// (relative, clipped to the footprint): the smallest left end or the
+    /// largest right end; `None` when the interval misses the footprint.
+    /// The left end is convex in z and the right end concave, so the
+    /// extreme is at the footprint's extreme point clamped to the interval.
+    pub(crate) fn extreme_x(&self, za: f64, zb: f64, end: End) -> Option<f64> {
+        let (lo, hi) = self.z_range();
+        let (za, zb) = (za.max(lo), zb.min(hi));
+        if za > zb {
+            return None;
+        }
+        let dir = match end {
+            End::Left => -1.0,
+            End::Right => 1.0,
+        };
+        // The extreme point in x is a vertex's (the disc adds R along x).
+        let apex = self
+            .triangle
+            .iter()
+            .max_by(|p, q| (dir * p[0]).total_cmp(&(dir * q[0])))
+            .map_or(0.0, |v| v[1]);
+        self.x_at(apex.clamp(za, zb), end)
+    }
+}
+
 impl SupportMap for KneeForm {
     fn local_support_point(&self, dir: Vector) -> Vector {
         let [x, z] = self.xz_support(dir.x, dir.z);
@@ -418,6 +503,43 @@ mod tests {
                         .fold(f64::NEG_INFINITY, f64::max);
                     assert!(best <= support + 1e-9, "angle {angle}: {best} > {support}");
                     assert!(best >= support - 1e-3, "angle {angle}: {best} << {support}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn left_and_right_ends_agree_with_the_distance_to_the_triangle() {
+        let dims = KneeFormDims::default();
+        for angle in [-30.0, -7.0, 0.0, 25.0, 30.0] {
+            let knee = KneeForm::new(dims, angle);
+            let (lo, hi) = knee.z_range();
+            assert_eq!(knee.x_at(lo - 0.1, End::Left), None);
+            for k in 1..400 {
+                let z = lo + (hi - lo) * k as f64 / 400.0;
+                let left = knee.x_at(z, End::Left).unwrap();
+                let right = knee.x_at(z, End::Right).unwrap();
+                assert!(left <= right);
+                // Both ends are on the boundary of T (+) D_R ...
+                for x in [left, right] {
+                    let d = distance_to_triangle([x, z], knee.triangle());
+                    assert!((d - dims.radius).abs() < 1e-9, "angle {angle} z {z}: {d}");
+                }
+                // ... and just outside them is outside the shape.
+                assert!(distance_to_triangle([left - 1e-6, z], knee.triangle()) > dims.radius);
+                assert!(distance_to_triangle([right + 1e-6, z], knee.triangle()) > dims.radius);
+                // The interval extremes bound every height inside.
+                let (za, zb) = (z - 7.0, z + 3.0);
+                let min_left = knee.extreme_x(za, zb, End::Left).unwrap();
+                let max_right = knee.extreme_x(za, zb, End::Right).unwrap();
+                for i in 0..=20 {
+                    let zi = za + (zb - za) * i as f64 / 20.0;
+                    if let Some(x) = knee.x_at(zi, End::Left) {
+                        assert!(min_left <= x + 1e-9);
+                    }
+                    if let Some(x) = knee.x_at(zi, End::Right) {
+                        assert!(max_right >= x - 1e-9);
+                    }
                 }
             }
         }

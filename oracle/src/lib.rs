@@ -23,14 +23,18 @@
 
 //!
 //! **Invariant:** a start is never reported clear on a failed query: parry
-//! returns "no hit" when GJK runs out of iterations, so every miss is
-//! confirmed by a contact query between the swept knee-form and the mesh, and
-//! every non-converged cast makes the start [`StartStatus::Failed`].
+//! returns "no hit" when GJK runs out of iterations, so every triangle a
+//! cast reports as missed is confirmed by a contact query with the swept
+//! knee-form, and every non-converged cast makes the start
+//! [`StartStatus::Failed`].
+//!
+//! **Invariant:** the oracle does not depend on the `kneeform` engine.
 
 mod batch;
 mod error;
 mod knee_form;
 mod part;
+mod sweep;
 
 mod trace;
 

@@ -37,11 +37,11 @@
 //! knee-form is already past it) and is skipped, so reported travels never
 //! decrease by more than `jump_tolerance`.
 
-use parry3d_f64::math::{Pose, Vector};
-use parry3d_f64::query::{ShapeCastOptions, ShapeCastStatus, cast_shapes, contact};
+use parry3d_f64::math::Vector;
 use serde::{Deserialize, Serialize};
 
-use crate::knee_form::{KneeForm, KneeFormDims, SweptKneeForm};
+use crate::knee_form::{KneeForm, KneeFormDims};
+use crate::sweep::{self, Motion};
 use crate::{OracleError, Part};
 
 /// How far below the mesh's lowest point the push cast starts, mm. Any
@@ -290,75 +290,38 @@ struct Tracer<'a> {
 }
 
 impl Tracer<'_> {
-    /// One shape cast of the knee-form from `pose` along the unit `dir`, up
-    /// to `max_travel` mm. A miss is confirmed by a contact query between
-    /// the swept knee-form and the mesh before it is believed.
+    /// One shape cast (see [`crate::sweep`]) from the reference point at
+    /// `start`, face level `level`, counted against the budget.
     fn cast(
         &mut self,
-        pose: &Pose,
-        dir: Vector,
+        level: f64,
+        motion: Motion,
         max_travel: f64,
     ) -> Result<Option<(f64, Vector)>, FailureReason> {
         if self.casts >= self.options.max_casts {
             return Err(FailureReason::CastBudgetExhausted);
         }
         self.casts += 1;
-        let cast_options = ShapeCastOptions {
-            max_time_of_impact: max_travel,
-            target_distance: 0.0,
-            stop_at_penetration: false,
-            compute_impact_geometry_on_penetration: true,
-        };
-        let mesh = self.part.mesh();
-        let hit = cast_shapes(
-            pose,
-            dir,
+        let origin = Vector::new(self.start[0], level, self.start[1]);
+        let grazing = GRAZING_FRACTION * self.options.eps;
+        let hit = sweep::cast(
+            self.part.mesh(),
             &self.knee,
-            &Pose::IDENTITY,
-            Vector::ZERO,
-            mesh,
-            cast_options,
-        )
-        .map_err(|_| FailureReason::Unsupported)?;
-        match hit {
-            Some(hit) => match hit.status {
-                ShapeCastStatus::Converged => Ok(Some((hit.time_of_impact, hit.witness2))),
-                ShapeCastStatus::PenetratingOrWithinTargetDist => {
-                    Err(FailureReason::PenetratingStart)
-                }
-                ShapeCastStatus::OutOfIterations | ShapeCastStatus::Failed => {
-                    Err(FailureReason::CastNotConverged)
-                }
-            },
-            None => {
-                let swept = SweptKneeForm {
-                    knee: self.knee,
-                    sweep: dir * max_travel,
-                };
-                let overlap = contact(pose, &swept, &Pose::IDENTITY, mesh, 0.0)
-                    .map_err(|_| FailureReason::Unsupported)?;
-                // GJK also gives up on casts that only graze the mesh. An
-                // overlap shallower than a tenth of eps is below what the
-                // grid's rule `h < f - eps` can see: such a pass counts as
-                // a miss. A deeper one means the cast failed.
-                match overlap {
-                    Some(c) if -c.dist > GRAZING_FRACTION * self.options.eps => {
-                        Err(FailureReason::UnconfirmedMiss)
-                    }
-                    _ => Ok(None),
-                }
-            }
-        }
+            origin,
+            motion,
+            max_travel,
+            grazing,
+        )?;
+        Ok(hit.map(|c| (c.travel, c.witness)))
     }
 
     /// The push: `Some((yr*, witness))`, or `None` when not placed.
     fn push(&mut self) -> Result<Option<(f64, Vector)>, FailureReason> {
         let (mins, maxs) = self.part.bounds();
         let from = mins[1] - PUSH_CLEARANCE;
-        let pose = KneeForm::pose(self.start, from);
         let reach = maxs[1] - from + PUSH_CLEARANCE;
         Ok(self
-            .cast(&pose, Vector::Y, reach)?
+            .cast(from, Motion::Push, reach)?
             .map(|(toi, witness)| (from + toi, witness)))
     }
 
@@ -370,9 +333,8 @@ impl Tracer<'_> {
         let back = self.start[0] + self.knee.x_extent().1;
         let edge = mins[0].max(self.options.x_min);
         let reach = (back - edge + SLIDE_MARGIN).max(SLIDE_MARGIN);
-        let pose = KneeForm::pose(self.start, level);
         Ok(self
-            .cast(&pose, -Vector::X, reach)?
+            .cast(level, Motion::Slide, reach)?
             .map(|(travel, witness)| Hit { travel, witness }))
     }
 
