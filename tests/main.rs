@@ -1,5 +1,7 @@
 //! The integration tests, one binary: helpers in `util`, one module per
 //! capability.
 
+mod analytic;
+mod cli;
 mod engine;
 mod util;

@@ -214,3 +214,43 @@ pub fn mask_diff(grid: &HeightGrid, got: &[u8], want: &[u8]) -> String {
         diffs.join("; ")
     )
 }
+
+/// Samples `triangles` on SPEC's default grid and runs the fast engine.
+pub fn analyse(
+    triangles: &[kneeform::mesh::Triangle],
+    pitch: f64,
+    knee: &KneeForm,
+    angles: &[f64],
+) -> (HeightGrid, Vec<kneeform::AngleMask>) {
+    use kneeform::{EngineOptions, Footprint, GridFootprint, Part, Side, colliding_masks};
+    let part =
+        Part::from_triangles("test", triangles.to_vec(), 1.0, Side::Left).expect("a valid part");
+    let extent: Vec<Footprint> = angles
+        .iter()
+        .flat_map(|&a| [Footprint::new(knee, a), Footprint::new(knee, -a)])
+        .collect();
+    let grid = HeightGrid::sample(
+        &part.triangles,
+        GridSpec::around(&part.bbox(), &extent, pitch),
+    );
+    let footprints: Vec<GridFootprint> = angles
+        .iter()
+        .map(|&a| GridFootprint::new(&Footprint::new(knee, a), a, pitch))
+        .collect();
+    let masks = colliding_masks(&grid, &footprints, &EngineOptions::default(), &|| {});
+    (grid, masks)
+}
+
+/// A unique, empty scratch directory under the system's temporary one.
+pub fn scratch_dir(name: &str) -> std::path::PathBuf {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "kneeform-test-{}-{}-{name}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("a scratch directory");
+    dir
+}

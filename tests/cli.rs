@@ -1,0 +1,337 @@
+//! The `kneeform` binary end to end: real third-party meshes, bad input,
+//! determinism across thread counts, and the side and z symmetries.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use kneeform::mesh::Triangle;
+use kneeform::scenario::{HeightField, Scenario, triangulate, write_stl};
+
+use crate::util::scratch_dir;
+
+fn kneeform(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_kneeform"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn shared_meshes() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes")
+}
+
+const OUTPUTS: [&str; 6] = [
+    "summary.json",
+    "colliding_points.csv",
+    "composite.csv",
+    "colliding_area.stl",
+    "depth.png",
+    "composite.png",
+];
+
+/// Asserts a run failed cleanly: exit 2, one line on stderr, no output
+/// directory and no staging directory left beside it.
+fn assert_clean_failure(out: &Output, dir: &Path, what: &str) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{what}: {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{what}: not one line: {stderr}");
+    assert!(stderr.starts_with("kneeform: error: "), "{what}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{what}: {stderr}");
+    assert!(!dir.exists(), "{what}: output directory left behind");
+    let parent = dir.parent().expect("a parent");
+    let leftovers: Vec<_> = std::fs::read_dir(parent)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().contains("partial"))
+        .collect();
+    assert!(
+        leftovers.is_empty(),
+        "{what}: staging left behind: {leftovers:?}"
+    );
+}
+
+#[test]
+fn every_shared_mesh_analyses_or_fails_cleanly() {
+    let mut analysed = 0;
+    let mut refused = 0;
+    let mut files: Vec<PathBuf> = std::fs::read_dir(shared_meshes())
+        .expect("../shared/meshes beside the repository")
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("stl")))
+        .collect();
+    files.sort();
+    assert!(
+        files.len() >= 10,
+        "expected the shared meshes, found {files:?}"
+    );
+    for file in &files {
+        let scratch = scratch_dir("mesh");
+        let dir = scratch.join("out");
+        let out = kneeform(&[
+            "analyze",
+            file.to_str().unwrap(),
+            "--out",
+            dir.to_str().unwrap(),
+            "--pitch",
+            "2",
+            "--angles=-30,0,30",
+        ]);
+        let name = file.file_name().unwrap().to_string_lossy().to_string();
+        if out.status.success() {
+            for f in OUTPUTS {
+                let len = std::fs::metadata(dir.join(f)).map(|m| m.len()).unwrap_or(0);
+                assert!(
+                    len > 0 || f.ends_with(".csv"),
+                    "{name}: {f} missing or empty"
+                );
+            }
+            let summary: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap();
+            let triangles = summary["triangles"].as_u64().unwrap();
+            assert!(
+                triangles > 0 && summary["degenerate_triangles"].as_u64().unwrap() < triangles,
+                "{name}"
+            );
+            assert_eq!(summary["sha256"].as_str().unwrap().len(), 64, "{name}");
+            assert_eq!(summary["triangle_side_mm"], 200.0);
+            assert_eq!(summary["triangle_side_assumed"], true);
+            analysed += 1;
+        } else {
+            assert_clean_failure(&out, &dir, &name);
+            refused += 1;
+        }
+        std::fs::remove_dir_all(&scratch).unwrap();
+    }
+    // The three empty files must be refused; the real parts must analyse.
+    assert_eq!(refused, 3, "analysed {analysed}, refused {refused}");
+    assert_eq!(analysed, files.len() - 3);
+}
+
+#[test]
+fn bad_input_gets_one_line_and_exit_2() {
+    let scratch = scratch_dir("bad");
+    let dir = scratch.join("out");
+    let garbage = scratch.join("garbage.stl");
+    std::fs::write(&garbage, vec![7u8; 300]).unwrap();
+    let truncated = scratch.join("truncated.stl");
+    let mut bytes = std::fs::read(shared_meshes().join("featuretype.STL")).unwrap();
+    bytes.truncate(bytes.len() / 2);
+    std::fs::write(&truncated, bytes).unwrap();
+    let nan = scratch.join("nan.stl");
+    write_stl(
+        &nan,
+        &[[[0.0, f64::NAN, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]],
+    )
+    .unwrap();
+    let part = scratch.join("part.stl");
+    write_stl(&part, &triangulate(Scenario::Bump, &HeightField::default())).unwrap();
+    let (g, t, n, p, d) = (
+        garbage.to_str().unwrap(),
+        truncated.to_str().unwrap(),
+        nan.to_str().unwrap(),
+        part.to_str().unwrap(),
+        dir.to_str().unwrap(),
+    );
+    let cases: Vec<(&str, Vec<&str>)> = vec![
+        (
+            "missing file",
+            vec!["analyze", "/nonexistent/part.stl", "--out", d],
+        ),
+        ("garbage", vec!["analyze", g, "--out", d]),
+        ("truncated", vec!["analyze", t, "--out", d]),
+        ("NaN vertex", vec!["analyze", n, "--out", d]),
+        ("zero pitch", vec!["analyze", p, "--out", d, "--pitch", "0"]),
+        (
+            "grid too large",
+            vec!["analyze", p, "--out", d, "--pitch", "0.001"],
+        ),
+        (
+            "bad angles",
+            vec!["analyze", p, "--out", d, "--angles", "0:10"],
+        ),
+        (
+            "bad grid origin",
+            vec![
+                "analyze",
+                p,
+                "--out",
+                d,
+                "--grid-origin",
+                "x,1",
+                "--grid-size",
+                "10,10",
+            ],
+        ),
+    ];
+    for (what, args) in cases {
+        let out = kneeform(&args);
+        assert_clean_failure(&out, &dir, what);
+    }
+    // The memory refusal names what it would need.
+    let out = kneeform(&["analyze", p, "--out", d, "--pitch", "0.001"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("GiB"));
+    std::fs::remove_dir_all(&scratch).unwrap();
+}
+
+fn analyse_to(part: &Path, dir: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "analyze",
+        part.to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+        "--pitch",
+        "2.5",
+        "--angles=-30,-12,0,12,30",
+    ];
+    args.extend_from_slice(extra);
+    let out = kneeform(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+#[test]
+fn thread_count_does_not_change_any_byte() {
+    let scratch = scratch_dir("threads");
+    let part = scratch.join("part.stl");
+    write_stl(
+        &part,
+        &triangulate(Scenario::Depression, &HeightField::default()),
+    )
+    .unwrap();
+    analyse_to(&part, &scratch.join("one"), &["--threads", "1"]);
+    analyse_to(&part, &scratch.join("many"), &[]);
+    for f in [
+        "colliding_points.csv",
+        "composite.csv",
+        "colliding_area.stl",
+    ] {
+        let a = std::fs::read(scratch.join("one").join(f)).unwrap();
+        let b = std::fs::read(scratch.join("many").join(f)).unwrap();
+        assert!(
+            a.len() > 100,
+            "{f} is nearly empty: the comparison would prove nothing"
+        );
+        assert!(a == b, "{f} differs between --threads 1 and the default");
+    }
+    std::fs::remove_dir_all(&scratch).unwrap();
+}
+
+/// Rows of a CSV file as text fields, header dropped.
+fn csv_rows(path: &Path) -> Vec<Vec<String>> {
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    reader
+        .records()
+        .map(|r| r.unwrap().iter().map(str::to_string).collect())
+        .collect()
+}
+
+fn mirrored(tris: &[Triangle], axis: usize) -> Vec<Triangle> {
+    tris.iter()
+        .map(|t| {
+            // Mirroring flips the winding; swap two vertices to keep it.
+            let m = t.map(|mut v| {
+                v[axis] = -v[axis];
+                v
+            });
+            [m[0], m[2], m[1]]
+        })
+        .collect()
+}
+
+/// A part with features varying along z, so that the angle matters.
+fn asymmetric_part() -> Vec<Triangle> {
+    let field = HeightField {
+        x_range: (-150.0, 150.0),
+        z_range: (-40.0, 90.0),
+        step: 2.5,
+    };
+    triangulate(Scenario::Bump, &field)
+        .into_iter()
+        .map(|t| t.map(|[x, y, z]| [x, y - 0.05 * z * (x / 50.0).sin(), z]))
+        .collect()
+}
+
+#[test]
+fn right_side_of_a_mirrored_part_gives_the_mirrored_result() {
+    let scratch = scratch_dir("side");
+    let tris = asymmetric_part();
+    let (left, right) = (scratch.join("left.stl"), scratch.join("right.stl"));
+    write_stl(&left, &tris).unwrap();
+    write_stl(&right, &mirrored(&tris, 1)).unwrap();
+    analyse_to(&left, &scratch.join("l"), &["--side", "left"]);
+    analyse_to(&right, &scratch.join("r"), &["--side", "right"]);
+    // y is column 4 of colliding_points (angle_deg,i,j,x,y,z) and column 3
+    // of composite (i,j,x,y,z,angles).
+    for (f, y_col) in [("colliding_points.csv", 4), ("composite.csv", 3)] {
+        let l = csv_rows(&scratch.join("l").join(f));
+        let r = csv_rows(&scratch.join("r").join(f));
+        assert!(l.len() > 20, "{f}: too few rows to prove anything");
+        assert_eq!(l.len(), r.len(), "{f}");
+        // Same nodes, y negated.
+        for (a, b) in l.iter().zip(&r) {
+            for (k, (u, v)) in a.iter().zip(b).enumerate() {
+                if k == y_col {
+                    assert_eq!(
+                        u.parse::<f64>().unwrap(),
+                        -v.parse::<f64>().unwrap(),
+                        "{f}: {a:?} vs {b:?}"
+                    );
+                } else {
+                    assert_eq!(u, v, "{f}: {a:?} vs {b:?}");
+                }
+            }
+        }
+    }
+    std::fs::remove_dir_all(&scratch).unwrap();
+}
+
+#[test]
+fn part_mirrored_in_z_gives_the_composite_mirrored_with_angles_swapped() {
+    let scratch = scratch_dir("zmirror");
+    let tris = asymmetric_part();
+    let (a, b) = (scratch.join("a.stl"), scratch.join("b.stl"));
+    write_stl(&a, &tris).unwrap();
+    write_stl(&b, &mirrored(&tris, 2)).unwrap();
+    analyse_to(&a, &scratch.join("a"), &[]);
+    analyse_to(&b, &scratch.join("b"), &[]);
+    // colliding_points: angle_deg,i,j,x,y,z -> key (angle, x, z).
+    let key = |rows: Vec<Vec<String>>, flip: f64| {
+        let mut keys: Vec<(i64, i64, i64)> = rows
+            .iter()
+            .map(|r| {
+                let f = |k: usize| r[k].parse::<f64>().unwrap();
+                (
+                    (flip * f(0)).round() as i64,
+                    (f(3) * 1000.0).round() as i64,
+                    (flip * f(5) * 1000.0).round() as i64,
+                )
+            })
+            .collect();
+        keys.sort();
+        keys
+    };
+    let ka = key(
+        csv_rows(&scratch.join("a").join("colliding_points.csv")),
+        1.0,
+    );
+    let kb = key(
+        csv_rows(&scratch.join("b").join("colliding_points.csv")),
+        -1.0,
+    );
+    assert!(ka.len() > 20, "too few colliding points to prove anything");
+    assert_eq!(ka, kb);
+    // And the angle does matter here: the masks at -30 and +30 differ.
+    let at = |angle: i64| {
+        ka.iter()
+            .filter(|k| k.0 == angle)
+            .map(|k| (k.1, k.2))
+            .collect::<Vec<_>>()
+    };
+    assert_ne!(at(-30), at(30));
+    std::fs::remove_dir_all(&scratch).unwrap();
+}
