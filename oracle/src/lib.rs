@@ -20,6 +20,8 @@
 //! * [`trace_start`] and [`evaluate`]: push and slide one start, or many
 //!   starts at many angles in parallel; [`OracleOptions`] in,
 //!   [`StartTrace`] with a [`StartStatus`] out.
+//! * [`rapier_slide`]: the same slide driven by rapier3d's kinematic
+//!   character controller, a second view for cross-checking.
 
 //!
 //! **Invariant:** a start is never reported clear on a failed query: parry
@@ -34,6 +36,7 @@ mod batch;
 mod error;
 mod knee_form;
 mod part;
+mod rapier;
 mod sweep;
 
 mod trace;
@@ -42,6 +45,7 @@ pub use batch::evaluate;
 pub use error::OracleError;
 pub use knee_form::{KneeForm, KneeFormDims};
 pub use part::{Part, Side};
+pub use rapier::{RapierComparison, RapierOptions, RapierSlide, rapier_slide};
 
 pub use trace::{
     ContactPoint, FailureReason, OracleOptions, SlideEnd, StartStatus, StartTrace, trace_start,
