@@ -45,6 +45,10 @@ pub enum Scenario {
     /// x = 120 with half-width 40 mm. The knee rides over the ridge and runs
     /// straight over the dip, which never collides.
     Depression,
+    /// The benchmark console side ([`crate::console`]): 1500 x 600 mm with
+    /// a bulge, waves, a wavy ridge, switch-like bosses and a depression
+    /// behind a protrusion, tessellated at 8 mm by default.
+    Console,
 }
 
 /// Where and how finely to sample a scenario (mm, analysis frame).
@@ -74,7 +78,14 @@ impl Scenario {
     /// The field to sample this scenario on. Every scenario is laid out for
     /// the default panel ([`HeightField::default`]).
     pub fn default_field(self) -> HeightField {
-        HeightField::default()
+        match self {
+            Scenario::Console => HeightField {
+                x_range: (0.0, crate::console::CONSOLE_SIZE[0]),
+                z_range: (0.0, crate::console::CONSOLE_SIZE[1]),
+                step: 8.0,
+            },
+            _ => HeightField::default(),
+        }
     }
 
     /// The x of the lines where the surface has a crease that the lattice
@@ -130,6 +141,7 @@ pub fn height(scenario: Scenario, x: f64, z: f64) -> f64 {
             }
         }
         Scenario::Bump => -BUMP_HEIGHT * cosine_bell(x.hypot(z) / BUMP_RADIUS),
+        Scenario::Console => crate::console::console_height(x, z),
         Scenario::Depression => {
             DIP_DEPTH * cosine_bell(x.hypot(z) / DIP_RADIUS)
                 - RIDGE_HEIGHT * cosine_bell((x - RIDGE_X) / RIDGE_HALF_WIDTH)
@@ -237,7 +249,7 @@ mod tests {
     use super::*;
     use clap::ValueEnum;
 
-    const ALL: [Scenario; 7] = [
+    const ALL: [Scenario; 8] = [
         Scenario::FlatWall,
         Scenario::Ramp,
         Scenario::Wave,
@@ -245,6 +257,7 @@ mod tests {
         Scenario::Step,
         Scenario::Bump,
         Scenario::Depression,
+        Scenario::Console,
     ];
 
     fn small() -> HeightField {
@@ -365,7 +378,8 @@ mod tests {
                 "growing-wave",
                 "step",
                 "bump",
-                "depression"
+                "depression",
+                "console"
             ]
         );
     }

@@ -30,15 +30,30 @@ pub fn write_colliding_points<W: Write>(
     }
     let mut order: Vec<&AngleMask> = masks.iter().collect();
     order.sort_by(|a, b| a.angle_deg.total_cmp(&b.angle_deg));
+    // A node colliding at many angles is written many times: format its
+    // fields once (a paper-sized run writes some ten million rows).
+    let mut first_row = vec![u32::MAX; grid.spec.len()];
+    let mut nodes = Row::default();
+    for m in &order {
+        for (k, _) in m.mask.iter().enumerate().filter(|&(_, &v)| v != 0) {
+            if first_row[k] == u32::MAX {
+                first_row[k] = nodes.ends.len() as u32;
+                nodes.node(grid, k, side);
+            }
+        }
+    }
     let mut out = csv::Writer::from_writer(w);
     out.write_record(["angle_deg", "i", "j", "x", "y", "z"])?;
-    let mut row = Row::default();
+    let mut angle = Row::default();
     for m in order {
+        angle.start();
+        angle.num(m.angle_deg);
+        let angle_field = angle.fields().next().expect("one field");
         for (k, _) in m.mask.iter().enumerate().filter(|&(_, &v)| v != 0) {
-            row.start();
-            row.num(m.angle_deg);
-            row.node(grid, k, side);
-            out.write_record(row.fields())?;
+            let first = first_row[k] as usize;
+            out.write_record(
+                std::iter::once(angle_field).chain(nodes.field_range(first..first + 5)),
+            )?;
         }
     }
     out.flush()?;
@@ -124,8 +139,15 @@ impl Row {
     }
 
     fn fields(&self) -> impl Iterator<Item = &str> {
-        let starts = std::iter::once(0).chain(self.ends.iter().copied());
-        starts.zip(&self.ends).map(|(a, &b)| &self.text[a..b])
+        self.field_range(0..self.ends.len())
+    }
+
+    /// Fields `range` of the buffer.
+    fn field_range(&self, range: std::ops::Range<usize>) -> impl Iterator<Item = &str> {
+        range.map(|f| {
+            let start = if f == 0 { 0 } else { self.ends[f - 1] };
+            &self.text[start..self.ends[f]]
+        })
     }
 }
 
