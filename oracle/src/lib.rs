@@ -10,19 +10,21 @@
 //! * [`KneeForm`]: the knee-form as a parry3d shape. It is the **exact**
 //!   rounded prism, a custom support-map shape (triangle support + `R` in
 //!   the xz direction of the query + the face or the back along y), not a
-//!   tessellated polyhedron: parry's default dispatcher casts a custom
-//!   [`parry3d_f64::shape::SupportMap`] shape against a
-//!   [`parry3d_f64::shape::TriMesh`] triangle by triangle, and the tests
-//!   check its support points against the analytic rounded triangle and
-//!   its casts against analytic contacts.
+//!   tessellated polyhedron: a custom [`parry3d_f64::shape::SupportMap`]
+//!   shape goes through parry's GJK shape casting against a
+//!   [`parry3d_f64::shape::TriMesh`] like a built-in one, so nothing is
+//!   gained by approximating it. Tests check its support points against
+//!   the analytic rounded triangle and its casts against analytic contacts.
 //! * [`Part`]: the mesh, read from STL with the engine's `scale` and
 //!   `side`, or built from triangles.
 //! * [`trace_start`] and [`evaluate`]: push and slide one start, or many
 //!   starts at many angles in parallel; [`OracleOptions`] in,
-//!   [`StartTrace`] with a [`StartStatus`] out.
+//!   [`StartTrace`] with a [`StartStatus`] out. The casts walk the mesh's
+//!   BVH with bounds from the exact footprint and cast each remaining
+//!   triangle with parry's GJK (30x faster than parry's composite cast on
+//!   a 400k-triangle part, same answers).
 //! * [`rapier_slide`]: the same slide driven by rapier3d's kinematic
 //!   character controller, a second view for cross-checking.
-
 //!
 //! **Invariant:** a start is never reported clear on a failed query: parry
 //! returns "no hit" when GJK runs out of iterations, so every triangle a
@@ -38,7 +40,6 @@ mod knee_form;
 mod part;
 mod rapier;
 mod sweep;
-
 mod trace;
 
 pub use batch::evaluate;
@@ -46,7 +47,6 @@ pub use error::OracleError;
 pub use knee_form::{KneeForm, KneeFormDims};
 pub use part::{Part, Side};
 pub use rapier::{RapierComparison, RapierOptions, RapierSlide, rapier_slide};
-
 pub use trace::{
     ContactPoint, FailureReason, OracleOptions, SlideEnd, StartStatus, StartTrace, trace_start,
 };

@@ -438,3 +438,94 @@ fn batch_output_is_deterministic_and_equals_single_starts() {
     };
     assert!(evaluate(&part, &starts, &angles, &bad).is_err());
 }
+
+#[test]
+fn cast_budget_exhaustion_fails_the_start_and_keeps_its_contacts() {
+    let (c, k, x_w) = (0.0, 0.35, -50.0);
+    let xs = knots(&[linspace(-400.0, x_w, 36), linspace(x_w, 600.0, 13)]);
+    let zs = linspace(-400.0, 400.0, 9);
+    let g = |x: f64| if x < x_w { c - k * (x_w - x) } else { c };
+    let part = Part::from_triangles(&height_field(&xs, &zs, |i, _| g(xs[i]))).unwrap();
+    let options = OracleOptions {
+        max_casts: 6,
+        ..options()
+    };
+    let trace = trace_start(&part, [100.0, 0.0], 0.0, &options).unwrap();
+    assert_eq!(
+        trace.status,
+        StartStatus::Failed {
+            reason: kneeform_oracle::FailureReason::CastBudgetExhausted
+        }
+    );
+    assert_eq!(trace.casts, 6);
+    assert!(trace.yr_star.is_some() && !trace.contacts.is_empty());
+    assert_eq!(trace.slide_end, SlideEnd::NotRun);
+}
+
+/// Writes triangles as an ASCII STL.
+fn ascii_stl(triangles: &[[[f64; 3]; 3]]) -> String {
+    let mut out = String::from("solid t\n");
+    for t in triangles {
+        out.push_str(" facet normal 0 0 0\n  outer loop\n");
+        for v in t {
+            out.push_str(&format!("   vertex {} {} {}\n", v[0], v[1], v[2]));
+        }
+        out.push_str("  endloop\n endfacet\n");
+    }
+    out.push_str("endsolid t\n");
+    out
+}
+
+#[test]
+fn a_right_hand_part_read_as_right_traces_like_its_left_hand_mirror() {
+    // A parabolic bump rounded to 1/4 mm terraces, in the analysis frame,
+    // and its mirror image y -> -y (a right-hand part facing +y); reading
+    // the mirror with Side::Right must give the same traces. Coordinates
+    // are multiples of 1/4 mm, exact in f32, so the STL round trip is
+    // lossless.
+    let xs = knots(&[
+        linspace(-500.0, -140.0, 10),
+        linspace(-140.0, -60.0, 321),
+        linspace(-60.0, 500.0, 15),
+    ]);
+    let zs = linspace(-400.0, 400.0, 9);
+    let g = |x: f64| {
+        let u: f64 = x + 100.0;
+        if u.abs() < 40.0 {
+            -(0.25 * (1600.0 - u * u) / 40.0).round() / 4.0
+        } else {
+            0.0
+        }
+    };
+    let left = height_field(&xs, &zs, |i, _| g(xs[i]));
+    let mirrored: Vec<[[f64; 3]; 3]> = left.iter().map(|t| t.map(|[x, y, z]| [x, -y, z])).collect();
+    let read = |triangles: &[[[f64; 3]; 3]], side| {
+        let text = ascii_stl(triangles);
+        Part::from_stl_reader(&mut std::io::Cursor::new(text), 1.0, side).unwrap()
+    };
+    let as_left = read(&left, kneeform_oracle::Side::Left);
+    let as_right = read(&mirrored, kneeform_oracle::Side::Right);
+    assert_eq!(as_left.bounds(), as_right.bounds());
+    let options = options();
+    let starts = [[150.0, 0.0], [120.0, -30.0]];
+    let a = evaluate(&as_left, &starts, &ANGLES, &options).unwrap();
+    let b = evaluate(&as_right, &starts, &ANGLES, &options).unwrap();
+    // The mirror swaps each triangle's winding back, so the meshes are the
+    // same up to vertex order; GJK may then pick another witness where the
+    // contact is not unique (the push's face lies on the flat part), so
+    // witnesses are compared to TANGENT_TOL, levels and travels tightly.
+    for (a, b) in a.iter().zip(&b) {
+        assert_eq!(a.status, b.status);
+        assert!((a.yr_star.unwrap() - b.yr_star.unwrap()).abs() < 1e-9);
+        assert!(!a.contacts.is_empty());
+        assert_eq!(a.contacts.len(), b.contacts.len(), "{a:?}\n{b:?}");
+        for (p, q) in a.contacts.iter().zip(&b.contacts) {
+            assert!((p.travel - q.travel).abs() < 1e-6, "{p:?} {q:?}");
+            assert!((p.face_level - q.face_level).abs() < 1e-9, "{p:?} {q:?}");
+            assert!(
+                (0..3).all(|k| (p.witness[k] - q.witness[k]).abs() < TANGENT_TOL),
+                "{p:?} {q:?}"
+            );
+        }
+    }
+}
