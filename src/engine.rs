@@ -237,6 +237,32 @@ fn paper_band(
         .sum()
 }
 
+/// SPEC's push alone, for every start at one angle: `yr[j * nx + i]` (mm),
+/// `+inf` where the start is not placed. For comparisons with the exact
+/// oracle; [`colliding_masks`] computes these on the way.
+pub fn push_levels(grid: &HeightGrid, fp: &GridFootprint) -> Vec<f64> {
+    let padded = PaddedGrid::new(grid, std::slice::from_ref(fp));
+    let max_width = fp
+        .rows
+        .iter()
+        .map(|r| (r.khi - r.klo + 1).max(1) as usize)
+        .max()
+        .unwrap_or(1);
+    let table = WindowMin::new(&padded, max_width);
+    let rows = PushRows::new(&padded, fp);
+    let nx = grid.spec.nx;
+    let mut yr = vec![f64::INFINITY; grid.spec.len()];
+    for (j0, out) in yr.chunks_exact_mut(nx).enumerate() {
+        for (block, out) in out.chunks_mut(LANES).enumerate() {
+            // The padding's slack covers the lanes past the last column.
+            let levels: [f64; LANES] =
+                push_block(&table, &rows, padded.index(j0 as i64, 0) + block * LANES);
+            out.copy_from_slice(&levels[..out.len()]);
+        }
+    }
+    yr
+}
+
 /// SPEC's composite: for every node, the number of angles whose mask holds it.
 pub fn composite(masks: &[AngleMask]) -> Vec<u16> {
     let n = masks.first().map_or(0, |m| m.mask.len());

@@ -27,7 +27,7 @@ mod simd;
 pub mod slide;
 pub mod summary;
 
-pub use engine::{Algorithm, AngleMask, EngineOptions, colliding_masks, composite};
+pub use engine::{Algorithm, AngleMask, EngineOptions, colliding_masks, composite, push_levels};
 pub use grid::{GridSpec, HeightGrid};
 pub use kneeform::{Footprint, GridFootprint, KneeForm};
 pub use mesh::{Part, Side};

@@ -4,4 +4,5 @@
 mod analytic;
 mod cli;
 mod engine;
+mod oracle;
 mod util;
