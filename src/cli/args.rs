@@ -115,12 +115,19 @@ pub struct AnalyzeArgs {
 /// `kneeform scenario`.
 #[derive(Debug, Args)]
 pub struct ScenarioArgs {
-    /// The synthetic part.
-    #[arg(value_enum)]
-    pub name: kneeform::scenario::Scenario,
+    /// The synthetic part: a scenario file (`.toml`, e.g.
+    /// scenarios/thin-rib.toml) or a built-in name (flat-wall, ramp, wave,
+    /// growing-wave, step, bump, depression, console).
+    #[arg(value_name = "NAME|FILE.toml")]
+    pub part: String,
     /// Where to write the STL.
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
+    /// Tessellate into at least N triangles, refining the part's step
+    /// uniformly (e.g. 369408, the paper's console); default: the part's
+    /// own step.
+    #[arg(long, value_name = "N")]
+    pub triangles: Option<usize>,
 }
 
 /// `kneeform bench`.

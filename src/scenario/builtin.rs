@@ -1,17 +1,11 @@
-//! Synthetic height-field parts with known geometry, for tests and the
-//! README example.
-//!
-//! Each scenario is a surface `y = g(x, z)` in SPEC's analysis frame (mm):
-//! the surface faces -y, the knee comes from -y, is pushed in +y and
-//! slides in -x (towards the vehicle front). So a feature that **sticks out
-//! towards the knee has a smaller y**. [`triangulate`] samples a surface on
-//! a square lattice and [`write_stl`] stores it as a binary STL that the
-//! CLI reads like any other part.
+//! The built-in scenarios: the synthetic parts the integration tests and
+//! the README example were written against, each a closed-form surface
+//! `y = g(x, z)` on a [`HeightField`]. Their names are the CLI's
+//! `kneeform scenario NAME`. The scenario files in `scenarios/` (see
+//! [`super::file`]) reproduce all but the console within rounding, and add
+//! the parts these lack.
 
-use std::f64::consts::PI;
-use std::io;
-use std::path::Path;
-
+use super::lattice::{axis, cosine_bell, refined_step, sin_turns, tessellate};
 use crate::mesh::Triangle;
 
 /// A synthetic part. The names on the command line are kebab-case
@@ -88,6 +82,23 @@ impl Scenario {
         }
     }
 
+    /// [`Scenario::default_field`] with its step refined, when
+    /// `min_triangles` is given, until [`triangulate`] makes at least that
+    /// many triangles (the largest such step; see
+    /// [`super::ScenarioFile::step_for`]).
+    pub fn field_for(self, min_triangles: Option<usize>) -> HeightField {
+        let mut field = self.default_field();
+        if let Some(n) = min_triangles {
+            field.step = refined_step(
+                [field.x_range, field.z_range],
+                field.step,
+                [self.creases_x(), &[]],
+                n,
+            );
+        }
+        field
+    }
+
     /// The x of the lines where the surface has a crease that the lattice
     /// might step over; [`triangulate`] puts vertices on them, so the
     /// tessellation is exact there at any step.
@@ -149,43 +160,6 @@ pub fn height(scenario: Scenario, x: f64, z: f64) -> f64 {
     }
 }
 
-/// `sin(2 pi t)`, exact at quarter turns: the waves' zeros and crests on
-/// the lattice are then exactly 0 and the amplitude, not 1e-16 off (a crest
-/// region that starts 1e-15 mm out would show up in the results).
-fn sin_turns(t: f64) -> f64 {
-    let phase = t.rem_euclid(1.0);
-    match phase {
-        0.0 | 0.5 => 0.0,
-        0.25 => 1.0,
-        0.75 => -1.0,
-        _ => (2.0 * PI * phase).sin(),
-    }
-}
-
-/// 1 at `u = 0` falling smoothly to 0 at `|u| = 1`, 0 beyond.
-fn cosine_bell(u: f64) -> f64 {
-    if u.abs() < 1.0 {
-        0.5 * (1.0 + (PI * u).cos())
-    } else {
-        0.0
-    }
-}
-
-/// The lattice coordinates along one axis: every multiple of `step` inside
-/// `range`, the range's ends, and the `extra` creases inside it, sorted.
-fn lattice(range: (f64, f64), step: f64, extra: &[f64]) -> Vec<f64> {
-    let (lo, hi) = range;
-    let first = (lo / step).ceil() as i64;
-    let last = (hi / step).floor() as i64;
-    let mut v: Vec<f64> = (first..=last).map(|k| k as f64 * step).collect();
-    v.push(lo);
-    v.push(hi);
-    v.extend(extra.iter().copied().filter(|&c| lo < c && c < hi));
-    v.sort_by(f64::total_cmp);
-    v.dedup();
-    v
-}
-
 /// Samples the surface on the lattice of `field` (plus vertex lines at the
 /// scenario's creases) and splits each lattice cell into two triangles,
 /// wound so their normals face -y (towards the knee). Vertices are exact
@@ -206,42 +180,9 @@ pub fn triangulate(scenario: Scenario, field: &HeightField) -> Vec<Triangle> {
         field.x_range,
         field.z_range
     );
-    let xs = lattice(field.x_range, field.step, scenario.creases_x());
-    let zs = lattice(field.z_range, field.step, &[]);
-    let v = |x: f64, z: f64| [x, height(scenario, x, z), z];
-    let mut out = Vec::with_capacity(2 * (xs.len() - 1) * (zs.len() - 1));
-    for z in zs.windows(2) {
-        for x in xs.windows(2) {
-            // Counter-clockwise in (x, z), x right and z up: normal -y.
-            let (a, b, c, d) = (v(x[0], z[0]), v(x[1], z[0]), v(x[1], z[1]), v(x[0], z[1]));
-            out.push([a, b, c]);
-            out.push([a, c, d]);
-        }
-    }
-    out
-}
-
-/// Writes `triangles` (mm) as a binary STL at `path`, through a temporary
-/// file in the same directory renamed into place, so `path` is never a
-/// partial file.
-pub fn write_stl(path: &Path, triangles: &[Triangle]) -> io::Result<()> {
-    let mut tmp_name = path.file_name().unwrap_or_default().to_os_string();
-    tmp_name.push(format!(".tmp-{}", std::process::id()));
-    let tmp = path.with_file_name(tmp_name);
-    let written = (|| {
-        let mut file = std::fs::File::create(&tmp)?;
-        let stl: Vec<stl_io::Triangle> = triangles
-            .iter()
-            .map(crate::output::to_stl_triangle)
-            .collect();
-        stl_io::write_stl(&mut file, stl.iter())?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if written.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    written
+    let xs = axis(field.x_range, field.step, scenario.creases_x());
+    let zs = axis(field.z_range, field.step, &[]);
+    tessellate(&xs, &zs, |x, z| height(scenario, x, z))
 }
 
 #[cfg(test)]
@@ -293,11 +234,11 @@ mod tests {
     }
 
     #[test]
-    fn odd_ranges_keep_multiples_and_add_the_ends() {
-        assert_eq!(
-            lattice((-3.0, 4.5), 2.0, &[-0.5, 9.0]),
-            [-3.0, -2.0, -0.5, 0.0, 2.0, 4.0, 4.5]
-        );
+    fn field_for_reaches_the_requested_count() {
+        let f = Scenario::Console.field_for(Some(369_408));
+        assert!(f.step < 8.0);
+        assert!(triangulate(Scenario::Console, &f).len() >= 369_408);
+        assert_eq!(Scenario::Bump.field_for(None), HeightField::default());
     }
 
     #[test]
@@ -335,32 +276,6 @@ mod tests {
             assert_eq!(height(Scenario::Wave, x, 0.0), 0.0, "x = {x}");
         }
         assert_eq!(height(Scenario::Wave, -75.0, 0.0), 5.0);
-    }
-
-    #[test]
-    fn stl_round_trips() {
-        let dir = crate::output::temp_dir("scenario");
-        let path = dir.join("bump.stl");
-        let tris = triangulate(Scenario::Bump, &small());
-        write_stl(&path, &tris).unwrap();
-        // Only the final file remains.
-        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
-        let mut file = std::fs::File::open(&path).unwrap();
-        let back: Vec<stl_io::Triangle> = stl_io::create_stl_reader(&mut file)
-            .unwrap()
-            .map(Result::unwrap)
-            .collect();
-        assert_eq!(back.len(), tris.len());
-        for (b, t) in back.iter().zip(&tris) {
-            for (bv, tv) in b.vertices.iter().zip(t) {
-                for k in 0..3 {
-                    // STL stores f32.
-                    assert!((f64::from(bv[k]) - tv[k]).abs() <= 1e-5 * tv[k].abs().max(1.0));
-                }
-            }
-            assert!(b.normal[1] < 0.0);
-        }
-        std::fs::remove_dir_all(dir).unwrap();
     }
 
     #[test]

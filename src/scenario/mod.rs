@@ -1,0 +1,100 @@
+//! Synthetic height-field parts with known geometry: the scenario library
+//! for tests, convergence studies and the benchmark.
+//!
+//! Each part is a surface `y = g(x, z)` in SPEC's analysis frame (mm): the
+//! surface faces -y, the knee comes from -y, is pushed in +y and slides in
+//! -x (towards the vehicle front). So a feature that **sticks out towards
+//! the knee has a smaller y**. A part is tessellated on a square lattice
+//! (plus vertex lines at its creases, so thin features are in the mesh at
+//! any step), two triangles per cell facing -y, and stored with
+//! [`write_stl`] as a binary STL that the CLI reads like any other part.
+//!
+//! Two sources of parts:
+//!
+//! * scenario files ([`load`], [`ScenarioFile`]): the library in
+//!   `scenarios/*.toml`, one part per file, each a sum of named
+//!   [`Feature`] primitives (plane, wave, bump, boss, ridge, groove, rib,
+//!   step, console) over an extent with its tessellation step and a
+//!   one-line description; `kneeform scenario FILE.toml` writes one;
+//! * the built-in [`Scenario`]s, closed-form surfaces on a [`HeightField`]
+//!   that the integration tests were written against; the files reproduce
+//!   them (all but the console) within rounding.
+
+mod builtin;
+mod file;
+mod lattice;
+mod primitive;
+
+#[cfg(test)]
+mod library_tests;
+
+use std::io;
+use std::path::Path;
+
+use crate::mesh::Triangle;
+
+pub use builtin::{HeightField, Scenario, height, triangulate};
+pub use file::{
+    Extent, MAX_TRIANGLES, ScenarioError, ScenarioFile, is_scenario_file, load, parse,
+    triangles_from_file,
+};
+pub use primitive::{Boss, Bump, Console, Feature, Groove, Plane, Rib, Ridge, Step, Wave};
+
+/// Writes `triangles` (mm) as a binary STL at `path`, through a temporary
+/// file in the same directory renamed into place, so `path` is never a
+/// partial file.
+pub fn write_stl(path: &Path, triangles: &[Triangle]) -> io::Result<()> {
+    let mut tmp_name = path.file_name().unwrap_or_default().to_os_string();
+    tmp_name.push(format!(".tmp-{}", std::process::id()));
+    let tmp = path.with_file_name(tmp_name);
+    let written = (|| {
+        let mut file = std::fs::File::create(&tmp)?;
+        let stl: Vec<stl_io::Triangle> = triangles
+            .iter()
+            .map(crate::output::to_stl_triangle)
+            .collect();
+        stl_io::write_stl(&mut file, stl.iter())?;
+        file.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stl_round_trips() {
+        let dir = crate::output::temp_dir("scenario");
+        let path = dir.join("bump.stl");
+        let field = HeightField {
+            x_range: (-300.0, 300.0),
+            z_range: (-20.0, 20.0),
+            step: 5.0,
+        };
+        let tris = triangulate(Scenario::Bump, &field);
+        write_stl(&path, &tris).unwrap();
+        // Only the final file remains.
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        let mut file = std::fs::File::open(&path).unwrap();
+        let back: Vec<stl_io::Triangle> = stl_io::create_stl_reader(&mut file)
+            .unwrap()
+            .map(Result::unwrap)
+            .collect();
+        assert_eq!(back.len(), tris.len());
+        for (b, t) in back.iter().zip(&tris) {
+            for (bv, tv) in b.vertices.iter().zip(t) {
+                for k in 0..3 {
+                    // STL stores f32.
+                    assert!((f64::from(bv[k]) - tv[k]).abs() <= 1e-5 * tv[k].abs().max(1.0));
+                }
+            }
+            assert!(b.normal[1] < 0.0);
+        }
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+}
