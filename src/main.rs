@@ -31,6 +31,9 @@ fn run(cli: &Cli) -> anyhow::Result<ExitCode> {
             cli::set_threads(args.threads)?;
             cli::bench::run(args)?;
         }
+        Command::Verify(args) => return cli::verify::run(args),
+        Command::Converge(args) => return cli::converge::run(args),
+        Command::Report(args) => cli::report::run(args)?,
     }
     Ok(ExitCode::SUCCESS)
 }

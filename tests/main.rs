@@ -4,5 +4,7 @@
 mod analytic;
 mod cli;
 mod engine;
+mod harness;
 mod oracle;
+mod report;
 mod util;

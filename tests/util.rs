@@ -254,3 +254,40 @@ pub fn scratch_dir(name: &str) -> std::path::PathBuf {
     std::fs::create_dir_all(&dir).expect("a scratch directory");
     dir
 }
+
+/// A height-field part on the lattice `xs` x `zs` (sorted, mm), two
+/// triangles per cell, surface facing -y: put lattice lines on a feature's
+/// edges to make it sharp.
+pub fn lattice_part(
+    xs: &[f64],
+    zs: &[f64],
+    y: impl Fn(f64, f64) -> f64,
+) -> Vec<kneeform::mesh::Triangle> {
+    let v = |x: f64, z: f64| [x, y(x, z), z];
+    let mut tris = Vec::new();
+    for zw in zs.windows(2) {
+        for xw in xs.windows(2) {
+            let (a, b, c, d) = (
+                v(xw[0], zw[0]),
+                v(xw[1], zw[0]),
+                v(xw[1], zw[1]),
+                v(xw[0], zw[1]),
+            );
+            tris.push([a, b, c]);
+            tris.push([a, c, d]);
+        }
+    }
+    tris
+}
+
+/// `from..=to` by `step`, plus the `extra` lines, sorted and deduplicated.
+pub fn lines(from: f64, to: f64, step: f64, extra: &[f64]) -> Vec<f64> {
+    let n = ((to - from) / step).round() as usize;
+    let mut v: Vec<f64> = (0..=n)
+        .map(|k| from + k as f64 * step)
+        .chain(extra.iter().copied())
+        .collect();
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    v
+}

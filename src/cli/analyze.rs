@@ -15,7 +15,6 @@ use kneeform::{
     AngleMask, EngineOptions, Footprint, GridFootprint, HeightGrid, KneeForm, Part, Side,
     colliding_masks, composite,
 };
-use sha2::Digest;
 
 use super::args::{AnalyzeArgs, GridPlacement, Setup};
 
@@ -32,10 +31,7 @@ pub struct Prepared {
 /// Reads the part, lays the grid and samples it.
 pub fn prepare(path: &Path, scale: f64, side: Side, setup: &Setup) -> anyhow::Result<Prepared> {
     let t = Instant::now();
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let sha256 = hex(&sha2::Sha256::digest(&bytes));
-    let part = Part::from_stl_bytes(&path.display().to_string(), &bytes, scale, side)?;
-    drop(bytes);
+    let (part, sha256) = super::load_part(path, scale, side)?;
     let read_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -64,7 +60,7 @@ pub fn prepare(path: &Path, scale: f64, side: Side, setup: &Setup) -> anyhow::Re
 
 /// SPEC's default extent covers every requested angle and its mirror, so
 /// that a part mirrored in z gets the mirrored grid.
-fn grid_spec(part: &Part, knee: &KneeForm, setup: &Setup) -> anyhow::Result<GridSpec> {
+pub fn grid_spec(part: &Part, knee: &KneeForm, setup: &Setup) -> anyhow::Result<GridSpec> {
     Ok(match setup.grid {
         GridPlacement::AroundPart => {
             let extents: Vec<Footprint> = setup
@@ -124,6 +120,13 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<()> {
     output::write_colliding_points(create("colliding_points.csv")?, grid, &masks, side)?;
     output::write_composite(create("composite.csv")?, grid, &counts, side)?;
     output::write_colliding_area(create("colliding_area.stl")?, grid, &counts, side)?;
+    output::write_colliding_area_ply(
+        create("colliding_area.ply")?,
+        grid,
+        &counts,
+        masks.len(),
+        side,
+    )?;
     output::write_depth_png(&out.path("depth.png"), grid)?;
     let title = format!(
         "Composite colliding area, {} angles (L = {} mm)",
@@ -149,6 +152,17 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<()> {
         out.path("summary.json"),
         serde_json::to_string_pretty(&summary)? + "\n",
     )?;
+    if args.report {
+        // Written from the staged files, so report.html appears with them
+        // or not at all.
+        let options = kneeform::report::ReportOptions {
+            part: Some(args.part.part.clone()),
+            run_name: Some(args.out.clone()),
+            ..kneeform::report::ReportOptions::new(out.path(""))
+        };
+        let shown_as = args.out.join("report.html");
+        super::report::write(&options, &out.path("report.html"), &shown_as)?;
+    }
     out.commit()
         .with_context(|| format!("cannot move results into {}", args.out.display()))?;
     eprintln!(
@@ -220,8 +234,4 @@ fn summarize(
         composite_area_mm2: composite_nodes as f64 * area,
         timings: Timings::default(),
     }
-}
-
-fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
 }

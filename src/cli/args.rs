@@ -27,6 +27,16 @@ pub enum Command {
     /// Time the engine on a paper-sized console (369,408+ triangles, a
     /// 1538 x 801 grid at 1.24 mm, 61 angles) against the paper algorithm.
     Bench(BenchArgs),
+    /// Compare the grid engine with the exact oracle on the same starts.
+    /// Exit 0 when every metric is within --tolerance, 1 when not, 2 on error.
+    Verify(VerifyArgs),
+    /// Compare grid and oracle at several pitches: errors, fitted orders of
+    /// convergence, and the coarsest pitch meeting --tolerance.
+    Converge(ConvergeArgs),
+    /// Write the evidence report of a run: one self-contained HTML file
+    /// with views of the part, the colliding area per angle, and the
+    /// verification results of any VERIFY_DIR given.
+    Report(ReportArgs),
 }
 
 /// The part and how to read it.
@@ -109,6 +119,96 @@ pub struct AnalyzeArgs {
     pub setup: SetupArgs,
     /// Output directory (created; files are written whole or not at all).
     #[arg(long, default_value = "kneeform-out", value_name = "DIR")]
+    pub out: PathBuf,
+    /// Also write the evidence report, `report.html`, into the output
+    /// directory (as `kneeform report DIR` would).
+    #[arg(long)]
+    pub report: bool,
+}
+
+/// `kneeform report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// The `analyze` output directory.
+    pub run_dir: PathBuf,
+    /// Output directories of `kneeform verify` or `kneeform converge`.
+    #[arg(value_name = "VERIFY_DIR")]
+    pub verify_dirs: Vec<PathBuf>,
+    /// The HTML file to write.
+    #[arg(long, default_value = "report.html", value_name = "FILE")]
+    pub out: PathBuf,
+    /// The analysed part, when it is no longer at the path the run names
+    /// (its SHA-256 must still be the run's).
+    #[arg(long, value_name = "FILE")]
+    pub part: Option<PathBuf>,
+}
+
+/// Which starts a comparison uses.
+#[derive(Debug, Args)]
+pub struct StartArgs {
+    /// Starts to compare: `all` (every node whose start is placed at some
+    /// angle) or a number N for a seeded random sample of them.
+    #[arg(long, default_value = "100", value_name = "all|N")]
+    pub starts: String,
+    /// Seed of the start sample.
+    #[arg(long, default_value_t = 1, value_name = "S")]
+    pub seed: u64,
+}
+
+impl StartArgs {
+    /// Validates the flags.
+    pub fn validate(&self) -> anyhow::Result<kneeform::harness::StartSelection> {
+        use kneeform::harness::StartSelection;
+        if self.starts == "all" {
+            return Ok(StartSelection::All);
+        }
+        let count: usize = self
+            .starts
+            .parse()
+            .with_context(|| format!("--starts {:?}: expected `all` or a number", self.starts))?;
+        ensure!(count > 0, "--starts must be at least 1");
+        Ok(StartSelection::Sample {
+            count,
+            seed: self.seed,
+        })
+    }
+}
+
+/// `kneeform verify`.
+#[derive(Debug, Args)]
+pub struct VerifyArgs {
+    #[command(flatten)]
+    pub part: PartArgs,
+    #[command(flatten)]
+    pub setup: SetupArgs,
+    #[command(flatten)]
+    pub starts: StartArgs,
+    /// Largest error allowed for every metric (mm).
+    #[arg(long, default_value_t = 1.0, value_name = "MM")]
+    pub tolerance: f64,
+    /// Output directory for verify.csv and verify.json.
+    #[arg(long, default_value = "kneeform-verify", value_name = "DIR")]
+    pub out: PathBuf,
+}
+
+/// `kneeform converge`.
+#[derive(Debug, Args)]
+pub struct ConvergeArgs {
+    #[command(flatten)]
+    pub part: PartArgs,
+    #[command(flatten)]
+    pub setup: SetupArgs,
+    #[command(flatten)]
+    pub starts: StartArgs,
+    /// Pitches to compare (mm), each dividing the coarsest so that grids
+    /// nest, e.g. 8,4,2,1,0.5. Overrides --pitch.
+    #[arg(long, default_value = "8,4,2,1", value_name = "MM,MM,...")]
+    pub pitches: String,
+    /// Name the coarsest pitch whose errors are all within this (mm).
+    #[arg(long, value_name = "MM")]
+    pub tolerance: Option<f64>,
+    /// Output directory for converge.csv, converge.json and the plots.
+    #[arg(long, default_value = "kneeform-converge", value_name = "DIR")]
     pub out: PathBuf,
 }
 

@@ -1,0 +1,177 @@
+//! The grid's push and slide of one start, with the travel at which each
+//! colliding node is met: what the harness compares with the oracle's
+//! contact trace.
+//!
+//! This is SPEC's per-start definition, transcribed directly (every node in
+//! front of the start, merged into distance order, tie groups judged at one
+//! level), with test-only faults that the harness must catch.
+
+use crate::grid::HeightGrid;
+use crate::kneeform::{GridFootprint, NODE_TOL};
+
+/// A deliberate mistake in the grid side of a comparison, for the tests
+/// that show the harness catches a broken engine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fault {
+    /// Every height offset by half a pitch away from the knee (+y).
+    HeightsOffsetHalfPitch,
+    /// The footprint loses its leading row (the row reaching furthest to
+    /// -x, where first contacts happen).
+    FootprintRowShort,
+    /// The slide judges each node at its own level, ignoring tie groups.
+    IgnoreTies,
+}
+
+/// A colliding node of one start.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridContact {
+    /// Column and row of the node.
+    pub node: (usize, usize),
+    /// The node as a point: `(x, h, z)` in mm, analysis frame.
+    pub point: [f64; 3],
+    /// Distance (mm) the knee-form travelled in -x when it met the node.
+    pub travel: f64,
+}
+
+/// The grid's push and slide of one start.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GridTrace {
+    /// The face level after the push (mm), `+inf` when not placed.
+    pub yr: f64,
+    /// The colliding nodes in the order they are met.
+    pub colliding: Vec<GridContact>,
+}
+
+/// Pushes and slides the start at node `(i0, j0)`, with an optional fault.
+pub fn grid_trace(
+    grid: &HeightGrid,
+    fp: &GridFootprint,
+    i0: usize,
+    j0: usize,
+    eps: f64,
+    fault: Option<Fault>,
+) -> GridTrace {
+    let spec = grid.spec;
+    let p = spec.pitch;
+    let offset = if fault == Some(Fault::HeightsOffsetHalfPitch) {
+        p / 2.0
+    } else {
+        0.0
+    };
+    let h = |i: usize, j: usize| grid.at(i, j) + offset;
+    let leading = fp.rows.iter().min_by_key(|r| (r.kf, r.dj)).map(|r| r.dj);
+    let rows = fp
+        .rows
+        .iter()
+        .filter(|r| !(fault == Some(Fault::FootprintRowShort) && Some(r.dj) == leading))
+        .filter_map(|r| {
+            let j = j0 as i64 + i64::from(r.dj);
+            (0..spec.nz as i64).contains(&j).then_some((r, j as usize))
+        });
+    let mut yr = f64::INFINITY;
+    let mut front: Vec<(f64, usize, usize)> = Vec::new();
+    for (row, j) in rows {
+        for k in row.klo..=row.khi {
+            let i = i0 as i64 + i64::from(k);
+            if (0..spec.nx as i64).contains(&i) {
+                yr = yr.min(h(i as usize, j));
+            }
+        }
+        // Nodes in front: offsets kf, kf - 1, ... down to column 0.
+        let mut m = 0;
+        loop {
+            let i = i0 as i64 + i64::from(row.kf) - m;
+            if i < 0 {
+                break;
+            }
+            if i < spec.nx as i64 {
+                front.push((row.d0 + m as f64 * p, i as usize, j));
+            }
+            m += 1;
+        }
+    }
+    let mut trace = GridTrace {
+        yr,
+        colliding: Vec::new(),
+    };
+    if yr == f64::INFINITY {
+        return trace;
+    }
+    front.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
+    let mut f = yr;
+    let mut k = 0;
+    while k < front.len() {
+        let mut end = k + 1;
+        if fault != Some(Fault::IgnoreTies) {
+            while end < front.len() && front[end].0 - front[end - 1].0 <= NODE_TOL {
+                end += 1;
+            }
+        }
+        let mut gmin = f64::INFINITY;
+        for &(d, i, j) in &front[k..end] {
+            let hv = h(i, j);
+            if hv < f - eps {
+                trace.colliding.push(GridContact {
+                    node: (i, j),
+                    point: [spec.x(i), hv, spec.z(j)],
+                    travel: d,
+                });
+            }
+            gmin = gmin.min(hv);
+        }
+        f = f.min(gmin);
+        k = end;
+    }
+    trace
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::{EngineOptions, colliding_masks};
+    use crate::grid::GridSpec;
+    use crate::kneeform::{Footprint, KneeForm};
+
+    /// The union of the per-start traces is the engine's mask.
+    #[test]
+    fn union_of_start_traces_is_the_engine_mask() {
+        let spec = GridSpec {
+            pitch: 3.0,
+            i_origin: -10,
+            j_origin: -5,
+            nx: 70,
+            nz: 30,
+        };
+        let h: Vec<f64> = (0..spec.len())
+            .map(|n| {
+                let (x, z) = (spec.x(n % spec.nx), spec.z(n / spec.nx));
+                0.15 * x + 4.0 * (0.11 * x).sin() * (0.07 * z).cos()
+            })
+            .collect();
+        let grid = HeightGrid { spec, h };
+        let knee = KneeForm {
+            triangle_side: 50.0,
+            radius: 15.0,
+            thickness: 100.0,
+        };
+        for angle in [-30.0, 0.0, 12.0] {
+            let fp = GridFootprint::new(&Footprint::new(&knee, angle), angle, spec.pitch);
+            let mut union = vec![0u8; spec.len()];
+            for j0 in 0..spec.nz {
+                for i0 in 0..spec.nx {
+                    for c in grid_trace(&grid, &fp, i0, j0, 1e-3, None).colliding {
+                        union[c.node.1 * spec.nx + c.node.0] = 1;
+                    }
+                }
+            }
+            let masks = colliding_masks(
+                &grid,
+                std::slice::from_ref(&fp),
+                &EngineOptions::default(),
+                &|| {},
+            );
+            assert_eq!(masks[0].mask, union, "angle {angle}");
+            assert!(masks[0].colliding > 0);
+        }
+    }
+}
