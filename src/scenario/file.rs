@@ -64,12 +64,13 @@ pub struct Extent {
 #[derive(Debug, thiserror::Error)]
 pub enum ScenarioError {
     /// The file could not be read.
-    #[error("cannot read scenario {}: {source}", path.display())]
+    #[error("cannot read scenario {}: {cause}", path.display())]
     Read {
         /// The file.
         path: PathBuf,
-        /// Why.
-        source: std::io::Error,
+        /// Why. Not a `source`: the message already says it, and the CLI
+        /// prints the whole chain.
+        cause: std::io::Error,
     },
     /// The file is not valid TOML, or not the scenario schema (an unknown
     /// kind or field, a missing parameter, a wrong type).
@@ -97,9 +98,9 @@ pub enum ScenarioError {
 
 /// Reads and checks the scenario file at `path`.
 pub fn load(path: &Path) -> Result<ScenarioFile, ScenarioError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Read {
+    let text = std::fs::read_to_string(path).map_err(|cause| ScenarioError::Read {
         path: path.to_owned(),
-        source,
+        cause,
     })?;
     parse(&text, path)
 }
@@ -336,10 +337,13 @@ mod tests {
     #[test]
     fn unreadable_files_are_named() {
         let err = load(Path::new("/nonexistent/part.toml")).unwrap_err();
+        let msg = format!("{:#}", anyhow::Error::from(err));
         assert!(
-            err.to_string()
-                .starts_with("cannot read scenario /nonexistent/part.toml: ")
+            msg.starts_with("cannot read scenario /nonexistent/part.toml: "),
+            "{msg}"
         );
+        // Said once, though the CLI prints the whole chain.
+        assert_eq!(msg.matches("os error").count(), 1, "{msg}");
     }
 
     #[test]

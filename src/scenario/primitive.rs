@@ -468,6 +468,10 @@ impl Feature {
     }
 }
 
+/// The most crease lines a wave reports: one per two triangles of
+/// [`super::MAX_TRIANGLES`] (a lattice line makes at least two).
+const MAX_CREASES: i64 = (super::MAX_TRIANGLES / 2) as i64;
+
 impl Wave {
     /// The amplitude at x: grows by `growth` per mm towards -x, never below
     /// 0.
@@ -505,8 +509,8 @@ impl Wave {
     }
 
     /// With `crests_only` and no tilt, the x of the zeros of the sine in
-    /// `x_range` (where a crest meets the flat); with `growth`, the x where
-    /// the amplitude reaches 0.
+    /// `x_range` (where a crest meets the flat; none if there are more than
+    /// [`MAX_CREASES`]); with `growth`, the x where the amplitude reaches 0.
     fn creases_x(&self, (lo, hi): (f64, f64)) -> Vec<f64> {
         let mut out = Vec::new();
         if self.crests_only && self.tilt == 0.0 {
@@ -514,7 +518,11 @@ impl Wave {
             let shift = self.phase / 360.0;
             let first = ((lo / self.wavelength + shift) * 2.0).floor() as i64;
             let last = ((hi / self.wavelength + shift) * 2.0).ceil() as i64;
-            out.extend((first..=last).map(|k| (k as f64 * 0.5 - shift) * self.wavelength));
+            // More zeros than a lattice within `MAX_TRIANGLES` could hold
+            // lines for would only exhaust memory: such a wave is sampled.
+            if last - first <= MAX_CREASES {
+                out.extend((first..=last).map(|k| (k as f64 * 0.5 - shift) * self.wavelength));
+            }
         }
         if self.growth != 0.0 {
             out.push(self.growth_from + self.amplitude / self.growth);
