@@ -16,12 +16,14 @@
 pub mod console;
 pub mod engine;
 pub mod grid;
+pub mod harness;
 pub mod kneeform;
 pub mod mesh;
 pub mod output;
 pub mod padded;
 pub mod paper;
 pub mod push;
+pub mod report;
 pub mod scenario;
 mod simd;
 pub mod slide;

@@ -22,10 +22,14 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 mod csv;
+mod ply;
 mod png;
 mod stl;
 
 pub use self::csv::{write_colliding_points, write_composite};
+pub use self::ply::write_colliding_area_ply;
+pub(crate) use self::png::count_colour;
+pub(crate) use self::png::register_font;
 pub use self::png::{PngError, write_composite_png, write_depth_png};
 pub(crate) use self::stl::to_stl_triangle;
 pub use self::stl::write_colliding_area;

@@ -373,7 +373,7 @@ fn tick(v: &f64) -> String {
 }
 
 /// Registers DejaVu Sans as plotters' `sans-serif` once per process.
-fn register_font() -> Result<(), PngError> {
+pub(crate) fn register_font() -> Result<(), PngError> {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
     let ok = *REGISTERED.get_or_init(|| {
         plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular()).is_ok()
@@ -406,7 +406,7 @@ fn viridis(t: f64) -> RGBColor {
 }
 
 /// The colour of count `c` of `n`: 1 darkest, `n` brightest.
-fn count_colour(c: usize, n: usize) -> RGBColor {
+pub(crate) fn count_colour(c: usize, n: usize) -> RGBColor {
     if n <= 1 {
         viridis(1.0)
     } else {

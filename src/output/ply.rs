@@ -1,0 +1,241 @@
+//! The colliding area as a coloured PLY mesh: the surface of
+//! [`write_colliding_area`](super::write_colliding_area), indexed, with a
+//! per-vertex colour by composite count, to open over the part in MeshLab
+//! or Blender.
+//!
+//! Each colliding node is one vertex at its height, so a vertex's colour is
+//! exactly its node's count (the viridis ramp of the composite image, 1
+//! dark to `n_angles` bright); the count itself is also stored as the
+//! vertex `quality`, MeshLab's scalar per vertex. Faces join colliding nodes
+//! as in the STL (a cell with four colliding corners gives two triangles,
+//! one with three gives one), and a node in no face gets a small square of
+//! its own colour. ASCII PLY, so the file can be read and diffed as text.
+
+use std::io::{self, Write};
+
+use crate::grid::HeightGrid;
+use crate::mesh::Side;
+
+use super::count_colour;
+
+/// Side of the square drawn on an unconnected colliding node, as a fraction
+/// of the pitch: the STL's patch size, so both files show the same area.
+const PATCH_FRACTION: f64 = 0.25;
+
+/// Writes the composite area (nodes with `composite > 0`) as an ASCII PLY
+/// mesh in the part's coordinates (mm; vertex `(x, side.to_part(h), z)`),
+/// faces wound towards the knee, every vertex coloured by its node's count
+/// of `n_angles`. Returns the number of faces written.
+///
+/// Fails with [`io::ErrorKind::InvalidInput`] when `composite` does not have
+/// one entry per grid node.
+pub fn write_colliding_area_ply<W: Write>(
+    mut w: W,
+    grid: &HeightGrid,
+    composite: &[u16],
+    n_angles: usize,
+    side: Side,
+) -> io::Result<usize> {
+    if composite.len() != grid.spec.len() {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "composite has {} entries but the grid has {} nodes",
+                composite.len(),
+                grid.spec.len()
+            ),
+        ));
+    }
+    let mesh = ColouredMesh::build(grid, composite, side);
+    let max_count = composite.iter().copied().max().unwrap_or(0);
+    let n = n_angles.max(usize::from(max_count)).max(1);
+    writeln!(w, "ply")?;
+    writeln!(w, "format ascii 1.0")?;
+    writeln!(
+        w,
+        "comment kneeform {} colliding area (mm, part frame); colour and quality = number of knee-form angles (of {n}) striking the node",
+        env!("CARGO_PKG_VERSION")
+    )?;
+    writeln!(w, "element vertex {}", mesh.vertices.len())?;
+    for axis in ["x", "y", "z"] {
+        writeln!(w, "property double {axis}")?;
+    }
+    for channel in ["red", "green", "blue"] {
+        writeln!(w, "property uchar {channel}")?;
+    }
+    writeln!(w, "property float quality")?;
+    writeln!(w, "element face {}", mesh.faces.len())?;
+    writeln!(w, "property list uchar int vertex_indices")?;
+    writeln!(w, "end_header")?;
+    for &([x, y, z], count) in &mesh.vertices {
+        let c = count_colour(usize::from(count), n);
+        // -0 is written as 0, as in the CSV files: mirroring a zero height
+        // must not change the file.
+        let num = |v: f64| if v == 0.0 { 0.0 } else { v };
+        writeln!(
+            w,
+            "{} {} {} {} {} {} {count}",
+            num(x),
+            num(y),
+            num(z),
+            c.0,
+            c.1,
+            c.2
+        )?;
+    }
+    for [a, b, c] in &mesh.faces {
+        writeln!(w, "3 {a} {b} {c}")?;
+    }
+    w.flush()?;
+    Ok(mesh.faces.len())
+}
+
+/// Vertices (part frame, mm) with their count, and triangles indexing them.
+struct ColouredMesh {
+    vertices: Vec<([f64; 3], u16)>,
+    faces: Vec<[u32; 3]>,
+}
+
+impl ColouredMesh {
+    fn build(grid: &HeightGrid, composite: &[u16], side: Side) -> ColouredMesh {
+        let (nx, nz) = (grid.spec.nx, grid.spec.nz);
+        let hit = |i: usize, j: usize| composite[j * nx + i] > 0;
+        let mut index = vec![u32::MAX; composite.len()];
+        let mut mesh = ColouredMesh {
+            vertices: Vec::new(),
+            faces: Vec::new(),
+        };
+        let mut vertex = |mesh: &mut ColouredMesh, i: usize, j: usize| -> u32 {
+            let k = j * nx + i;
+            if index[k] == u32::MAX {
+                index[k] = mesh.vertices.len() as u32;
+                let p = [grid.spec.x(i), side.to_part(grid.h[k]), grid.spec.z(j)];
+                mesh.vertices.push((p, composite[k]));
+            }
+            index[k]
+        };
+        for j in 0..nz.saturating_sub(1) {
+            for i in 0..nx.saturating_sub(1) {
+                // Corners counter-clockwise in (x, z), x right and z up: the
+                // normal faces -y in the analysis frame.
+                let corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
+                let on: Vec<(usize, usize)> =
+                    corners.into_iter().filter(|&(a, b)| hit(a, b)).collect();
+                let tris: &[[usize; 3]] = match on.len() {
+                    4 => &[[0, 1, 2], [0, 2, 3]],
+                    3 => &[[0, 1, 2]],
+                    _ => &[],
+                };
+                for t in tris {
+                    let f = t.map(|c| vertex(&mut mesh, on[c].0, on[c].1));
+                    mesh.faces.push(wound(f, side));
+                }
+            }
+        }
+        let half = 0.5 * PATCH_FRACTION * grid.spec.pitch;
+        for k in 0..composite.len() {
+            if composite[k] == 0 || index[k] != u32::MAX {
+                continue;
+            }
+            let (x, z) = (grid.spec.x(k % nx), grid.spec.z(k / nx));
+            let y = side.to_part(grid.h[k]);
+            let first = mesh.vertices.len() as u32;
+            for (dx, dz) in [(-half, -half), (half, -half), (half, half), (-half, half)] {
+                mesh.vertices.push(([x + dx, y, z + dz], composite[k]));
+            }
+            mesh.faces.push(wound([first, first + 1, first + 2], side));
+            mesh.faces.push(wound([first, first + 2, first + 3], side));
+        }
+        mesh
+    }
+}
+
+/// A mirror (the right side) reverses the sense of rotation: swap two
+/// vertices so the face still faces the knee.
+fn wound([a, b, c]: [u32; 3], side: Side) -> [u32; 3] {
+    match side {
+        Side::Left => [a, b, c],
+        Side::Right => [a, c, b],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::GridSpec;
+
+    /// A 3 x 3 grid at pitch 2 with heights `h = i + 10 j`.
+    fn grid() -> HeightGrid {
+        let spec = GridSpec {
+            pitch: 2.0,
+            i_origin: 0,
+            j_origin: 0,
+            nx: 3,
+            nz: 3,
+        };
+        let h = (0..9)
+            .map(|k| (k % 3) as f64 + 10.0 * (k / 3) as f64)
+            .collect();
+        HeightGrid { spec, h }
+    }
+
+    fn body(text: &str) -> Vec<&str> {
+        let end = text.find("end_header\n").expect("a header") + "end_header\n".len();
+        text[end..].lines().collect()
+    }
+
+    #[test]
+    fn a_full_cell_and_an_isolated_node_with_colours_by_count() {
+        let g = grid();
+        // Cell (0,0)-(1,1) fully colliding; node (2,2) alone.
+        let mut composite = vec![0u16; 9];
+        for k in [0, 1, 3, 4] {
+            composite[k] = 1;
+        }
+        composite[4] = 3;
+        composite[8] = 3;
+        let mut out = Vec::new();
+        let faces = write_colliding_area_ply(&mut out, &g, &composite, 3, Side::Left).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        assert!(text.starts_with("ply\nformat ascii 1.0\n"));
+        assert!(text.contains("element vertex 8\n"), "{text}");
+        assert!(text.contains("element face 4\n"), "{text}");
+        assert_eq!(faces, 4);
+        let lines = body(&text);
+        assert_eq!(lines.len(), 12);
+        // Node (0,0): count 1, the darkest colour; node (1,1): count 3 of 3,
+        // the brightest; vertices at the nodes' heights.
+        assert_eq!(lines[0], "0 0 0 68 1 84 1");
+        assert!(lines.contains(&"2 11 2 253 231 37 3"), "{lines:?}");
+        // The faces of the cell are counter-clockwise in (x, z).
+        assert_eq!(lines[8], "3 0 1 2");
+        assert_eq!(lines[9], "3 0 2 3");
+        // The isolated node gets a patch of its own colour at its height.
+        assert_eq!(lines[4], "3.75 22 3.75 253 231 37 3");
+    }
+
+    #[test]
+    fn right_side_mirrors_y_and_reverses_the_winding() {
+        let g = grid();
+        let composite = vec![1u16; 9];
+        let mut left = Vec::new();
+        let mut right = Vec::new();
+        write_colliding_area_ply(&mut left, &g, &composite, 1, Side::Left).unwrap();
+        write_colliding_area_ply(&mut right, &g, &composite, 1, Side::Right).unwrap();
+        let (left, right) = (
+            String::from_utf8(left).unwrap(),
+            String::from_utf8(right).unwrap(),
+        );
+        let (l, r) = (body(&left), body(&right));
+        assert_eq!(l.len(), r.len());
+        assert_eq!(l[1], "2 1 0 253 231 37 1");
+        assert_eq!(r[1], "2 -1 0 253 231 37 1");
+        let face = |s: &str| -> Vec<u32> { s.split(' ').map(|v| v.parse().unwrap()).collect() };
+        let (fl, fr) = (face(l[9]), face(r[9]));
+        assert_eq!((fl[1], fl[2], fl[3]), (fr[1], fr[3], fr[2]));
+        assert!(matches!(
+            write_colliding_area_ply(Vec::new(), &g, &[1], 1, Side::Left),
+            Err(e) if e.kind() == io::ErrorKind::InvalidInput
+        ));
+    }
+}

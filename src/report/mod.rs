@@ -1,0 +1,216 @@
+//! The evidence report: one self-contained HTML file that shows what was
+//! analysed, how, what the knee-form can strike, and how accurate that is.
+//!
+//! * [`build_report`], [`write_report`]: a run directory (and any
+//!   verification directories) in, the page out; [`ReportOptions`] says
+//!   where things are;
+//! * [`render`]: the CPU renderer (orthographic, z-buffered, Lambert
+//!   shading) and its pixel ↔ part mapping;
+//! * [`views`]: the report's views of the part and how they are painted;
+//! * [`run`], [`verify`]: reading the run and verification files back;
+//! * [`html`]: escaping, number formatting and citations.
+//!
+//! **Invariant:** every value the report shows from a run comes from the
+//! run's files, cited by file and JSON pointer (`data-src`); the part is
+//! drawn from the very file the run analysed (its SHA-256 is checked).
+
+use std::path::{Path, PathBuf};
+
+mod document;
+pub mod html;
+pub mod render;
+pub mod run;
+pub mod verify;
+pub mod views;
+
+pub use self::document::{MAIN_BORDER, SUMMARY, verify_label};
+pub use self::render::{Camera, DepthImage, RgbImage, View};
+pub use self::run::{NodeCounts, Run, read_part_file};
+pub use self::verify::{Verdict, Verification};
+pub use self::views::{Views, render_views, small_multiple_angles};
+
+/// The images of the run directory embedded in the report, when present.
+pub const RUN_FIGURES: [&str; 2] = ["composite.png", "depth.png"];
+
+/// Why a report could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    /// A file could not be read or written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A JSON file does not parse (or lacks a field the report needs).
+    #[error("{} is not a readable run file: {source}", path.display())]
+    Json {
+        /// The file.
+        path: PathBuf,
+        /// What serde said.
+        source: serde_json::Error,
+    },
+    /// A run file contradicts the run's summary.
+    #[error("{}: {reason}", path.display())]
+    Inconsistent {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The part file is not the one the run analysed.
+    #[error(
+        "{} has changed since the run: its SHA-256 is {found}, the run analysed {expected}; pass the analysed file with --part",
+        path.display()
+    )]
+    PartChanged {
+        /// The file found.
+        path: PathBuf,
+        /// The run's SHA-256.
+        expected: String,
+        /// The file's.
+        found: String,
+    },
+    /// The part file is nowhere to be found.
+    #[error(
+        "cannot find the analysed part {input_file:?} (tried {}); pass it with --part",
+        tried.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+    )]
+    PartMissing {
+        /// The file as the run named it.
+        input_file: String,
+        /// Where it was looked for.
+        tried: Vec<PathBuf>,
+    },
+    /// The part file does not read.
+    #[error("cannot read the part {}: {reason}", path.display())]
+    Part {
+        /// The file.
+        path: PathBuf,
+        /// What the reader said.
+        reason: String,
+    },
+    /// A verification directory holds neither `verify.json` nor
+    /// `converge.json`.
+    #[error("{} holds neither verify.json nor converge.json", dir.display())]
+    NotAVerification {
+        /// The directory.
+        dir: PathBuf,
+    },
+    /// An image could not be encoded.
+    #[error("cannot encode a PNG: {0}")]
+    Png(#[from] png::EncodingError),
+}
+
+/// What to report on.
+#[derive(Debug, Clone)]
+pub struct ReportOptions {
+    /// The `analyze` output directory.
+    pub run_dir: PathBuf,
+    /// `verify` or `converge` output directories.
+    pub verify_dirs: Vec<PathBuf>,
+    /// The part file, when not where the run's `input_file` says.
+    pub part: Option<PathBuf>,
+    /// The run directory's name on the page, when `run_dir` is not (e.g. a
+    /// staging directory about to be renamed).
+    pub run_name: Option<PathBuf>,
+}
+
+impl ReportOptions {
+    /// A report on `run_dir` alone, its part read as STL.
+    pub fn new(run_dir: impl Into<PathBuf>) -> ReportOptions {
+        ReportOptions {
+            run_dir: run_dir.into(),
+            verify_dirs: Vec::new(),
+            part: None,
+            run_name: None,
+        }
+    }
+}
+
+/// A report, built.
+#[derive(Debug)]
+pub struct Report {
+    /// The page.
+    pub html: String,
+    /// The run it reports on.
+    pub run: Run,
+    /// The rendered views.
+    pub views: Views,
+}
+
+/// Reads the run and verification directories, renders the views and
+/// assembles the page.
+pub fn build_report(options: &ReportOptions) -> Result<Report, ReportError> {
+    let mut run = Run::read(&options.run_dir, options.part.as_deref())?;
+    let verifications = options
+        .verify_dirs
+        .iter()
+        .map(|d| Verification::read(d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let angles = small_multiple_angles(&run.summary.angles_deg);
+    let masks = run.angle_masks(&angles)?;
+    let masks: Vec<(f64, NodeCounts)> = angles.into_iter().zip(masks).collect();
+    let views = render_views(&run, &masks);
+    let mut pngs = vec![
+        encode_png(&views.side.image)?,
+        encode_png(&views.oblique.image)?,
+    ];
+    for (_, figure) in &views.per_angle {
+        pngs.push(encode_png(&figure.image)?);
+    }
+    let run_figures: Vec<(String, Vec<u8>)> = RUN_FIGURES
+        .iter()
+        .filter_map(|name| {
+            std::fs::read(run.dir.join(name))
+                .ok()
+                .map(|b| (name.to_string(), b))
+        })
+        .collect();
+    if let Some(name) = &options.run_name {
+        run.dir.clone_from(name);
+    }
+    let html = document::document(&document::Inputs {
+        run: &run,
+        verifications: &verifications,
+        views: &views,
+        pngs: &pngs,
+        run_figures: &run_figures,
+    });
+    Ok(Report { html, run, views })
+}
+
+/// Builds the report and writes it to `out` through a temporary file in the
+/// same directory, renamed into place: `out` is never half written.
+pub fn write_report(options: &ReportOptions, out: &Path) -> Result<Report, ReportError> {
+    let report = build_report(options)?;
+    let io = |source| ReportError::Io {
+        path: out.to_path_buf(),
+        source,
+    };
+    let mut tmp_name = out.file_name().unwrap_or_default().to_os_string();
+    tmp_name.push(format!(".tmp-{}", std::process::id()));
+    let tmp = out.with_file_name(tmp_name);
+    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).map_err(io)?;
+    }
+    let written = std::fs::write(&tmp, &report.html).and_then(|()| std::fs::rename(&tmp, out));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written.map_err(io)?;
+    Ok(report)
+}
+
+/// An RGB image as PNG bytes.
+pub fn encode_png(image: &RgbImage) -> Result<Vec<u8>, ReportError> {
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, image.width as u32, image.height as u32);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(&image.pixels)?;
+    writer.finish()?;
+    Ok(bytes)
+}

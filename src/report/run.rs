@@ -1,0 +1,388 @@
+//! Reading an `analyze` run directory back: `summary.json` (typed, and as
+//! raw JSON so the report can cite every number by its JSON pointer), the
+//! composite and per-angle masks from the CSV files, and the part, re-read
+//! from the file the run names and checked against its SHA-256.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use sha2::Digest;
+
+use crate::grid::GridSpec;
+use crate::mesh::{Part, Side};
+use crate::summary::Summary;
+
+use super::ReportError;
+
+/// The counts of one run's grid nodes (composite or one angle's mask) with
+/// the heights the run reported, for painting the part.
+#[derive(Debug, Clone)]
+pub struct NodeCounts {
+    /// The run's grid (part frame x, z; mm).
+    pub spec: GridSpec,
+    /// Per node, row-major by z (`j * nx + i`): number of angles (or 1/0).
+    pub count: Vec<u16>,
+    /// Per node, the y of the node in the part's frame (mm) as the CSV
+    /// gave it; NaN for nodes not in the file.
+    pub y: Vec<f64>,
+}
+
+impl NodeCounts {
+    fn empty(spec: GridSpec) -> NodeCounts {
+        NodeCounts {
+            spec,
+            count: vec![0; spec.len()],
+            y: vec![f64::NAN; spec.len()],
+        }
+    }
+
+    /// The largest count of the nodes whose cell holds `(x, z)` (mm): nodes
+    /// with `|x - x_i| <= p/2` and `|z - z_j| <= p/2`, and their y (part
+    /// frame) alongside; `None` when no such node has a count.
+    ///
+    /// This is the report's rule for painting a surface point: a point is
+    /// coloured when it lies within half a pitch, in x and in z, of a
+    /// colliding node.
+    pub fn at(&self, x: f64, z: f64) -> Option<(u16, f64)> {
+        let s = &self.spec;
+        let half = 0.5 * s.pitch;
+        let near = |v: f64, origin: i64, n: usize| {
+            let k = (v / s.pitch).round() as i64 - origin;
+            (k - 1).max(0)..(k + 2).min(n as i64)
+        };
+        let mut best: Option<(u16, f64)> = None;
+        for j in near(z, s.j_origin, s.nz) {
+            let j = j as usize;
+            if (z - s.z(j)).abs() > half {
+                continue;
+            }
+            for i in near(x, s.i_origin, s.nx) {
+                let i = i as usize;
+                let k = j * s.nx + i;
+                let c = self.count[k];
+                if c > 0 && (x - s.x(i)).abs() <= half && best.is_none_or(|b| c > b.0) {
+                    best = Some((c, self.y[k]));
+                }
+            }
+        }
+        best
+    }
+
+    /// Nodes with a count.
+    pub fn nodes(&self) -> usize {
+        self.count.iter().filter(|&&c| c > 0).count()
+    }
+}
+
+/// Reads a part file as `analyze` does, an STL mesh or a scenario file
+/// (`.toml`, tessellated as `analyze` would), into triangles in the part's
+/// own frame, scaled by `scale` to mm and never mirrored: the report draws
+/// the part as it is.
+pub fn read_part_file(path: &Path, bytes: &[u8], scale: f64) -> Result<Part, ReportError> {
+    let name = path.display().to_string();
+    let failed = |reason: String| ReportError::Part {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let part = if crate::scenario::is_scenario_file(path) {
+        let triangles =
+            crate::scenario::triangles_from_file(path, None).map_err(|e| failed(e.to_string()))?;
+        Part::from_triangles(&name, triangles, scale, Side::Left)
+    } else {
+        Part::from_stl_bytes(&name, bytes, scale, Side::Left)
+    };
+    part.map_err(|e| failed(e.to_string()))
+}
+
+/// A run directory, read.
+#[derive(Debug)]
+pub struct Run {
+    /// The directory.
+    pub dir: PathBuf,
+    /// `summary.json`, typed.
+    pub summary: Summary,
+    /// `summary.json`, as written (for citing values by pointer).
+    pub summary_json: serde_json::Value,
+    /// The run's grid.
+    pub spec: GridSpec,
+    /// `composite.csv`: angles per node.
+    pub composite: NodeCounts,
+    /// The part file that was re-read (its SHA-256 matched the run's).
+    pub part_path: PathBuf,
+    /// The part in its own frame (mm, after the run's scale; not mirrored).
+    pub part: Part,
+}
+
+impl Run {
+    /// Reads `dir`. The part is looked for at `part` when given, else at the
+    /// run's `input_file` as given (relative to the current directory) and
+    /// relative to the run directory's parent; the first file whose SHA-256
+    /// is the run's is used ([`read_part_file`]).
+    pub fn read(dir: &Path, part: Option<&Path>) -> Result<Run, ReportError> {
+        let summary_path = dir.join("summary.json");
+        let text = read_text(&summary_path)?;
+        let json = |source| ReportError::Json {
+            path: summary_path.clone(),
+            source,
+        };
+        let summary_json: serde_json::Value = serde_json::from_str(&text).map_err(json)?;
+        let summary: Summary = serde_json::from_str(&text).map_err(json)?;
+        let spec = grid_spec(&summary).ok_or_else(|| ReportError::Inconsistent {
+            path: summary_path.clone(),
+            reason: format!(
+                "grid origin {:?}, size {:?} and pitch {} do not describe a grid",
+                summary.grid_origin, summary.grid_size, summary.pitch_mm
+            ),
+        })?;
+        let composite = read_composite(&dir.join("composite.csv"), spec)?;
+        let (part_path, part) = find_part(dir, part, &summary)?;
+        Ok(Run {
+            dir: dir.to_path_buf(),
+            summary,
+            summary_json,
+            spec,
+            composite,
+            part_path,
+            part,
+        })
+    }
+
+    /// The colliding masks of `angles` (degrees, each one of the run's),
+    /// from `colliding_points.csv`, as counts of 1.
+    pub fn angle_masks(&self, angles: &[f64]) -> Result<Vec<NodeCounts>, ReportError> {
+        let path = self.dir.join("colliding_points.csv");
+        let mut masks: BTreeMap<u64, NodeCounts> = angles
+            .iter()
+            .map(|a| (a.to_bits(), NodeCounts::empty(self.spec)))
+            .collect();
+        let mut rows = CsvRows::open(&path, &["angle_deg", "i", "j", "x", "y", "z"])?;
+        while let Some(row) = rows.next_row()? {
+            let angle: f64 = rows.parse(&row, 0)?;
+            if let Some(mask) = masks.get_mut(&angle.to_bits()) {
+                let k = rows.node(&row, self.spec)?;
+                mask.count[k] = 1;
+                mask.y[k] = rows.parse(&row, 4)?;
+            }
+        }
+        Ok(angles
+            .iter()
+            .map(|a| masks.remove(&a.to_bits()).expect("one mask per angle"))
+            .collect())
+    }
+}
+
+/// The run's grid: nodes on multiples of the pitch, as [`GridSpec`] lays
+/// them; `None` when the summary's origin is not on such a multiple.
+fn grid_spec(s: &Summary) -> Option<GridSpec> {
+    let p = s.pitch_mm;
+    if !(p.is_finite() && p > 0.0) || s.grid_size[0] == 0 || s.grid_size[1] == 0 {
+        return None;
+    }
+    let spec = GridSpec {
+        pitch: p,
+        i_origin: (s.grid_origin[0] / p).round() as i64,
+        j_origin: (s.grid_origin[1] / p).round() as i64,
+        nx: s.grid_size[0],
+        nz: s.grid_size[1],
+    };
+    (spec.x(0) == s.grid_origin[0] && spec.z(0) == s.grid_origin[1]).then_some(spec)
+}
+
+fn read_composite(path: &Path, spec: GridSpec) -> Result<NodeCounts, ReportError> {
+    let mut counts = NodeCounts::empty(spec);
+    let mut rows = CsvRows::open(path, &["i", "j", "x", "y", "z", "angles"])?;
+    while let Some(row) = rows.next_row()? {
+        let k = rows.node(&row, spec)?;
+        counts.count[k] = rows.parse(&row, 5)?;
+        counts.y[k] = rows.parse(&row, 3)?;
+    }
+    Ok(counts)
+}
+
+/// A CSV file read row by row, its columns located by name.
+struct CsvRows {
+    path: PathBuf,
+    reader: csv::Reader<std::fs::File>,
+    /// Column of each wanted name.
+    columns: Vec<usize>,
+    names: Vec<String>,
+    line: u64,
+}
+
+impl CsvRows {
+    fn open(path: &Path, wanted: &[&str]) -> Result<CsvRows, ReportError> {
+        let file = std::fs::File::open(path).map_err(|source| ReportError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let mut reader = csv::Reader::from_reader(file);
+        let bad = |reason: String| ReportError::Inconsistent {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let headers = reader.headers().map_err(|e| bad(e.to_string()))?.clone();
+        let columns = wanted
+            .iter()
+            .map(|w| {
+                headers
+                    .iter()
+                    .position(|h| h == *w)
+                    .ok_or_else(|| bad(format!("no column {w:?}")))
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(CsvRows {
+            path: path.to_path_buf(),
+            reader,
+            columns,
+            names: wanted.iter().map(|w| w.to_string()).collect(),
+            line: 1,
+        })
+    }
+
+    fn bad(&self, reason: String) -> ReportError {
+        ReportError::Inconsistent {
+            path: self.path.clone(),
+            reason: format!("line {}: {reason}", self.line),
+        }
+    }
+
+    fn next_row(&mut self) -> Result<Option<csv::StringRecord>, ReportError> {
+        let mut row = csv::StringRecord::new();
+        self.line += 1;
+        match self.reader.read_record(&mut row) {
+            Ok(true) => Ok(Some(row)),
+            Ok(false) => Ok(None),
+            Err(e) => Err(self.bad(e.to_string())),
+        }
+    }
+
+    /// The `n`-th wanted column of `row`, parsed.
+    fn parse<T: std::str::FromStr>(
+        &self,
+        row: &csv::StringRecord,
+        n: usize,
+    ) -> Result<T, ReportError> {
+        let field = row.get(self.columns[n]).unwrap_or("");
+        field
+            .parse()
+            .map_err(|_| self.bad(format!("{} = {field:?} is not a number", self.names[n])))
+    }
+
+    /// The node index of a row with `i`, `j`, `x`, `z` among its wanted
+    /// columns (by those names), checked against the grid: a CSV of another
+    /// grid must not be painted on this one.
+    fn node(&self, row: &csv::StringRecord, spec: GridSpec) -> Result<usize, ReportError> {
+        let col = |name: &str| {
+            self.names
+                .iter()
+                .position(|n| n == name)
+                .expect("a wanted column")
+        };
+        let i: usize = self.parse(row, col("i"))?;
+        let j: usize = self.parse(row, col("j"))?;
+        let x: f64 = self.parse(row, col("x"))?;
+        let z: f64 = self.parse(row, col("z"))?;
+        if i >= spec.nx || j >= spec.nz || x != spec.x(i) || z != spec.z(j) {
+            return Err(self.bad(format!(
+                "node ({i}, {j}) at x = {x}, z = {z} is not a node of the run's {} x {} grid",
+                spec.nx, spec.nz
+            )));
+        }
+        Ok(j * spec.nx + i)
+    }
+}
+
+/// Finds the part file and reads it in its own frame.
+fn find_part(
+    dir: &Path,
+    given: Option<&Path>,
+    summary: &Summary,
+) -> Result<(PathBuf, Part), ReportError> {
+    let named = PathBuf::from(&summary.input_file);
+    let candidates: Vec<PathBuf> = match given {
+        Some(p) => vec![p.to_path_buf()],
+        None => {
+            let mut c = vec![named.clone()];
+            if named.is_relative()
+                && let Some(parent) = dir.parent()
+            {
+                c.push(parent.join(&named));
+            }
+            c
+        }
+    };
+    let mut mismatched = Vec::new();
+    for path in &candidates {
+        let Ok(bytes) = std::fs::read(path) else {
+            continue;
+        };
+        let sha = hex(&sha2::Sha256::digest(&bytes));
+        if sha != summary.sha256 {
+            mismatched.push((path.clone(), sha));
+            continue;
+        }
+        let part = read_part_file(path, &bytes, summary.scale)?;
+        return Ok((path.clone(), part));
+    }
+    if let Some((path, sha)) = mismatched.into_iter().next() {
+        return Err(ReportError::PartChanged {
+            path,
+            expected: summary.sha256.clone(),
+            found: sha,
+        });
+    }
+    Err(ReportError::PartMissing {
+        input_file: summary.input_file.clone(),
+        tried: candidates,
+    })
+}
+
+fn read_text(path: &Path) -> Result<String, ReportError> {
+    std::fs::read_to_string(path).map_err(|source| ReportError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+pub(super) fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn counts() -> NodeCounts {
+        let spec = GridSpec {
+            pitch: 2.0,
+            i_origin: -3,
+            j_origin: 10,
+            nx: 5,
+            nz: 4,
+        };
+        let mut c = NodeCounts::empty(spec);
+        // Node (1, 2) at x = -4, z = 24, count 3; its neighbour (2, 2) at
+        // x = -2, count 5.
+        c.count[2 * 5 + 1] = 3;
+        c.y[2 * 5 + 1] = -1.0;
+        c.count[2 * 5 + 2] = 5;
+        c.y[2 * 5 + 2] = -2.0;
+        c
+    }
+
+    #[test]
+    fn a_point_takes_the_largest_count_of_the_cells_holding_it() {
+        let c = counts();
+        assert_eq!(c.at(-4.0, 24.0), Some((3, -1.0)));
+        assert_eq!(c.at(-4.99, 24.99), Some((3, -1.0)));
+        // On the shared cell edge both nodes hold it: the larger count.
+        assert_eq!(c.at(-3.0, 24.0), Some((5, -2.0)));
+        assert_eq!(c.at(-1.0, 23.0), Some((5, -2.0)));
+        assert_eq!(c.at(-0.99, 24.0), None);
+        assert_eq!(c.at(-4.0, 25.01), None);
+        assert_eq!(c.at(-5.01, 24.0), None);
+        // Far outside the grid.
+        assert_eq!(c.at(1e6, -1e6), None);
+        assert_eq!(c.nodes(), 2);
+    }
+}

@@ -1,0 +1,180 @@
+//! The report's pictures of the part: the analysed side seen face on and an
+//! oblique view, painted with the composite (colour by number of angles, the
+//! paper's Figure 13), and small multiples of single angles (its Figure 12).
+//!
+//! The side view looks at the analysed surface along the knee's push: from
+//! -y towards +y for the left side, from +y towards -y for the right side
+//! (both in the part's own frame, so the right side is not mirrored: its
+//! vehicle front, -x, is on the right of the picture). Its pixel ↔ (x, z)
+//! mapping is [`View::pixel_centre`] with `x = ±u`, `z = v`.
+//!
+//! A pixel is painted when the surface point under it lies within half a
+//! pitch, in x and in z, of a colliding node ([`NodeCounts::at`]); in the
+//! oblique view the point must also lie within [`OBLIQUE_Y_TOL_PITCHES`]
+//! pitches of the node's y, so faces that only share the node's x and z
+//! (the top of a console seen from above) stay grey.
+
+use crate::mesh::Side;
+use crate::output::count_colour;
+
+use super::render::{Camera, Rgb, RgbImage, View, paint, rasterize};
+use super::run::{NodeCounts, Run};
+
+/// Width of the large views (pixels): sharp on a printed A4 page.
+pub const LARGE_WIDTH: usize = 1100;
+/// Width of each small multiple (pixels).
+pub const SMALL_WIDTH: usize = 560;
+/// Empty border around the part (pixels).
+const MARGIN: usize = 8;
+/// Colour of a single angle's colliding area in the small multiples: a red
+/// that no grey shade of the part can take.
+pub const ANGLE_COLOUR: Rgb = [215, 48, 39];
+/// In the oblique view, a surface point is painted only within this many
+/// pitches of its node's y: enough for the slope across a cell of any face
+/// the knee can strike, far less than a console's depth.
+pub const OBLIQUE_Y_TOL_PITCHES: f64 = 2.0;
+
+/// One rendered picture.
+#[derive(Debug, Clone)]
+pub struct Figure {
+    /// The pixels.
+    pub image: RgbImage,
+    /// How pixels map to the part.
+    pub view: View,
+}
+
+/// Every picture of the report.
+#[derive(Debug, Clone)]
+pub struct Views {
+    /// The analysed side, face on, painted with the composite.
+    pub side: Figure,
+    /// The oblique view, painted with the composite.
+    pub oblique: Figure,
+    /// Per chosen angle (degrees), the side view painted with its mask.
+    pub per_angle: Vec<(f64, Figure)>,
+    /// Wall-clock time of all the rendering (seconds).
+    pub render_s: f64,
+}
+
+/// The camera of the side view: along the knee's push, z up.
+pub fn side_camera(side: Side) -> Camera {
+    Camera::looking([0.0, side.to_part(1.0), 0.0], [0.0, 0.0, 1.0])
+}
+
+/// The camera of the oblique view: from the analysed side, in front of the
+/// part (towards -x) and above it, looking back at it.
+pub fn oblique_camera(side: Side) -> Camera {
+    Camera::looking([0.55, side.to_part(1.0), -0.45], [0.0, 0.0, 1.0])
+}
+
+/// The number of colours of the composite's ramp: the angles analysed (or
+/// the largest count, if a file had more).
+pub fn ramp_len(run: &Run) -> usize {
+    let max = run.composite.count.iter().copied().max().unwrap_or(0);
+    run.summary.angles_deg.len().max(usize::from(max)).max(1)
+}
+
+/// The colour of composite count `c` (of [`ramp_len`]).
+pub fn composite_colour(c: u16, n: usize) -> Rgb {
+    let rgb = count_colour(usize::from(c), n);
+    [rgb.0, rgb.1, rgb.2]
+}
+
+/// Renders every view of `run`, the small multiples from `masks` (angle in
+/// degrees and its mask).
+pub fn render_views(run: &Run, masks: &[(f64, NodeCounts)]) -> Views {
+    let started = std::time::Instant::now();
+    let tris = &run.part.triangles;
+    let n = ramp_len(run);
+    let composite = &run.composite;
+    let by_count = |p: [f64; 3]| {
+        composite
+            .at(p[0], p[2])
+            .map(|(c, _)| composite_colour(c, n))
+    };
+
+    let view = View::fit(side_camera(run.summary.side), tris, LARGE_WIDTH, MARGIN);
+    let side = Figure {
+        image: paint(&rasterize(tris, &view), by_count),
+        view,
+    };
+
+    let y_tol = OBLIQUE_Y_TOL_PITCHES * run.spec.pitch;
+    let view = View::fit(oblique_camera(run.summary.side), tris, LARGE_WIDTH, MARGIN);
+    let oblique = Figure {
+        image: paint(&rasterize(tris, &view), |p| {
+            composite
+                .at(p[0], p[2])
+                .filter(|&(_, y)| (p[1] - y).abs() <= y_tol)
+                .map(|(c, _)| composite_colour(c, n))
+        }),
+        view,
+    };
+
+    let view = View::fit(side_camera(run.summary.side), tris, SMALL_WIDTH, MARGIN);
+    let small = rasterize(tris, &view);
+    let per_angle = masks
+        .iter()
+        .map(|(angle, mask)| {
+            let image = paint(&small, |p| mask.at(p[0], p[2]).map(|_| ANGLE_COLOUR));
+            (*angle, Figure { image, view })
+        })
+        .collect();
+    Views {
+        side,
+        oblique,
+        per_angle,
+        render_s: started.elapsed().as_secs_f64(),
+    }
+}
+
+/// The angles of the small multiples: the analysed angles nearest to -30,
+/// 0 and +30 degrees (the paper's Figure 12), each once, in increasing
+/// order.
+pub fn small_multiple_angles(angles: &[f64]) -> Vec<f64> {
+    let mut chosen: Vec<f64> = [-30.0, 0.0, 30.0]
+        .iter()
+        .filter_map(|&want: &f64| {
+            angles
+                .iter()
+                .copied()
+                .min_by(|a, b| (a - want).abs().total_cmp(&(b - want).abs()))
+        })
+        .collect();
+    chosen.sort_by(f64::total_cmp);
+    chosen.dedup();
+    chosen
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn small_multiples_pick_the_nearest_analysed_angles() {
+        let all: Vec<f64> = (-30..=30).map(f64::from).collect();
+        assert_eq!(small_multiple_angles(&all), [-30.0, 0.0, 30.0]);
+        assert_eq!(
+            small_multiple_angles(&[-10.0, 5.0, 25.0]),
+            [-10.0, 5.0, 25.0]
+        );
+        assert_eq!(small_multiple_angles(&[3.0]), [3.0]);
+        assert!(small_multiple_angles(&[]).is_empty());
+    }
+
+    #[test]
+    fn the_side_cameras_look_along_the_push_with_z_up() {
+        let left = side_camera(Side::Left);
+        assert_eq!(left.forward, [0.0, 1.0, 0.0]);
+        assert_eq!(left.right, [1.0, 0.0, 0.0]);
+        assert_eq!(left.up, [0.0, 0.0, 1.0]);
+        let right = side_camera(Side::Right);
+        assert_eq!(right.forward, [0.0, -1.0, 0.0]);
+        assert_eq!(right.right, [-1.0, 0.0, 0.0]);
+        assert_eq!(right.up, [0.0, 0.0, 1.0]);
+        // The oblique camera sits on the analysed side, in front and above.
+        let o = oblique_camera(Side::Left);
+        assert!(o.forward[0] > 0.0 && o.forward[1] > 0.0 && o.forward[2] < 0.0);
+        assert!(o.up[2] > 0.0);
+    }
+}

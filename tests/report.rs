@@ -1,0 +1,693 @@
+//! The evidence report end to end: `kneeform analyze` on a scenario with a
+//! known colliding strip, then `kneeform report` (and `analyze --report`):
+//! every section is there, every image is embedded, every cited value is
+//! the run file's, the rendered side views are coloured exactly on the
+//! composite's node cells, and the page renders in headless Chromium.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+use crate::util::scratch_dir;
+
+/// Angles of the test runs: the paper's Figure 12 angles and two between.
+const ANGLES: &str = "--angles=-30,-15,0,15,30";
+/// The step scenario strikes exactly the node column x = -2 mm at this
+/// pitch (the step's front edge), at every angle.
+const PITCH: &str = "2";
+
+fn kneeform(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_kneeform"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn ok(out: Output, what: &str) -> Output {
+    assert!(
+        out.status.success(),
+        "{what}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// A scratch directory holding `part.stl` (the step scenario, mirrored in
+/// y for the right side) and its analysis in `run/`.
+fn step_run(name: &str, side: &str) -> PathBuf {
+    let dir = scratch_dir(name);
+    ok(
+        kneeform(&dir, &["scenario", "step", "--out", "step.stl"]),
+        "scenario",
+    );
+    if side == "right" {
+        // The same part on the vehicle's right: its surface faces +y.
+        let part = kneeform::Part::read(&dir.join("step.stl"), 1.0, kneeform::Side::Right)
+            .expect("the scenario reads");
+        kneeform::scenario::write_stl(&dir.join("part.stl"), &part.triangles).unwrap();
+    } else {
+        std::fs::rename(dir.join("step.stl"), dir.join("part.stl")).unwrap();
+    }
+    ok(
+        kneeform(
+            &dir,
+            &[
+                "analyze", "part.stl", "--pitch", PITCH, ANGLES, "--side", side, "--out", "run",
+            ],
+        ),
+        "analyze",
+    );
+    dir
+}
+
+/// Writes a tiny valid PNG (a 4 x 3 gradient) to `path`.
+fn write_png(path: &Path) {
+    let mut bytes = Vec::new();
+    let mut enc = png::Encoder::new(&mut bytes, 4, 3);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut w = enc.write_header().unwrap();
+    w.write_image_data(&(0..36u8).map(|v| v * 7).collect::<Vec<_>>())
+        .unwrap();
+    w.finish().unwrap();
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// A `verify` + `converge` directory that fails its tolerance, and a
+/// `verify`-only one that passes: the schema of those commands, with two
+/// metrics, one within the tolerance and one not.
+fn verification_fixtures(dir: &Path) -> [PathBuf; 2] {
+    let failing = dir.join("verify-fail");
+    std::fs::create_dir_all(&failing).unwrap();
+    std::fs::write(
+        failing.join("verify.json"),
+        r#"{"tolerance_mm": 0.5, "pass": false, "pitch_mm": 2.0,
+            "metrics": {"push_error": {"max": 0.31, "p95": 0.2, "mean": 0.051, "n": 120},
+                        "miss_distance": {"max": 1.7, "p95": 0.9, "mean": 0.3, "n": 80}},
+            "area_iou": 0.93, "counts": {"starts": 120, "placed": 100},
+            "timings": {"grid_s": 0.12, "oracle_s": 2.5}}"#,
+    )
+    .unwrap();
+    std::fs::write(
+        failing.join("verify.csv"),
+        "metric,max\npush_error,0.31\n<b>odd</b>,1\n",
+    )
+    .unwrap();
+    std::fs::write(
+        failing.join("converge.json"),
+        r#"{"pitches_mm": [4.0, 2.0, 1.0], "fits": {"push_error": {"alpha": 1.9, "c": 0.021}},
+            "tolerance_mm": 0.5, "recommended_pitch_mm": 1.0, "predicted_full_time_s": 12.5}"#,
+    )
+    .unwrap();
+    std::fs::write(
+        failing.join("converge.csv"),
+        "pitch_mm,push_error_max\n4,1.2\n2,0.31\n1,0.08\n",
+    )
+    .unwrap();
+    write_png(&failing.join("error_vs_pitch.png"));
+    write_png(&failing.join("time_vs_pitch.png"));
+    let passing = dir.join("verify-pass");
+    std::fs::create_dir_all(&passing).unwrap();
+    std::fs::write(
+        passing.join("verify.json"),
+        r#"{"tolerance_mm": 2.0, "pass": true, "pitch_mm": 2.0,
+            "metrics": {"push_error": {"max": 0.31, "p95": 0.2, "mean": 0.05, "n": 120}}}"#,
+    )
+    .unwrap();
+    [failing, passing]
+}
+
+/// Standard base64 decoding (the report's data URIs).
+fn unbase64(text: &str) -> Vec<u8> {
+    let value = |c: u8| -> u32 {
+        match c {
+            b'A'..=b'Z' => u32::from(c - b'A'),
+            b'a'..=b'z' => u32::from(c - b'a') + 26,
+            b'0'..=b'9' => u32::from(c - b'0') + 52,
+            b'+' => 62,
+            b'/' => 63,
+            _ => panic!("not base64: {c}"),
+        }
+    };
+    let mut out = Vec::new();
+    for chunk in text.as_bytes().chunks(4) {
+        let pad = chunk.iter().filter(|&&c| c == b'=').count();
+        let n = chunk
+            .iter()
+            .map(|&c| if c == b'=' { 0 } else { value(c) })
+            .fold(0u32, |acc, v| acc << 6 | v);
+        out.extend_from_slice(&n.to_be_bytes()[1..4 - pad]);
+    }
+    out
+}
+
+/// A decoded RGB(A) image.
+struct Image {
+    width: usize,
+    height: usize,
+    channels: usize,
+    pixels: Vec<u8>,
+}
+
+impl Image {
+    fn decode(bytes: &[u8]) -> Image {
+        let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+        let mut reader = decoder.read_info().expect("a PNG");
+        let mut pixels = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut pixels).expect("a frame");
+        assert_eq!(info.bit_depth, png::BitDepth::Eight);
+        let channels = match info.color_type {
+            png::ColorType::Rgb => 3,
+            png::ColorType::Rgba => 4,
+            other => panic!("unexpected colour type {other:?}"),
+        };
+        pixels.truncate(info.buffer_size());
+        Image {
+            width: info.width as usize,
+            height: info.height as usize,
+            channels,
+            pixels,
+        }
+    }
+
+    fn at(&self, c: usize, r: usize) -> [u8; 3] {
+        let k = self.channels * (r * self.width + c);
+        [self.pixels[k], self.pixels[k + 1], self.pixels[k + 2]]
+    }
+}
+
+/// The value of attribute `name` in the tag `tag`.
+fn attr<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
+    let key = format!(" {name}=\"");
+    let start = tag.find(&key)? + key.len();
+    Some(&tag[start..start + tag[start..].find('"')?])
+}
+
+/// Every `<img ...>` tag of the page.
+fn img_tags(html: &str) -> Vec<&str> {
+    html.match_indices("<img ")
+        .map(|(k, _)| &html[k..k + html[k..].find('>').expect("a closed tag") + 1])
+        .collect()
+}
+
+/// The tag of the image with `id`.
+fn img_by_id<'a>(html: &'a str, id: &str) -> &'a str {
+    img_tags(html)
+        .into_iter()
+        .find(|t| attr(t, "id") == Some(id))
+        .unwrap_or_else(|| panic!("no image {id}"))
+}
+
+fn unescape(s: &str) -> String {
+    s.replace("&lt;", "<")
+        .replace("&gt;", ">")
+        .replace("&quot;", "\"")
+        .replace("&#39;", "'")
+        .replace("&amp;", "&")
+}
+
+/// Every cited value: (file, JSON pointer, text shown).
+fn citations(html: &str) -> Vec<(String, String, String)> {
+    html.match_indices("<span data-src=\"")
+        .map(|(k, m)| {
+            let rest = &html[k + m.len()..];
+            let src = &rest[..rest.find('"').unwrap()];
+            let text_start = rest.find('>').unwrap() + 1;
+            let text = &rest[text_start..text_start + rest[text_start..].find("</span>").unwrap()];
+            let (file, pointer) = src.split_once('#').expect("FILE#POINTER");
+            (unescape(file), unescape(pointer), unescape(text))
+        })
+        .collect()
+}
+
+/// Whether `shown` is how the report shows `value`: numbers to six
+/// significant digits (whole numbers exactly), strings as they are,
+/// booleans as yes/no, number arrays joined by ", ".
+fn shows(value: &Value, shown: &str) -> bool {
+    match value {
+        Value::Number(n) => {
+            let v = n.as_f64().unwrap();
+            let Ok(s) = shown.parse::<f64>() else {
+                return false;
+            };
+            if v == v.trunc() && v.abs() < 1e15 {
+                s == v
+            } else {
+                (s - v).abs() <= 5e-6 * v.abs()
+            }
+        }
+        Value::String(s) => s == shown,
+        Value::Bool(b) => shown == if *b { "yes" } else { "no" },
+        Value::Array(items) => {
+            let parts: Vec<&str> = shown.split(", ").collect();
+            parts.len() == items.len() && items.iter().zip(parts).all(|(v, p)| shows(v, p))
+        }
+        _ => false,
+    }
+}
+
+fn read_json(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// The nodes (x, z) of a CSV with those columns, optionally only the rows
+/// whose `angle_deg` is `angle`.
+fn csv_nodes(path: &Path, angle: Option<f64>) -> Vec<(f64, f64)> {
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    let headers = reader.headers().unwrap().clone();
+    let col = |name: &str| headers.iter().position(|h| h == name);
+    let (x, z) = (col("x").unwrap(), col("z").unwrap());
+    reader
+        .records()
+        .map(|r| r.unwrap())
+        .filter(|r| angle.is_none_or(|a| r[col("angle_deg").unwrap()].parse::<f64>().unwrap() == a))
+        .map(|r| (r[x].parse().unwrap(), r[z].parse().unwrap()))
+        .collect()
+}
+
+/// Asserts that the side-view image `tag` is coloured exactly at the
+/// pixels whose centre lies within half a pitch (in x and z) of one of
+/// `nodes`, where it shows the part, using the pixel ↔ (x, z) mapping the
+/// tag declares. Returns the number of coloured pixels.
+fn assert_painted_exactly(tag: &str, nodes: &[(f64, f64)], pitch: f64) -> usize {
+    let num = |name: &str| -> f64 { attr(tag, name).unwrap().parse().unwrap() };
+    let (u_left, v_top, mm, sign) = (
+        num("data-u-left"),
+        num("data-v-top"),
+        num("data-mm-per-px"),
+        num("data-x-sign"),
+    );
+    let src = attr(tag, "src").unwrap();
+    let img = Image::decode(&unbase64(
+        src.strip_prefix("data:image/png;base64,").unwrap(),
+    ));
+    assert_eq!(attr(tag, "width"), Some(img.width.to_string().as_str()));
+    let half = 0.5 * pitch;
+    let mut painted = 0;
+    let mut mismatches = Vec::new();
+    for r in 0..img.height {
+        let z = v_top - (r as f64 + 0.5) * mm;
+        for c in 0..img.width {
+            let x = sign * (u_left + (c as f64 + 0.5) * mm);
+            let [red, green, blue] = img.at(c, r);
+            // White: no part; equal channels: the grey part; else painted.
+            let covered = [red, green, blue] != [255, 255, 255];
+            let coloured = !(red == green && green == blue);
+            let want = covered
+                && nodes
+                    .iter()
+                    .any(|&(nx, nz)| (x - nx).abs() <= half && (z - nz).abs() <= half);
+            if coloured != want {
+                mismatches.push((c, r, x, z, [red, green, blue]));
+            }
+            painted += usize::from(coloured);
+        }
+    }
+    assert!(
+        mismatches.is_empty(),
+        "{} pixels disagree with the CSV, first {:?}",
+        mismatches.len(),
+        &mismatches[..mismatches.len().min(5)]
+    );
+    painted
+}
+
+#[test]
+fn report_of_a_scenario_run_has_every_section_embeds_every_figure_and_cites_the_run() {
+    let dir = step_run("report-sections", "left");
+    let [failing, passing] = verification_fixtures(&dir);
+    ok(
+        kneeform(
+            &dir,
+            &[
+                "report",
+                "run",
+                failing.to_str().unwrap(),
+                passing.to_str().unwrap(),
+                "--out",
+                "report.html",
+            ],
+        ),
+        "report",
+    );
+    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+
+    for id in [
+        "result",
+        "part",
+        "method",
+        "per-angle",
+        "accuracy",
+        "runtime",
+        "run-figures",
+    ] {
+        assert!(
+            html.contains(&format!("<section id=\"{id}\">")),
+            "no section {id}"
+        );
+    }
+    // Self-contained: no script, no link, nothing fetched.
+    for banned in ["<script", "<link", "http://", "https://", "file:", "url("] {
+        assert!(!html.contains(banned), "the page contains {banned:?}");
+    }
+
+    // Every image is an embedded PNG: the rendered views, and every figure
+    // file of the run and of the verification directories, byte for byte.
+    let tags = img_tags(&html);
+    assert!(tags.len() >= 2 + 3 + 2 + 2, "{} images", tags.len());
+    let mut embedded = BTreeSet::new();
+    for tag in &tags {
+        let src = attr(tag, "src").expect("a src");
+        let data = src
+            .strip_prefix("data:image/png;base64,")
+            .unwrap_or_else(|| panic!("not an embedded PNG: {}", &src[..src.len().min(60)]));
+        let bytes = unbase64(data);
+        let img = Image::decode(&bytes);
+        assert!(img.width > 0 && img.height > 0);
+        embedded.insert(bytes);
+    }
+    for file in [
+        dir.join("run/composite.png"),
+        dir.join("run/depth.png"),
+        failing.join("error_vs_pitch.png"),
+        failing.join("time_vs_pitch.png"),
+    ] {
+        assert!(
+            embedded.contains(&std::fs::read(&file).unwrap()),
+            "{} is not embedded",
+            file.display()
+        );
+    }
+    for id in [
+        "main-view",
+        "oblique-view",
+        "angle-view-0",
+        "angle-view-1",
+        "angle-view-2",
+    ] {
+        img_by_id(&html, id);
+    }
+
+    // Every cited value is the run file's.
+    let summary = read_json(&dir.join("run/summary.json"));
+    let files = [
+        ("summary.json".to_string(), summary.clone()),
+        (
+            "verify[0]/verify.json".into(),
+            read_json(&failing.join("verify.json")),
+        ),
+        (
+            "verify[0]/converge.json".into(),
+            read_json(&failing.join("converge.json")),
+        ),
+        (
+            "verify[1]/verify.json".into(),
+            read_json(&passing.join("verify.json")),
+        ),
+    ];
+    let cited = citations(&html);
+    let mut pointers = BTreeSet::new();
+    for (file, pointer, text) in &cited {
+        let json = &files
+            .iter()
+            .find(|(name, _)| name == file)
+            .unwrap_or_else(|| panic!("cites an unknown file {file}"))
+            .1;
+        let value = json
+            .pointer(pointer)
+            .unwrap_or_else(|| panic!("{file}#{pointer} is not in the file"));
+        assert!(
+            shows(value, text),
+            "{file}#{pointer}: shows {text:?}, file has {value}"
+        );
+        pointers.insert(format!("{file}#{pointer}"));
+    }
+    // The figures that must be there: identity, knee-form, grid, every
+    // angle's area, the runtime, and the verification verdicts.
+    let mut required: Vec<String> = [
+        "/input_file",
+        "/sha256",
+        "/triangles",
+        "/bbox_min/0",
+        "/bbox_max/2",
+        "/scale",
+        "/triangle_side_mm",
+        "/radius_mm",
+        "/thickness_mm",
+        "/pitch_mm",
+        "/grid_origin/0",
+        "/grid_size/1",
+        "/angles_deg",
+        "/side",
+        "/kneeform_version",
+        "/run_unix_time",
+        "/composite_area_mm2",
+        "/timings/total_s",
+        "/timings/push_slide_s",
+    ]
+    .iter()
+    .map(|p| format!("summary.json#{p}"))
+    .collect();
+    for k in 0..summary["per_angle"].as_array().unwrap().len() {
+        for f in [
+            "angle_deg",
+            "placed_starts",
+            "colliding_nodes",
+            "colliding_area_mm2",
+        ] {
+            required.push(format!("summary.json#/per_angle/{k}/{f}"));
+        }
+    }
+    for p in [
+        "verify[0]/verify.json#/tolerance_mm",
+        "verify[0]/verify.json#/pass",
+        "verify[0]/verify.json#/metrics/push_error/max",
+        "verify[0]/verify.json#/metrics/miss_distance/p95",
+        "verify[0]/verify.json#/area_iou",
+        "verify[0]/verify.json#/counts/starts",
+        "verify[0]/converge.json#/recommended_pitch_mm",
+        "verify[0]/converge.json#/predicted_full_time_s",
+        "verify[0]/converge.json#/fits/push_error/alpha",
+        "verify[1]/verify.json#/pass",
+    ] {
+        required.push(p.into());
+    }
+    for p in &required {
+        assert!(pointers.contains(p), "{p} is not cited");
+    }
+    // The assumed triangle side is called out; the verdicts are clear.
+    assert!(html.contains("ASSUMED"));
+    assert!(html.contains("id=\"verdict-0\">FAIL"), "no FAIL verdict");
+    assert!(html.contains("id=\"verdict-1\">PASS"), "no PASS verdict");
+    // Text from files is escaped.
+    assert!(html.contains("&lt;b&gt;odd&lt;/b&gt;") && !html.contains("<b>odd</b>"));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn side_views_are_coloured_exactly_on_the_csv_node_cells() {
+    for side in ["left", "right"] {
+        let dir = step_run(&format!("report-strip-{side}"), side);
+        ok(
+            kneeform(&dir, &["report", "run", "--out", "report.html"]),
+            "report",
+        );
+        let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+        let summary = read_json(&dir.join("run/summary.json"));
+        let pitch = summary["pitch_mm"].as_f64().unwrap();
+        // The known strip: the composite is the column x = -2 mm, the whole
+        // height of the part, at every angle.
+        let composite = csv_nodes(&dir.join("run/composite.csv"), None);
+        assert_eq!(composite.len(), 151, "{side}");
+        assert!(composite.iter().all(|&(x, _)| x == -2.0), "{side}");
+        let main = img_by_id(&html, "main-view");
+        assert_eq!(
+            attr(main, "data-x-sign"),
+            Some(if side == "left" { "1" } else { "-1" })
+        );
+        let painted = assert_painted_exactly(main, &composite, pitch);
+        // The strip's cells are 2 mm wide and cover the part's 300 mm
+        // height: whole pixels of it, give or take one row or column.
+        let mm: f64 = attr(main, "data-mm-per-px").unwrap().parse().unwrap();
+        let (cols, rows) = (2.0 / mm, 300.0 / mm);
+        let painted = painted as f64;
+        assert!(
+            painted >= (cols - 1.0) * (rows - 1.0) && painted <= (cols + 1.0) * (rows + 1.0),
+            "{side}: {painted} pixels painted for a strip of {cols} x {rows}"
+        );
+        // The small multiples, each against its angle's rows.
+        for (k, angle) in [-30.0, 0.0, 30.0].into_iter().enumerate() {
+            let nodes = csv_nodes(&dir.join("run/colliding_points.csv"), Some(angle));
+            assert!(!nodes.is_empty());
+            let tag = img_by_id(&html, &format!("angle-view-{k}"));
+            assert!(assert_painted_exactly(tag, &nodes, pitch) > 0);
+        }
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+}
+
+#[test]
+fn analyze_report_writes_the_report_and_the_coloured_mesh_with_the_run() {
+    let dir = scratch_dir("report-analyze");
+    ok(
+        kneeform(&dir, &["scenario", "step", "--out", "part.stl"]),
+        "scenario",
+    );
+    ok(
+        kneeform(
+            &dir,
+            &[
+                "analyze", "part.stl", "--pitch", PITCH, ANGLES, "--out", "run", "--report",
+            ],
+        ),
+        "analyze --report",
+    );
+    let html = std::fs::read_to_string(dir.join("run/report.html")).unwrap();
+    img_by_id(&html, "main-view");
+    // Named after the final directory, not the staging one.
+    assert!(!html.contains("partial"));
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().contains("partial"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+
+    // The coloured mesh: one patch of four vertices per node of the strip
+    // (a single column of nodes makes no cell), each in the brightest
+    // colour with quality 5, as every one of the 5 angles strikes it.
+    let ply = std::fs::read_to_string(dir.join("run/colliding_area.ply")).unwrap();
+    let (header, body) = ply.split_once("end_header\n").expect("a PLY header");
+    assert!(header.starts_with("ply\nformat ascii 1.0\n"));
+    assert!(header.contains("element vertex 604\n"), "{header}");
+    assert!(header.contains("element face 302\n"), "{header}");
+    assert!(header.contains("property uchar red\n"));
+    let lines: Vec<&str> = body.lines().collect();
+    assert_eq!(lines.len(), 604 + 302);
+    for v in &lines[..604] {
+        let f: Vec<f64> = v.split(' ').map(|t| t.parse().unwrap()).collect();
+        assert!((f[0] + 2.0).abs() <= 0.25, "{v}");
+        assert_eq!(&f[3..], [253.0, 231.0, 37.0, 5.0], "{v}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn a_changed_part_is_refused_with_a_clear_message() {
+    let dir = step_run("report-changed", "left");
+    let mut bytes = std::fs::read(dir.join("part.stl")).unwrap();
+    bytes[0] ^= 1;
+    std::fs::write(dir.join("part.stl"), bytes).unwrap();
+    let out = kneeform(&dir, &["report", "run", "--out", "report.html"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("has changed since the run"), "{stderr}");
+    assert!(stderr.contains("--part"), "{stderr}");
+    assert!(!dir.join("report.html").exists());
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Headless Chromium, when installed.
+fn chromium() -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    ["chromium", "chromium-browser"].iter().find_map(|name| {
+        std::env::split_paths(&path)
+            .map(|d| d.join(name))
+            .find(|p| p.is_file())
+    })
+}
+
+#[test]
+fn the_report_renders_in_headless_chromium() {
+    let Some(browser) = chromium() else {
+        eprintln!("skipped: chromium not installed (CI installs it in .ci/run)");
+        return;
+    };
+    let dir = step_run("report-chromium", "left");
+    ok(
+        kneeform(&dir, &["report", "run", "--out", "report.html"]),
+        "report",
+    );
+    let profile = dir.join("chromium-profile");
+    let shot = dir.join("shot.png");
+    let out = Command::new(&browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--hide-scrollbars",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg(format!("--screenshot={}", shot.display()))
+        .arg("--window-size=1200,1600")
+        .arg(format!("file://{}", dir.join("report.html").display()))
+        .output()
+        .expect("chromium runs");
+    assert!(
+        shot.is_file(),
+        "no screenshot: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let img = Image::decode(&std::fs::read(&shot).unwrap());
+    assert_eq!((img.width, img.height), (1200, 1600));
+
+    // Not blank: text, the part's shading and the colour ramp give many
+    // distinct colours.
+    let colours: BTreeSet<[u8; 3]> = (0..img.height)
+        .flat_map(|r| (0..img.width).map(move |c| (c, r)))
+        .map(|(c, r)| img.at(c, r))
+        .collect();
+    assert!(colours.len() > 100, "{} colours", colours.len());
+
+    // The main image: its border (MAIN_BORDER) frames a large box, inside
+    // which the part (grey) and the strip (the ramp's brightest colour,
+    // every angle) are visible.
+    let [br, bg, bb] = kneeform::report::MAIN_BORDER;
+    let near = |a: u8, b: u8| a.abs_diff(b) <= 3;
+    let border: Vec<(usize, usize)> = (0..img.height)
+        .flat_map(|r| (0..img.width).map(move |c| (c, r)))
+        .filter(|&(c, r)| {
+            let [x, y, z] = img.at(c, r);
+            near(x, br) && near(y, bg) && near(z, bb)
+        })
+        .collect();
+    assert!(border.len() > 1000, "main image border not found");
+    let (c0, c1) = (
+        border.iter().map(|p| p.0).min().unwrap(),
+        border.iter().map(|p| p.0).max().unwrap(),
+    );
+    let (r0, r1) = (
+        border.iter().map(|p| p.1).min().unwrap(),
+        border.iter().map(|p| p.1).max().unwrap(),
+    );
+    assert!(
+        c1 - c0 > 800 && r1 - r0 > 300,
+        "box {c0}..{c1} x {r0}..{r1}"
+    );
+    let inside: Vec<[u8; 3]> = (r0 + 8..r1 - 8)
+        .flat_map(|r| (c0 + 8..c1 - 8).map(move |c| (c, r)))
+        .map(|(c, r)| img.at(c, r))
+        .collect();
+    let grey = inside
+        .iter()
+        .filter(|p| p[0] == p[1] && p[1] == p[2] && p[0] > 120 && p[0] < 250)
+        .count();
+    let strip = inside
+        .iter()
+        .filter(|p| p[0] > 200 && p[1] > 180 && p[2] < 90)
+        .count();
+    assert!(grey > inside.len() / 2, "the part is not visible");
+    assert!(
+        strip > 100,
+        "the colliding strip is not visible ({strip} px)"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
