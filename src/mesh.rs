@@ -38,7 +38,7 @@ impl Side {
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
     /// The file could not be opened or read.
-    #[error("cannot read {path}: {source}")]
+    #[error("cannot read {path}")]
     Io {
         /// The file.
         path: String,

@@ -42,7 +42,8 @@ pub enum Command {
 /// The part and how to read it.
 #[derive(Debug, Args)]
 pub struct PartArgs {
-    /// The part, an STL file (binary or ASCII).
+    /// The part: an STL file (binary or ASCII), or a scenario file
+    /// (`scenarios/*.toml`, tessellated on the fly).
     pub part: PathBuf,
     /// Factor taking the file's units to mm (e.g. 1000 for metres).
     #[arg(long, default_value_t = 1.0, value_name = "FACTOR")]

@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Regenerates the committed evidence in results/: the convergence study of
+# every scenario family (results/converge/<scenario>/) and the benchmark
+# (results/bench.md). Run from the repository root:
+#
+#     bash results/regenerate.sh            # everything (about 10-20 minutes)
+#     bash results/regenerate.sh converge   # the convergence studies only
+#     bash results/regenerate.sh bench      # the benchmark only
+#
+# Every study uses the same settings so they can be compared: pitches 4, 2,
+# 1 and 0.5 mm, angles -30, 0 and 30 degrees, 60 seeded starts (seed 1),
+# tolerance 1 mm.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+what="${1:-all}"
+cargo build --release --quiet
+bin=target/release/kneeform
+
+if [[ "$what" == all || "$what" == converge ]]; then
+  for file in scenarios/*.toml; do
+    name=$(basename "$file" .toml)
+    pitches=4,2,1,0.5
+    # The console is 1500 x 600 mm: its finest grid alone would hold
+    # 12 million nodes; stop at 1 mm.
+    [[ "$name" == console ]] && pitches=4,2,1
+    echo "== $name"
+    "$bin" converge "$file" --pitches "$pitches" --angles=-30,0,30 --starts 60 --seed 1 \
+      --tolerance 1 --out "results/converge/$name"
+  done
+fi
+
+if [[ "$what" == all || "$what" == bench ]]; then
+  "$bin" bench --runs 5 --markdown results/bench.md
+fi
