@@ -217,7 +217,7 @@ pub fn compare_grid(
             let fp = &footprints[a];
             let trace = &traces[a * nodes.len() + s];
             let g = grid_trace(grid, fp, i, j, options.eps, options.fault);
-            let cmp = compare(&g, trace);
+            let cmp = compare(&g, trace, options.eps);
             let grid_placed = g.yr.is_finite();
             let status = match (trace.status, grid_placed) {
                 (StartStatus::Failed { .. }, _) => "oracle_failed",
