@@ -252,6 +252,10 @@ pub struct BenchArgs {
     /// Angles sampled for the paper-algorithm baseline.
     #[arg(long, default_value_t = 3, value_name = "N")]
     pub paper_angles: usize,
+    /// Starts traced by the exact oracle (angle 0), for its cost per start
+    /// against the engine's in the same run.
+    #[arg(long, default_value_t = 8, value_name = "N")]
+    pub oracle_starts: usize,
     /// Worker threads (default: one per CPU).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
