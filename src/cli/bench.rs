@@ -123,7 +123,12 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         let part = kneeform_oracle::Part::from_triangles(&triangles)?;
         let j = nz / 2;
         let starts: Vec<[f64; 2]> = (0..args.oracle_starts)
-            .map(|k| [spec.x(nx / 4 + k * (nx / 2) / args.oracle_starts), spec.z(j)])
+            .map(|k| {
+                [
+                    spec.x(nx / 4 + k * (nx / 2) / args.oracle_starts),
+                    spec.z(j),
+                ]
+            })
             .collect();
         let options = super::verify::oracle_options(&knee, fast.eps, PAPER_PITCH, spec.x(0));
         let t = Instant::now();
