@@ -9,20 +9,29 @@
 //! take minima, which are exact in every instruction set.
 
 /// Defines `$vis fn $name(args) -> ret` calling `$imp(args)` compiled for
-/// AVX-512F, AVX2 or the baseline, whichever the CPU supports.
+/// AVX-512F, AVX2 or the baseline, whichever the CPU supports. With
+/// `$imp::<A, B, C>`, the copies call `$imp::<A>`, `$imp::<B>` and
+/// `$imp::<C>`: a const parameter (a block width, say) tuned per
+/// instruction set.
 macro_rules! dispatch {
     ($(#[$meta:meta])* $vis:vis fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? => $imp:ident) => {
+        $crate::simd::dispatch!(@copies [$(#[$meta])*] $vis $name ($($arg: $ty),*) ($($ret)?) $imp, $imp, $imp);
+    };
+    ($(#[$meta:meta])* $vis:vis fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? => $imp:ident::<$a:literal, $b:literal, $c:literal>) => {
+        $crate::simd::dispatch!(@copies [$(#[$meta])*] $vis $name ($($arg: $ty),*) ($($ret)?) $imp::<$a>, $imp::<$b>, $imp::<$c>);
+    };
+    (@copies [$(#[$meta:meta])*] $vis:vis $name:ident ($($arg:ident: $ty:ty),*) ($($ret:ty)?) $f512:path, $f2:path, $f0:path) => {
         $(#[$meta])*
         $vis fn $name($($arg: $ty),*) $(-> $ret)? {
             #[cfg(target_arch = "x86_64")]
             {
                 #[target_feature(enable = "avx512f,avx2,fma")]
                 fn avx512($($arg: $ty),*) $(-> $ret)? {
-                    $imp($($arg),*)
+                    $f512($($arg),*)
                 }
                 #[target_feature(enable = "avx2,fma")]
                 fn avx2($($arg: $ty),*) $(-> $ret)? {
-                    $imp($($arg),*)
+                    $f2($($arg),*)
                 }
                 if $crate::simd::has_avx512() {
                     // SAFETY: the CPU supports AVX-512F, AVX2 and FMA,
@@ -37,7 +46,7 @@ macro_rules! dispatch {
                     return unsafe { avx2($($arg),*) };
                 }
             }
-            $imp($($arg),*)
+            $f0($($arg),*)
         }
     };
 }
