@@ -276,3 +276,57 @@ pub fn composite(masks: &[AngleMask]) -> Vec<u16> {
     }
     count
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::GridSpec;
+    use crate::kneeform::{Footprint, KneeForm};
+
+    /// The block width is a tuning knob per instruction set: every width
+    /// gives the same reach and placed count (the tests elsewhere run only
+    /// the width this machine's instruction set picks).
+    #[test]
+    fn every_block_width_gives_the_same_result() {
+        let spec = GridSpec {
+            pitch: 2.5,
+            i_origin: -40,
+            j_origin: -20,
+            nx: 150,
+            nz: 60,
+        };
+        let h: Vec<f64> = (0..spec.len())
+            .map(|n| {
+                let (x, z) = (spec.x(n % spec.nx), spec.z(n / spec.nx));
+                let hole = (x - 60.0).hypot(z - 10.0) < 25.0;
+                if hole {
+                    f64::INFINITY
+                } else {
+                    0.1 * x + 3.0 * (0.07 * x).sin() * (0.05 * z).cos()
+                }
+            })
+            .collect();
+        let grid = HeightGrid { spec, h };
+        let knee = KneeForm {
+            triangle_side: 80.0,
+            radius: 20.0,
+            thickness: 100.0,
+        };
+        let rows: Vec<usize> = (0..spec.nz).collect();
+        for angle in [-30.0, 0.0, 17.0] {
+            let fp = GridFootprint::new(&Footprint::new(&knee, angle), angle, spec.pitch);
+            let padded = PaddedGrid::new(&grid, std::slice::from_ref(&fp));
+            let table = WindowMin::new(&padded, 512);
+            let run =
+                |f: fn(&PaddedGrid, &WindowMin, &GridFootprint, &[usize], &mut [f64]) -> usize| {
+                    let mut reach = vec![f64::NEG_INFINITY; padded.h.len()];
+                    let placed = f(&padded, &table, &fp, &rows, &mut reach);
+                    (reach, placed)
+                };
+            let w16 = run(fast_band_impl::<16>);
+            assert!(w16.1 > 0);
+            assert!(run(fast_band_impl::<8>) == w16, "angle {angle}: 8 lanes");
+            assert!(run(fast_band_impl::<32>) == w16, "angle {angle}: 32 lanes");
+        }
+    }
+}
