@@ -7,10 +7,13 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use crate::mesh::Triangle;
 
-/// Creases closer than this (mm) to a lattice line or to each other are
-/// the same line: `10.3 - 0.3` is `10.000000000000002`, and a cell 2e-15 mm
-/// wide would only add a sliver. SPEC's node tolerance, 1e-9 mm.
-const SAME_LINE: f64 = 1e-9;
+/// Lines closer than this (mm) are the same line: `10.3 - 0.3` is
+/// `10.000000000000002`, and a cell 2e-15 mm wide would only add a sliver.
+/// 1 um, because binary STL stores f32: at 1400 mm its spacing is 1.2e-4 mm,
+/// and two lines closer than that became one, their cells zero-area
+/// triangles (1,896 of them in console.toml before this was raised from
+/// 1e-9).
+const SAME_LINE: f64 = 1e-3;
 
 /// The lattice coordinates along one axis: every multiple of `step` inside
 /// `range`, the range's ends, and the `extra` creases strictly inside it
@@ -23,7 +26,12 @@ pub(super) fn axis(range: (f64, f64), step: f64, extra: &[f64]) -> Vec<f64> {
     v.push(lo);
     v.push(hi);
     v.sort_by(f64::total_cmp);
-    v.dedup();
+    v.dedup_by(|later, earlier| *later - *earlier < SAME_LINE);
+    // The range's ends stay exact: a multiple of the step just below `hi`
+    // merged with it.
+    if let Some(last) = v.last_mut() {
+        *last = hi;
+    }
     let mut creases: Vec<f64> = extra
         .iter()
         .copied()

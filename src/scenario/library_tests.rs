@@ -78,10 +78,14 @@ fn every_file_loads_and_tessellates_exactly() {
                     "{stem}"
                 );
             }
-            // Each triangle has area in xz and faces the knee (-y).
+            // Each triangle has area in xz and faces the knee (-y), also
+            // as binary STL stores it, in f32.
             let [a, b, c] = t;
             let (e1, e2) = ([b[0] - a[0], b[2] - a[2]], [c[0] - a[0], c[2] - a[2]]);
             assert!(e1[1] * e2[0] - e1[0] * e2[1] < 0.0, "{stem}: {t:?}");
+            let [a, b, c] = t.map(|v| v.map(|x| f64::from(x as f32)));
+            let (e1, e2) = ([b[0] - a[0], b[2] - a[2]], [c[0] - a[0], c[2] - a[2]]);
+            assert!(e1[1] * e2[0] - e1[0] * e2[1] < 0.0, "{stem} in f32: {t:?}");
         }
         // The extent is covered exactly: the corners are vertices.
         for (x, z) in [(x0, z0), (x1, z0), (x0, z1), (x1, z1)] {
@@ -332,6 +336,16 @@ fn the_console_reaches_the_paper_triangle_count() {
     );
     for v in tris.iter().flatten() {
         assert_eq!(v[1], f.height(v[0], v[2]));
+    }
+    // No triangle loses its area when written as f32 (binary STL): lattice
+    // lines closer than f32's spacing at 1500 mm are merged.
+    for t in &tris {
+        let [a, b, c] = t.map(|v| v.map(|x| f64::from(x as f32)));
+        let (e1, e2) = ([b[0] - a[0], b[2] - a[2]], [c[0] - a[0], c[2] - a[2]]);
+        assert!(
+            e1[1] * e2[0] - e1[0] * e2[1] < 0.0,
+            "zero area in f32: {t:?}"
+        );
     }
     // It is the benchmark console plus its extra features: the rib's crest
     // stands 5 mm proud of the console there, the far corner is untouched.
