@@ -78,6 +78,22 @@ fn run(part: &Part, starts: &[[f64; 2]], angles: &[f64], options: &OracleOptions
         1e3 * seconds / traces.len() as f64,
         casts as f64 / traces.len() as f64,
     );
+    // Strikes at SPEC's default threshold, and the contacts whose stated
+    // rate error leaves them on either side of it.
+    let sigma = 0.5f64.to_radians().tan();
+    let strikes: usize = traces
+        .iter()
+        .filter_map(|t| t.strikes(sigma).ok())
+        .map(Iterator::count)
+        .sum();
+    let undecided = traces
+        .iter()
+        .flat_map(|t| &t.contacts)
+        .filter(|c| (c.rate - sigma).abs() <= c.rate_error)
+        .count();
+    println!(
+        "  strikes at 0.5 degrees: {strikes}, contacts within their rate error of it: {undecided}"
+    );
 }
 
 fn main() {

@@ -26,6 +26,35 @@
 //! * [`rapier_slide`]: the same slide driven by rapier3d's kinematic
 //!   character controller, a second view for cross-checking.
 //!
+//! # Deflection rates and strikes
+//!
+//! Each [`ContactPoint`] of a trace carries the deflection rate
+//! `rate = -df/ds` of the slide there and its stated accuracy
+//! `rate_error`; [`StartTrace::strikes`] gives the contacts with
+//! `rate > sigma`, SPEC's exact strikes. The rate is the larger of the two
+//! chord slopes `(f_a - f_b) / (s_b - s_a)` from the contact to its
+//! neighbours on the traced curve (the push pose `(0, yr*)` before the
+//! first contact), and infinite where a neighbour is at the same travel
+//! within `jump_tolerance` (a riser). A chord between contacts within
+//! `witness_tolerance` of each other is the mean of `-df/ds` over it; a
+//! longer chord is a straight run over a depression, whose rate is its
+//! chord (about 0). Because `f` is monotone, a chord steeper than `sigma`
+//! has travel in it where the true rate exceeds `sigma`, so every reported
+//! strike lies within one chord (`witness_tolerance` in travel) of a true
+//! one. Where `-df/ds` is monotone over the two chords (no inflection of
+//! the contact curve within them; one kink allowed) the true rate lies
+//! between the chord slopes, so `rate_error` is the difference of the two
+//! chords, a bound (next to a run, and at the last contact, the difference
+//! of the chord and the next one out on the same side, an estimate of the
+//! extrapolation error), plus the casts' rounding,
+//! `2 jump_tolerance sqrt(1 + rate^2) / ds`. That is 0 along a plane, about `|f''| ds` on a smooth contact
+//! curve with contacts `ds` apart (twice the actual error), and the jump
+//! in slope next to a kink of a faceted mesh, however close the contacts.
+//! A contact judged on the wrong side of `sigma` is therefore within one
+//! chord of a travel where the true rate crosses `sigma`: the strike's
+//! position is as accurate as the trace. The module `rate.rs` gives the
+//! reasoning in full.
+//!
 //! **Invariant:** a start is never reported clear on a failed query: parry
 //! returns "no hit" when GJK runs out of iterations, so every triangle a
 //! cast reports as missed is confirmed by a contact query with the swept
@@ -39,6 +68,7 @@ mod error;
 mod knee_form;
 mod part;
 mod rapier;
+mod rate;
 mod sweep;
 mod trace;
 
@@ -46,7 +76,7 @@ pub use batch::evaluate;
 pub use error::OracleError;
 pub use knee_form::{KneeForm, KneeFormDims};
 pub use part::{Part, Side};
-pub use rapier::{RapierComparison, RapierOptions, RapierSlide, rapier_slide};
+pub use rapier::{RapierComparison, RapierContact, RapierOptions, RapierSlide, rapier_slide};
 pub use trace::{
     ContactPoint, FailureReason, OracleOptions, SlideEnd, StartStatus, StartTrace, trace_start,
 };

@@ -31,7 +31,7 @@ use rapier3d_f64::geometry::{BroadPhaseBvh, ColliderBuilder, ColliderSet, Shared
 use rapier3d_f64::pipeline::QueryFilter;
 use serde::{Deserialize, Serialize};
 
-use crate::{ContactPoint, KneeForm, KneeFormDims, OracleError, Part, StartTrace};
+use crate::{KneeForm, KneeFormDims, OracleError, Part, StartTrace};
 
 /// Options of the rapier3d slide. Lengths in mm.
 #[derive(Copy, Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -58,13 +58,24 @@ impl Default for RapierOptions {
     }
 }
 
+/// A contact reported by the controller. Unlike an exact
+/// [`crate::ContactPoint`] it has no deflection rate: the controller's
+/// contacts are not a traced curve.
+#[derive(Copy, Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RapierContact {
+    /// Travel of the reference point along -x from the start (mm).
+    pub travel: f64,
+    /// Face level of the knee-form when it touched (mm, analysis y).
+    pub face_level: f64,
+    /// The touched point of the mesh, `[x, y, z]` (mm, analysis frame).
+    pub witness: [f64; 3],
+}
+
 /// The controller's slide of one start.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RapierSlide {
-    /// Contacts reported by the controller, in call order: the travel and
-    /// level of the knee-form when it touched, and the touched mesh point
-    /// (mm, analysis frame).
-    pub contacts: Vec<ContactPoint>,
+    /// Contacts reported by the controller, in call order.
+    pub contacts: Vec<RapierContact>,
     /// The pose after each controller call: `(travel, face level)` in mm.
     pub path: Vec<[f64; 2]>,
     /// Travel reached (mm).
@@ -210,7 +221,7 @@ pub fn rapier_slide(
         );
         for hit in hits {
             let at: Pose = hit.character_pos;
-            slide.contacts.push(ContactPoint {
+            slide.contacts.push(RapierContact {
                 travel: start[0] - at.translation.x,
                 face_level: at.translation.y,
                 // rapier's query pipeline casts with the hit collider as the

@@ -17,17 +17,25 @@
 //! ends when a cast misses (the knee-form clears the part) or a witness
 //! lies past [`OracleOptions::x_min`] (the grid's -x edge).
 //!
-//! **Contact tolerance.** The slide starts at `f0 = yr* - eps`, not at
-//! `yr*`: the traced motion is the exact motion of a knee-form released
-//! `eps` below its push level. A mesh point is therefore a slide contact
-//! exactly when it sticks out more than `eps` beyond the level the
-//! knee-form has at that point of its travel, which is the grid's rule
-//! `h < f - eps` (SPEC, "Step 2 — slide") for the first contact; after a
-//! contact the grid drops to the node's `h` and asks `h' < h - eps`, the
-//! trace drops to the contact and asks `h' < h`: the two differ by at most
-//! `eps` in level, far below any pitch. The offset also keeps the first
-//! cast off the touching pose, where parry reports a time of impact of 0.
-//! Every reported `face_level` is the level of the cast that touched.
+//! **Release offset.** The slide starts at `f0 = yr* - eps`
+//! ([`OracleOptions::eps`]), not at `yr*`: this keeps the first cast off
+//! the touching pose, where parry reports a time of impact of 0. On a
+//! part that bounds a solid it changes nothing but the first contact:
+//! lowering the knee-form only lets it travel further, so the slide
+//! released at `f0` follows SPEC's slide from `yr*` wherever that one is
+//! below `f0`, and every reported contact lies on SPEC's curve. What the
+//! trace does not sample is the curve's first drop by `eps`, between the
+//! push pose and the first contact: the first contact is late by the
+//! travel that drop takes, at most `eps / rate` (0.115 mm for any strike
+//! at 0.5 degrees), and a feature that sticks out less than `eps` beyond
+//! `yr*` is not seen. The push pose's chord to the first contact keeps
+//! that drop in the rates ([`crate::rate`]). Every reported `face_level`
+//! is the level of the cast that touched.
+//!
+//! **Deflection rates.** Once the trace is complete, each contact gets its
+//! rate `-df/ds` and a bound on that rate's error from the chords to its
+//! neighbours; [`crate::rate`] says how and how accurately.
+//! [`StartTrace::strikes`] are the contacts whose rate exceeds `sigma`.
 //!
 //! **Monotone travel.** A lower level normally travels at least as far as a
 //! higher one (lowering the knee-form only moves it away from a part that
@@ -41,6 +49,7 @@ use parry3d_f64::math::Vector;
 use serde::{Deserialize, Serialize};
 
 use crate::knee_form::{KneeForm, KneeFormDims};
+use crate::rate;
 use crate::sweep::{self, Motion};
 use crate::{OracleError, Part};
 
@@ -60,8 +69,12 @@ const SLIDE_MARGIN: f64 = 1.0;
 pub struct OracleOptions {
     /// The knee-form's `L`, `R`, `W`.
     pub knee_form: KneeFormDims,
-    /// SPEC's contact tolerance `eps` (mm, > 0): the slide starts this far
-    /// below `yr*`. Default 1e-3 mm, as the grid's.
+    /// The release offset (mm, > 0): the slide starts this far below
+    /// `yr*`, which keeps its first cast off the touching pose. It moves
+    /// the first contact later by at most `eps / rate` (0.115 mm for any
+    /// strike at 0.5 degrees) and hides features that stick out less than
+    /// `eps` beyond `yr*`; later contacts are unchanged (module docs).
+    /// Default 1e-3 mm.
     pub eps: f64,
     /// Consecutive contact points further apart than this (witness
     /// distance, or difference in travel) are bisected (mm). Default 0.1 mm,
@@ -142,6 +155,24 @@ pub struct ContactPoint {
     pub face_level: f64,
     /// The touched point of the mesh, `[x, y, z]` (mm, analysis frame).
     pub witness: [f64; 3],
+    /// The deflection rate `-df/ds` here (dimensionless, `>= 0`): the larger
+    /// of the chord slopes to the previous contact (the push pose
+    /// `(0, yr*)` for the first) and to the next one; `f64::INFINITY` where
+    /// a neighbour is at the same travel within `jump_tolerance` (a riser). JSON has no infinity:
+    /// an infinite rate is written as `null` and read back as infinite.
+    /// See [the crate docs](crate#deflection-rates-and-strikes) for how
+    /// accurate it is.
+    #[serde(with = "crate::rate::serde_rate")]
+    pub rate: f64,
+    /// The stated accuracy of `rate` (dimensionless, `>= 0`, finite): the
+    /// rate SPEC defines lies within `rate +- rate_error`. Between two
+    /// short chords this is a bound wherever the contact curve has no
+    /// inflection within them (a single kink is allowed); next to a jump,
+    /// and at the last contact, an estimate from the next chord out. 0 at
+    /// a riser and along a plane, up to rounding; about `|f''| ds` on a
+    /// smooth curve with contacts `ds` apart; the jump in slope next to a
+    /// kink. See [the crate docs](crate#deflection-rates-and-strikes).
+    pub rate_error: f64,
 }
 
 /// Why a start's trace could not be trusted.
@@ -215,6 +246,27 @@ pub struct StartTrace {
     pub casts: usize,
 }
 
+impl StartTrace {
+    /// The strikes of a placed start: its contacts whose deflection rate
+    /// exceeds `sigma = tan(delta)` (SPEC, "Exact strikes"), in the order
+    /// of the slide. Risers (infinite rate) are strikes for any `sigma`.
+    ///
+    /// A start that is not placed has none. A failed start's strikes are
+    /// unknown, not absent: that is an error, so no caller can take a
+    /// failed query for a clear start.
+    pub fn strikes(
+        &self,
+        sigma: f64,
+    ) -> Result<impl Iterator<Item = &ContactPoint> + '_, FailureReason> {
+        let contacts: &[ContactPoint] = match self.status {
+            StartStatus::Placed => &self.contacts,
+            StartStatus::NotPlaced => &[],
+            StartStatus::Failed { reason } => return Err(reason),
+        };
+        Ok(contacts.iter().filter(move |c| c.rate > sigma))
+    }
+}
+
 /// Push and slide one start: the reference point at `start = (x, z)` (mm,
 /// analysis frame), the knee-form at `angle_deg` degrees.
 pub fn trace_start(
@@ -269,6 +321,9 @@ pub(crate) fn trace_validated(
     }
     trace.contacts = tracer.contacts;
     trace.casts = tracer.casts;
+    if let (Some(yr_star), Some(push_witness)) = (trace.yr_star, trace.push_witness) {
+        rate::deflection_rates(yr_star, push_witness, &mut trace.contacts, options);
+    }
     trace
 }
 
@@ -372,6 +427,9 @@ impl Tracer<'_> {
             travel: hit.travel,
             face_level: level,
             witness: hit.witness.to_array(),
+            // Filled in once the trace is complete (`rate`).
+            rate: f64::NAN,
+            rate_error: f64::NAN,
         });
     }
 

@@ -78,7 +78,18 @@ fn assert_well_formed(trace: &StartTrace, options: &OracleOptions) {
             "{c:?}"
         );
         last = (c.travel, c.face_level);
+        // Every contact has its rate: >= 0 (infinite at a riser), with a
+        // finite stated error.
+        assert!(c.rate >= 0.0, "{c:?}");
+        assert!(c.rate_error.is_finite() && c.rate_error >= 0.0, "{c:?}");
     }
+}
+
+/// The plane `y = c + k (x - x_r)`, `k > 0`: it comes closer towards -x.
+fn tilted_wall(c: f64, k: f64, x_r: f64) -> Part {
+    let xs = linspace(-600.0, 600.0, 25);
+    let zs = linspace(-400.0, 400.0, 9);
+    Part::from_triangles(&height_field(&xs, &zs, |i, _| c + k * (xs[i] - x_r))).unwrap()
 }
 
 #[test]
@@ -87,9 +98,7 @@ fn tilted_wall_gives_the_level_under_the_front_of_the_footprint() {
     // touches under the footprint's front point (x0 - R, z0) at any angle
     // within +-30 degrees.
     let (c, k, x_r) = (10.0, 0.2, 0.0);
-    let xs = linspace(-600.0, 600.0, 25);
-    let zs = linspace(-400.0, 400.0, 9);
-    let part = Part::from_triangles(&height_field(&xs, &zs, |i, _| c + k * (xs[i] - x_r))).unwrap();
+    let part = tilted_wall(c, k, x_r);
     let starts = [[-100.0, 0.0], [50.0, 35.0], [200.0, -120.0]];
     let options = OracleOptions {
         x_min: -300.0,
@@ -139,15 +148,20 @@ fn tilted_wall_gives_the_level_under_the_front_of_the_footprint() {
     }
 }
 
-#[test]
-fn ramp_ahead_gives_the_analytic_first_contact_travel_and_contact_curve() {
-    // Flat at y = c behind x_w, then a ramp that sticks out towards -x:
-    // y = c - k (x_w - x) for x < x_w.
-    let (c, k, x_w) = (0.0, 0.35, -50.0);
+/// Flat at `y = c` behind `x_w`, then a ramp of slope `k` that sticks out
+/// towards -x: `y = c - k (x_w - x)` for `-400 <= x < x_w`.
+fn ramp_ahead(c: f64, k: f64, x_w: f64) -> (Part, impl Fn(f64) -> f64) {
     let xs = knots(&[linspace(-400.0, x_w, 36), linspace(x_w, 600.0, 13)]);
     let zs = linspace(-400.0, 400.0, 9);
-    let g = |x: f64| if x < x_w { c - k * (x_w - x) } else { c };
+    let g = move |x: f64| if x < x_w { c - k * (x_w - x) } else { c };
     let part = Part::from_triangles(&height_field(&xs, &zs, |i, _| g(xs[i]))).unwrap();
+    (part, g)
+}
+
+#[test]
+fn ramp_ahead_gives_the_analytic_first_contact_travel_and_contact_curve() {
+    let (c, k, x_w) = (0.0, 0.35, -50.0);
+    let (part, g) = ramp_ahead(c, k, x_w);
     let options = options();
     let starts = [[100.0, 0.0], [250.0, -40.0]];
     for trace in evaluate(&part, &starts, &ANGLES, &options).unwrap() {
@@ -336,20 +350,24 @@ fn run_over_a_depression_jumps_from_a_peak_to_the_next_point_that_sticks_out() {
     assert!((last.face_level - tall_peak).abs() < 1e-4, "{last:?}");
 }
 
-#[test]
-fn step_stops_the_knee_form_at_its_riser_down_to_the_step_level() {
-    // y = c - d for x <= x_e (sticking out), y = c behind, with a vertical
-    // riser at x = x_e (the knot x_e is repeated).
-    let (c, d, x_e) = (20.0, 15.0, -30.0);
+/// `y = c - d` for `x <= x_e` (sticking out), `y = c` behind, with a
+/// vertical riser at `x = x_e` (the knot `x_e` is repeated).
+fn step(c: f64, d: f64, x_e: f64) -> Part {
     let xs = knots(&[linspace(-500.0, x_e, 10), linspace(x_e, 500.0, 11)]);
     let mut xs_riser = xs.clone();
     let riser = xs.iter().position(|&x| x == x_e).unwrap();
     xs_riser.insert(riser, x_e);
     let zs = linspace(-400.0, 400.0, 9);
-    let part = Part::from_triangles(&height_field(&xs_riser, &zs, |i, _| {
+    Part::from_triangles(&height_field(&xs_riser, &zs, |i, _| {
         if i <= riser { c - d } else { c }
     }))
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn step_stops_the_knee_form_at_its_riser_down_to_the_step_level() {
+    let (c, d, x_e) = (20.0, 15.0, -30.0);
+    let part = step(c, d, x_e);
     let options = options();
     let starts = [[100.0, 0.0], [180.0, 90.0]];
     for trace in evaluate(&part, &starts, &ANGLES, &options).unwrap() {
@@ -441,11 +459,7 @@ fn batch_output_is_deterministic_and_equals_single_starts() {
 
 #[test]
 fn cast_budget_exhaustion_fails_the_start_and_keeps_its_contacts() {
-    let (c, k, x_w) = (0.0, 0.35, -50.0);
-    let xs = knots(&[linspace(-400.0, x_w, 36), linspace(x_w, 600.0, 13)]);
-    let zs = linspace(-400.0, 400.0, 9);
-    let g = |x: f64| if x < x_w { c - k * (x_w - x) } else { c };
-    let part = Part::from_triangles(&height_field(&xs, &zs, |i, _| g(xs[i]))).unwrap();
+    let (part, _) = ramp_ahead(0.0, 0.35, -50.0);
     let options = OracleOptions {
         max_casts: 6,
         ..options()
@@ -460,6 +474,11 @@ fn cast_budget_exhaustion_fails_the_start_and_keeps_its_contacts() {
     assert_eq!(trace.casts, 6);
     assert!(trace.yr_star.is_some() && !trace.contacts.is_empty());
     assert_eq!(trace.slide_end, SlideEnd::NotRun);
+    // Its strikes are unknown, not absent: never a clear start.
+    assert!(matches!(
+        trace.strikes(0.0),
+        Err(kneeform_oracle::FailureReason::CastBudgetExhausted)
+    ));
 }
 
 /// Writes triangles as an ASCII STL.
@@ -528,4 +547,232 @@ fn a_right_hand_part_read_as_right_traces_like_its_left_hand_mirror() {
             );
         }
     }
+}
+
+/// SPEC's default deflection threshold: tan 0.5 degrees.
+fn sigma_half_degree() -> f64 {
+    0.5f64.to_radians().tan()
+}
+
+/// What a rate may exceed its stated error by (float arithmetic). The
+/// stated error includes parry's gap error: on the planes below it held
+/// with 4e-6 to spare, rates within 8e-4 of the slope (relative), errors
+/// stated up to 2.5e-3.
+const RATE_TOL: f64 = 1e-9;
+
+#[test]
+fn ramp_contacts_have_its_slope_as_their_rate_and_strike_only_when_steeper_than_sigma() {
+    // Slopes on either side of tan 0.5 degrees (0.0087) and tan 3 degrees
+    // (0.0524). On the tilted wall the knee-form climbs from its first move
+    // (the first contact's rate is the chord from the push pose); on the
+    // ramp ahead it runs flat and then lands on the ramp.
+    let sigmas = [sigma_half_degree(), 3f64.to_radians().tan()];
+    let options = OracleOptions {
+        x_min: -300.0,
+        ..options()
+    };
+    for k in [0.35, 0.03, 0.012, 0.005] {
+        let wall = tilted_wall(10.0, k, 0.0);
+        let (ramp, _) = ramp_ahead(0.0, k, -50.0);
+        for part in [&wall, &ramp] {
+            let starts = [[100.0, 0.0], [150.0, 35.0]];
+            for trace in evaluate(part, &starts, &[-30.0, 0.0, 21.0], &options).unwrap() {
+                placed(&trace);
+                assert_well_formed(&trace, &options);
+                assert!(trace.contacts.len() > 10, "{trace:?}");
+                for c in &trace.contacts {
+                    assert!(
+                        (c.rate - k).abs() <= c.rate_error + RATE_TOL,
+                        "k {k}: {c:?}"
+                    );
+                    // A plane leaves only rounding.
+                    assert!(c.rate_error < 0.01 * k, "k {k}: {c:?}");
+                }
+                for sigma in sigmas {
+                    let strikes = trace.strikes(sigma).unwrap().count();
+                    let want = if k > sigma { trace.contacts.len() } else { 0 };
+                    assert_eq!(strikes, want, "k {k} sigma {sigma}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn riser_contacts_have_infinite_rate_and_are_strikes_at_any_threshold() {
+    let (c, d, x_e) = (20.0, 15.0, -30.0);
+    let part = step(c, d, x_e);
+    let options = options();
+    let starts = [[100.0, 0.0], [180.0, 90.0]];
+    for trace in evaluate(&part, &starts, &ANGLES, &options).unwrap() {
+        placed(&trace);
+        assert_well_formed(&trace, &options);
+        // Every contact is on the riser, at one travel: a drop at constant
+        // travel, on one side at least.
+        assert!(trace.contacts.len() >= 2, "{trace:?}");
+        for c_pt in &trace.contacts {
+            assert_eq!(c_pt.rate, f64::INFINITY, "{c_pt:?}");
+            assert_eq!(c_pt.rate_error, 0.0, "{c_pt:?}");
+        }
+        for sigma in [0.0, sigma_half_degree(), 1e12] {
+            let strikes: Vec<_> = trace.strikes(sigma).unwrap().copied().collect();
+            assert_eq!(strikes, trace.contacts);
+        }
+    }
+    // A start that is not placed strikes nothing.
+    let away = trace_start(&part, [2000.0, 0.0], 0.0, &options).unwrap();
+    assert_eq!(away.status, StartStatus::NotPlaced);
+    assert_eq!(away.strikes(0.0).unwrap().count(), 0);
+}
+
+/// The rate of the faceted bump profile under the front point `x`: the
+/// slope `dy/dx` of the facet it is on (SPEC's `-df/ds`, since the front
+/// point is at `x0 - R - s` and the level follows the profile), as the
+/// range of the two facets' slopes when `x` is within `tol` of a knot
+/// (there either may be the contact's), and 0 off the bumps.
+fn faceted_rate(c: f64, bumps: &[Bump], x: f64, tol: f64) -> (f64, f64) {
+    let Some(bump) = bumps.iter().find(|b| (x - b.xc).abs() < b.a + tol) else {
+        return (0.0, 0.0);
+    };
+    let knots = bump.knots();
+    let height = |x: f64| bump.height(c, x).unwrap_or(c);
+    let slope = |i: usize| match (knots.get(i), knots.get(i + 1)) {
+        (Some(&a), Some(&b)) => (height(b) - height(a)) / (b - a),
+        _ => 0.0,
+    };
+    let facets: Vec<f64> = (0..=knots.len())
+        .filter(|&i| {
+            let lo = if i == 0 {
+                f64::NEG_INFINITY
+            } else {
+                knots[i - 1]
+            };
+            let hi = knots.get(i).copied().unwrap_or(f64::INFINITY);
+            x > lo - tol && x < hi + tol
+        })
+        .map(|i| if i == 0 { 0.0 } else { slope(i - 1) })
+        .collect();
+    let lo = facets.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = facets.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    (lo, hi)
+}
+
+/// Checks every contact's rate against the faceted profile's, within its
+/// stated error, and the strikes at several thresholds wherever the
+/// stated error decides them.
+fn assert_rates_follow_the_profile(c: f64, bumps: &[Bump], trace: &StartTrace) {
+    let x0 = trace.start[0];
+    // The front point's x is known to the travel's accuracy: parry's gap
+    // error over the slope, ~1e-6 / 0.002 mm at the flattest facet.
+    let tol = 2e-3;
+    for c_pt in &trace.contacts {
+        let (lo, hi) = faceted_rate(c, bumps, x0 - R - c_pt.travel, tol);
+        assert!(
+            c_pt.rate >= lo - c_pt.rate_error - RATE_TOL
+                && c_pt.rate <= hi + c_pt.rate_error + RATE_TOL,
+            "{c_pt:?} vs {lo}..{hi}"
+        );
+    }
+    for sigma in [sigma_half_degree(), 0.05, 0.3] {
+        let strikes: Vec<f64> = trace.strikes(sigma).unwrap().map(|c| c.travel).collect();
+        for c_pt in &trace.contacts {
+            let (lo, hi) = faceted_rate(c, bumps, x0 - R - c_pt.travel, tol);
+            let struck = strikes.contains(&c_pt.travel);
+            if lo - c_pt.rate_error > sigma {
+                assert!(struck, "sigma {sigma}: {c_pt:?} vs {lo}");
+            }
+            if hi + c_pt.rate_error < sigma {
+                assert!(!struck, "sigma {sigma}: {c_pt:?} vs {hi}");
+            }
+        }
+    }
+}
+
+#[test]
+fn bump_rates_follow_its_facets_and_fall_to_zero_at_the_crest() {
+    let c = 5.0;
+    let bump = Bump {
+        xc: -100.0,
+        r: 80.0,
+        a: 40.0,
+    };
+    let part = bumps_part(c, &[bump]);
+    let options = OracleOptions {
+        witness_tolerance: 0.1,
+        ..OracleOptions::default()
+    };
+    let starts = [[150.0, 0.0], [200.0, 60.0]];
+    for trace in evaluate(&part, &starts, &ANGLES, &options).unwrap() {
+        placed(&trace);
+        assert_well_formed(&trace, &options);
+        assert_rates_follow_the_profile(c, &[bump], &trace);
+        // Rates fall from the foot of the bump, where the circle's slope is
+        // a / sqrt(r^2 - a^2) = 0.577, to the crest: the circle's slope
+        // only decreases as the knee-form climbs it.
+        let first = trace.contacts[0];
+        let foot = bump.a / (bump.r.powi(2) - bump.a.powi(2)).sqrt();
+        assert!((first.rate - foot).abs() < 0.01, "{first:?} vs {foot}");
+        for pair in trace.contacts.windows(2) {
+            assert!(
+                pair[1].rate <= pair[0].rate + pair[0].rate_error + pair[1].rate_error,
+                "{pair:?}"
+            );
+        }
+        // At the crest the rate is that of the last facet, 0.125 / r.
+        let last = trace.contacts.last().unwrap();
+        assert!(last.rate < 0.125 / bump.r + last.rate_error, "{last:?}");
+        assert!(last.rate < 0.5 * sigma_half_degree(), "{last:?}");
+    }
+}
+
+#[test]
+fn run_over_a_depression_leaves_the_crest_flat_and_lands_at_the_next_bumps_slope() {
+    let c = 0.0;
+    let small = Bump {
+        xc: 0.0,
+        r: 60.0,
+        a: 20.0,
+    };
+    let tall = Bump {
+        xc: -250.0,
+        r: 100.0,
+        a: 60.0,
+    };
+    let bumps = [small, tall];
+    let part = bumps_part(c, &bumps);
+    let options = options();
+    let trace = trace_start(&part, [150.0, 0.0], 0.0, &options).unwrap();
+    placed(&trace);
+    assert_well_formed(&trace, &options);
+    assert_rates_follow_the_profile(c, &bumps, &trace);
+    let landing = trace
+        .contacts
+        .iter()
+        .position(|c_pt| c_pt.witness[0] < -100.0)
+        .expect("the tall bump is reached");
+    // The small bump's crest: the knee-form leaves it flat, so its rate is
+    // its last facet's, 0.125 / 60 (not a strike at 0.5 degrees).
+    let crest = trace.contacts[landing - 1];
+    assert!(crest.rate < 0.125 / small.r + crest.rate_error, "{crest:?}");
+    assert_eq!(
+        trace
+            .strikes(sigma_half_degree())
+            .unwrap()
+            .filter(|c| c.travel == crest.travel)
+            .count(),
+        0
+    );
+    // The landing: the tall circle's slope where it reaches the small
+    // peak's level, steep enough to strike.
+    let after = trace.contacts[landing];
+    let u = (tall.r.powi(2) - (tall.yc(c) - small.peak(c)).powi(2)).sqrt();
+    let slope = u / (tall.r.powi(2) - u * u).sqrt();
+    assert!((after.rate - slope).abs() < 0.01, "{after:?} vs {slope}");
+    assert!(slope > sigma_half_degree());
+    assert!(
+        trace
+            .strikes(sigma_half_degree())
+            .unwrap()
+            .any(|c| c.travel == after.travel)
+    );
 }
