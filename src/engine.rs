@@ -17,6 +17,7 @@ use crate::paper::{PaperCounts, PaperScratch, paper_row};
 use crate::push::{PushRows, WindowMin, push_block};
 use crate::simd::dispatch;
 use crate::slide::{LayerRows, slide_block, slide_carried};
+use crate::strike::StrikeRule;
 
 /// Which implementation of push and slide to run. Both give identical masks.
 #[derive(
@@ -33,9 +34,9 @@ pub enum Algorithm {
 /// How to run the engine.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EngineOptions {
-    /// SPEC's contact tolerance `eps` (mm): a node collides when its height
-    /// is below the face level by more than this.
-    pub eps: f64,
+    /// SPEC's strike rule: rounding tolerance `e0` and deflection
+    /// threshold `sigma`.
+    pub rule: StrikeRule,
     /// The implementation.
     pub algorithm: Algorithm,
     /// Start rows to run (`None`: all). The benchmark runs the paper
@@ -46,7 +47,7 @@ pub struct EngineOptions {
 impl Default for EngineOptions {
     fn default() -> Self {
         EngineOptions {
-            eps: 1e-3,
+            rule: StrikeRule::default(),
             algorithm: Algorithm::Fast,
             start_rows: None,
         }
@@ -116,17 +117,12 @@ pub fn colliding_masks(
                     Some(table) => {
                         let mut reach = vec![f64::NEG_INFINITY; padded.h.len()];
                         let placed = fast_band(&padded, table, fp, band, &mut reach);
-                        let mask = padded
-                            .h
-                            .iter()
-                            .zip(&reach)
-                            .map(|(&h, &r)| u8::from(h < r - options.eps))
-                            .collect();
+                        let mask = strike_mask(&padded, &reach, &options.rule);
                         (mask, placed)
                     }
                     None => {
                         let mut mask = vec![0u8; padded.h.len()];
-                        let placed = paper_band(&padded, fp, band, options.eps, &mut mask);
+                        let placed = paper_band(&padded, fp, band, &options.rule, &mut mask);
                         (mask, placed)
                     }
                 })
@@ -224,18 +220,36 @@ fn fast_band_impl<const W: usize>(
     placed
 }
 
+/// SPEC's strike rule applied once per node to its reach, the highest face
+/// level that met it (`-inf`: never met). The rule is monotone in the
+/// level, so this is the union of the strikes of every slide that met the
+/// node. The node behind `n` is `n + 1` (the next column; the padding's
+/// `+inf` past the grid's +x edge).
+fn strike_mask(padded: &PaddedGrid, reach: &[f64], rule: &StrikeRule) -> Vec<u8> {
+    let p = padded.spec.pitch;
+    let h = &padded.h;
+    let mut mask: Vec<u8> = h
+        .windows(2)
+        .zip(reach)
+        .map(|(w, &r)| u8::from(rule.strikes(w[0], w[1], r, p)))
+        .collect();
+    // The last padded node is padding (`+inf`), never struck.
+    mask.push(0);
+    mask
+}
+
 /// The paper algorithm over a band of start rows.
 fn paper_band(
     padded: &PaddedGrid,
     fp: &GridFootprint,
     band: &[usize],
-    eps: f64,
+    rule: &StrikeRule,
     mask: &mut [u8],
 ) -> usize {
     let mut scratch = PaperScratch::default();
     let mut counts = PaperCounts::default();
     band.iter()
-        .map(|&j0| paper_row(padded, fp, j0, eps, mask, &mut scratch, &mut counts))
+        .map(|&j0| paper_row(padded, fp, j0, rule, mask, &mut scratch, &mut counts))
         .sum()
 }
 

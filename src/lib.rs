@@ -27,9 +27,11 @@ pub mod report;
 pub mod scenario;
 mod simd;
 pub mod slide;
+pub mod strike;
 pub mod summary;
 
 pub use engine::{Algorithm, AngleMask, EngineOptions, colliding_masks, composite, push_levels};
 pub use grid::{GridSpec, HeightGrid};
 pub use kneeform::{Footprint, GridFootprint, KneeForm};
 pub use mesh::{Part, Side};
+pub use strike::StrikeRule;

@@ -5,10 +5,12 @@
 //! Per start row and angle: the rows in front of the first start are merged
 //! into one list in distance order (a k-way merge: the rows share one pitch);
 //! each start to its left reuses that list with its first layer dropped; a
-//! slide that reaches a point already found by an earlier slide of the same
-//! start row and angle finishes that point's tie group and is cancelled,
-//! since from there on its face level is at or below the earlier slide's
-//! and the rest would repeat it. A slide that meets no colliding point scans
+//! slide that reaches a point already found (struck) by an earlier slide of
+//! the same start row and angle finishes that point's tie group and is
+//! cancelled: both slides see the same groups from there on, the earlier
+//! one dropped to the group's lowest height there (it struck a node of it),
+//! so this one's face level is at or below the earlier one's, and the
+//! strike rule is monotone in the level: the rest would strike nothing new. A slide that meets no colliding point scans
 //! to the end of the grid, so this is slow on flat parts by design.
 
 use std::cmp::Reverse;
@@ -17,6 +19,7 @@ use std::collections::BinaryHeap;
 use crate::kneeform::{GridFootprint, NODE_TOL};
 use crate::padded::{PaddedGrid, fmin};
 use crate::push::push_start_literal;
+use crate::strike::StrikeRule;
 
 /// One node of the merged list: its padded index, the layer it belongs to
 /// counted from the row's first start (`nx - 1`), and its tie group.
@@ -52,7 +55,7 @@ pub fn paper_row(
     grid: &PaddedGrid,
     fp: &GridFootprint,
     j0: usize,
-    eps: f64,
+    rule: &StrikeRule,
     mask: &mut [u8],
     scratch: &mut PaperScratch,
     counts: &mut PaperCounts,
@@ -126,7 +129,9 @@ pub fn paper_row(
                 let node = scratch.list[k].node;
                 let h = grid.h[node];
                 reached_found |= scratch.found[node] == stamp;
-                if h < f - eps {
+                // The node behind is the next column (padding past the
+                // grid's +x edge is `+inf`).
+                if rule.strikes(h, grid.h[node + 1], f, p) {
                     mask[node] = 1;
                     scratch.found[node] = stamp;
                 }

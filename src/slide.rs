@@ -15,10 +15,11 @@
 //! registers), then a scalar pass for the starts that are not placed but
 //! carry a level.
 //!
-//! Rather than test `h < M - eps` at every visit, each node keeps its
-//! **reach**, the highest level that met it; the test is monotone in the
-//! level, so `h < reach - eps` at the end gives the same mask with a
-//! `max` per visit instead of a compare-and-store.
+//! Rather than apply SPEC's strike rule at every visit, each node keeps its
+//! **reach**, the highest level that met it; the rule
+//! ([`StrikeRule::strikes`](crate::strike::StrikeRule::strikes)) is
+//! monotone in the level, so applying it to the reach at the end gives the
+//! same mask with a `max` per visit instead of a compare-and-store.
 
 use crate::kneeform::GridFootprint;
 use crate::padded::{PaddedGrid, fmax, fmin};
@@ -53,9 +54,9 @@ impl LayerRows {
 /// Slides `W` consecutive starts over their first layers. `base` is the
 /// padded node index of the first start, `level[w]` the level it enters
 /// with (`yr` if placed, `-inf` if not). Every node of the layer records in
-/// `reach` the highest face level that met it; a node is colliding where
-/// its height is below its reach by more than `eps` (SPEC's test, applied
-/// once at the end: it is monotone in the level). Returns the levels after
+/// `reach` the highest face level that met it; whether it is struck is
+/// decided once at the end by SPEC's strike rule applied to that reach
+/// (the rule is monotone in the level). Returns the levels after
 /// the layer and the lowest height of each layer.
 #[inline(always)]
 pub fn slide_block<const W: usize>(

@@ -73,8 +73,17 @@ pub struct Summary {
     pub sampled_nodes: usize,
     /// Angles analysed (degrees).
     pub angles_deg: Vec<f64>,
-    /// Contact tolerance eps (mm).
-    pub eps_mm: f64,
+    /// Deflection threshold delta (degrees): a contact is a strike when
+    /// the surface turns the knee-form aside by more than this.
+    pub deflection_deg: f64,
+    /// The same threshold as a rate, `sigma = tan(delta)`.
+    pub sigma: f64,
+    /// Rounding tolerance e0 (mm): a point is a contact when it sticks out
+    /// past the face level by more than this.
+    pub e0_mm: f64,
+    /// How a contact's deflection rate is estimated: `x-slope`, SPEC's
+    /// baseline (the rise from the node one pitch behind it).
+    pub rate: String,
     /// `fast` or `paper`.
     pub algorithm: crate::Algorithm,
     /// Worker threads.

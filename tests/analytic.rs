@@ -205,7 +205,8 @@ fn scenario_grids_agree_with_brute_force() {
     ] {
         let (grid, masks) = analyse(&triangulate(scenario, &small), 3.0, &knee, &ANGLES);
         for m in &masks {
-            let (want, placed) = brute_force(&grid, &knee, m.angle_deg, 1e-3);
+            let rule = kneeform::StrikeRule::default();
+            let (want, placed) = brute_force(&grid, &knee, m.angle_deg, rule.e0, rule.sigma);
             assert_eq!(
                 m.mask,
                 want,

@@ -2,10 +2,11 @@
 //! transcription of SPEC, on seeded random grids.
 
 use kneeform::{
-    Algorithm, EngineOptions, Footprint, GridFootprint, HeightGrid, KneeForm, colliding_masks,
+    Algorithm, EngineOptions, Footprint, GridFootprint, HeightGrid, KneeForm, StrikeRule,
+    colliding_masks,
 };
 
-use crate::util::{SEEDS, brute_force, mask_diff, random_grid};
+use crate::util::{SEEDS, brute_force_rules, mask_diff, random_grid_quantised};
 
 /// A knee-form smaller than the test grids.
 const SMALL: KneeForm = KneeForm {
@@ -21,83 +22,202 @@ fn run(
     knee: &KneeForm,
     angles: &[f64],
     algorithm: Algorithm,
-    eps: f64,
+    rule: StrikeRule,
 ) -> Vec<kneeform::AngleMask> {
     let footprints: Vec<GridFootprint> = angles
         .iter()
         .map(|&a| GridFootprint::new(&Footprint::new(knee, a), a, grid.spec.pitch))
         .collect();
     let options = EngineOptions {
-        eps,
+        rule,
         algorithm,
         start_rows: None,
     };
     colliding_masks(grid, &footprints, &options, &|| {})
 }
 
+/// The deflection thresholds SPEC asks the comparison for: the paper's
+/// literal rule (0), the default (0.5 degrees) and a steep one (3 degrees).
+const DEFLECTIONS_DEG: [f64; 3] = [0.0, 0.5, 3.0];
+
 /// Both implementations equal brute force, mask and placed count, for each
-/// grid shape, seed, angle and tolerance.
-fn check_against_brute_force(nx: usize, nz: usize, pitch: f64, knee: &KneeForm, eps: f64) {
-    let mut collisions = 0;
-    for (s, &seed) in SEEDS.iter().enumerate() {
-        let grid = random_grid(seed ^ pitch.to_bits(), nx, nz, pitch);
-        let fast = run(&grid, knee, &ANGLES, Algorithm::Fast, eps);
-        let paper = run(&grid, knee, &ANGLES, Algorithm::Paper, eps);
-        for (k, &angle) in ANGLES.iter().enumerate() {
-            let (want, placed) = brute_force(&grid, knee, angle, eps);
-            let what = format!("seed #{s}, {nx}x{nz} at p={pitch}, angle {angle}, eps {eps}");
-            assert_eq!(
-                fast[k].mask,
-                want,
-                "fast vs brute force, {what}: {}",
-                mask_diff(&grid, &fast[k].mask, &want)
-            );
-            assert_eq!(
-                paper[k].mask,
-                want,
-                "paper vs brute force, {what}: {}",
-                mask_diff(&grid, &paper[k].mask, &want)
-            );
-            assert_eq!(fast[k].placed, placed, "{what}");
-            assert_eq!(paper[k].placed, placed, "{what}");
-            collisions += fast[k].colliding;
-            eprintln!("{what}: {} colliding, {placed} placed", fast[k].colliding);
+/// grid shape, seed, angle and deflection threshold (rounding tolerance
+/// SPEC's default).
+fn check_against_brute_force(nx: usize, nz: usize, pitch: f64, knee: &KneeForm) -> Vec<usize> {
+    check_rules(nx, nz, pitch, knee, &default_rules())
+}
+
+/// SPEC's three thresholds with the default rounding tolerance.
+fn default_rules() -> [StrikeRule; 3] {
+    DEFLECTIONS_DEG.map(|d| StrikeRule::new(d, StrikeRule::DEFAULT_E0))
+}
+
+/// Both implementations equal brute force under each of `rules`, on
+/// coarse heights (0.5 mm: exact ties in height and at the thresholds) and
+/// fine, gentle ones (rises of hundredths of a mm: rates on both sides of a
+/// small threshold).
+fn check_rules(
+    nx: usize,
+    nz: usize,
+    pitch: f64,
+    knee: &KneeForm,
+    rules: &[StrikeRule],
+) -> Vec<usize> {
+    let coarse = SEEDS
+        .iter()
+        .map(|&seed| random_grid_quantised(seed ^ pitch.to_bits(), nx, nz, pitch, 0.5));
+    let fine = SEEDS[..2]
+        .iter()
+        .map(|&seed| random_grid_quantised(seed ^ pitch.to_bits(), nx, nz, pitch, 0.001));
+    let pairs: Vec<(f64, f64)> = rules.iter().map(|r| (r.e0, r.sigma)).collect();
+    let mut collisions = vec![0; rules.len()];
+    let mut contacts_not_struck = vec![0; rules.len()];
+    for (s, grid) in coarse.chain(fine).enumerate() {
+        let any_rise = run(
+            &grid,
+            knee,
+            &ANGLES,
+            Algorithm::Fast,
+            StrikeRule {
+                e0: StrikeRule::DEFAULT_E0,
+                sigma: 0.0,
+            },
+        );
+        let brute: Vec<(Vec<Vec<u8>>, usize)> = ANGLES
+            .iter()
+            .map(|&a| brute_force_rules(&grid, knee, a, &pairs))
+            .collect();
+        for (r, &rule) in rules.iter().enumerate() {
+            let fast = run(&grid, knee, &ANGLES, Algorithm::Fast, rule);
+            let paper = run(&grid, knee, &ANGLES, Algorithm::Paper, rule);
+            for (k, &angle) in ANGLES.iter().enumerate() {
+                let (want, placed) = (&brute[k].0[r], brute[k].1);
+                let what = format!(
+                    "grid #{s}, {nx}x{nz} at p={pitch}, angle {angle}, e0 {}, sigma {}",
+                    rule.e0, rule.sigma
+                );
+                assert!(
+                    fast[k].mask == *want,
+                    "fast vs brute force, {what}: {}",
+                    mask_diff(&grid, &fast[k].mask, want)
+                );
+                assert!(
+                    paper[k].mask == *want,
+                    "paper vs brute force, {what}: {}",
+                    mask_diff(&grid, &paper[k].mask, want)
+                );
+                assert_eq!(fast[k].placed, placed, "{what}");
+                assert_eq!(paper[k].placed, placed, "{what}");
+                collisions[r] += fast[k].colliding;
+                // At sigma = 0 (itself checked against brute force when it
+                // is among the rules) more is struck: the threshold works.
+                contacts_not_struck[r] += any_rise[k]
+                    .mask
+                    .iter()
+                    .zip(want)
+                    .filter(|(a, w)| a > w)
+                    .count();
+            }
         }
     }
-    // The grids are built to make the knee-form strike things.
-    assert!(
-        collisions > 0,
-        "no collision at all: the comparison proved nothing"
-    );
+    for (r, rule) in rules.iter().enumerate() {
+        // The grids are built to make the knee-form strike things.
+        assert!(
+            collisions[r] > 0,
+            "no collision at all under {rule:?}: the comparison proved nothing"
+        );
+    }
+    contacts_not_struck
+}
+
+/// Asserts that each rule with a positive threshold rejected some contact
+/// that `sigma = 0` strikes, over every comparison of a test (a knee-form
+/// as large as the grid meets little but the proud blocks, so not every
+/// single grid shape exercises the threshold).
+fn assert_thresholds_exercised(rules: &[StrikeRule], not_struck: &[Vec<usize>]) {
+    for (r, rule) in rules.iter().enumerate() {
+        let total: usize = not_struck.iter().map(|v| v[r]).sum();
+        assert!(
+            rule.sigma == 0.0 || total > 0,
+            "sigma {} rejected no contact: the threshold was not exercised",
+            rule.sigma
+        );
+    }
+}
+
+/// Whether some footprint row at one of the test angles is shorter than a
+/// pitch and holds no node (SPEC's exception for `sigma = 0`).
+fn has_a_row_without_nodes(knee: &KneeForm, pitch: f64) -> bool {
+    ANGLES.iter().any(|&a| {
+        GridFootprint::new(&Footprint::new(knee, a), a, pitch)
+            .rows
+            .iter()
+            .any(|r| r.klo > r.khi)
+    })
 }
 
 #[test]
 fn fast_and_paper_equal_brute_force_off_node_boundaries() {
-    check_against_brute_force(60, 45, 5.3, &KneeForm::default(), 1e-3);
-    check_against_brute_force(45, 40, 7.7, &KneeForm::default(), 1e-3);
+    let counts = [
+        check_against_brute_force(60, 45, 5.3, &KneeForm::default()),
+        check_against_brute_force(45, 40, 7.7, &KneeForm::default()),
+    ];
+    assert_thresholds_exercised(&default_rules(), &counts);
+}
+
+#[test]
+fn fast_and_paper_equal_brute_force_with_footprint_rows_holding_no_node() {
+    // The footprint spans z in [-160, 160] mm at angle 0; at this pitch the
+    // outermost rows (dz = +-30 p = +-159.995 mm) cut the rounding discs
+    // 0.005 mm from their edge: rows 1.6 mm long, shorter than the pitch,
+    // holding no node (SPEC's exception for sigma = 0).
+    let pitch = 160.0 / 30.01;
+    assert!(has_a_row_without_nodes(&KneeForm::default(), pitch));
+    let counts = check_against_brute_force(50, 70, pitch, &KneeForm::default());
+    assert_thresholds_exercised(&default_rules(), &[counts]);
 }
 
 #[test]
 fn fast_and_paper_equal_brute_force_with_boundaries_on_nodes() {
     // a(0) = -60 mm is a multiple of these pitches: footprint boundaries fall
     // exactly on nodes.
-    check_against_brute_force(50, 40, 4.0, &KneeForm::default(), 1e-3);
-    check_against_brute_force(60, 30, 2.0, &KneeForm::default(), 1e-3);
-    // a(0) = -12 mm for this one.
-    check_against_brute_force(50, 30, 1.0, &SMALL, 1e-3);
+    let counts = [
+        check_against_brute_force(50, 40, 4.0, &KneeForm::default()),
+        check_against_brute_force(60, 30, 2.0, &KneeForm::default()),
+        // a(0) = -12 mm for this one.
+        check_against_brute_force(50, 30, 1.0, &SMALL),
+    ];
+    assert_thresholds_exercised(&default_rules(), &counts);
 }
 
 #[test]
-fn fast_and_paper_equal_brute_force_at_an_exact_tolerance() {
-    // Heights are multiples of 0.5 mm: with eps = 0.5 some nodes sit exactly
-    // at the tolerance and must not collide.
-    check_against_brute_force(50, 40, 4.0, &KneeForm::default(), 0.5);
+fn fast_and_paper_equal_brute_force_at_exact_thresholds() {
+    // Heights are multiples of 0.5 mm. With e0 = 0.5 some nodes sit exactly
+    // at the rounding tolerance and must not be contacts; with sigma = 0.125
+    // at a 4 mm pitch a rise of one 0.5 mm step is exactly the threshold
+    // and must not strike, two steps must. (The fine grids of
+    // `check_rules` are compared too.)
+    let rules = [
+        StrikeRule {
+            e0: 0.5,
+            sigma: 0.0,
+        },
+        StrikeRule {
+            e0: 1e-6,
+            sigma: 0.125,
+        },
+    ];
+    let counts = check_rules(50, 40, 4.0, &KneeForm::default(), &rules);
+    assert_thresholds_exercised(&rules, &[counts]);
 }
 
 #[test]
 fn fast_and_paper_equal_brute_force_for_a_small_knee_form() {
     // A knee-form smaller than the grid, so that many starts are interior
     // and many slides run off the -x edge.
-    check_against_brute_force(60, 40, 2.0, &SMALL, 1e-3);
-    check_against_brute_force(50, 40, 3.3, &SMALL, 1e-3);
+    let counts = [
+        check_against_brute_force(60, 40, 2.0, &SMALL),
+        check_against_brute_force(50, 40, 3.3, &SMALL),
+    ];
+    assert_thresholds_exercised(&default_rules(), &counts);
 }

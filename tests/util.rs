@@ -29,10 +29,20 @@ impl Rng {
     }
 }
 
-/// A random height grid: a tilt, a smooth undulation plus noise, heights quantised
-/// to 0.5 mm so that exact ties (and exact-eps differences) occur, with
-/// holes (`+inf`) and a few blocks that stand proud.
-pub fn random_grid(seed: u64, nx: usize, nz: usize, pitch: f64) -> HeightGrid {
+/// A random height grid: a tilt, a smooth undulation plus noise, heights
+/// quantised to `quantum` mm, with holes (`+inf`) and a few blocks that
+/// stand proud. At 0.5 mm exact ties (and exact-threshold differences)
+/// occur; a finer quantum also makes the part gentle (tilt and undulation
+/// scaled down, noise of a few um): rises of hundredths of a mm between
+/// neighbours, rates on both sides of a deflection threshold of a
+/// fraction of a degree.
+pub fn random_grid_quantised(
+    seed: u64,
+    nx: usize,
+    nz: usize,
+    pitch: f64,
+    quantum: f64,
+) -> HeightGrid {
     let mut rng = Rng::new(seed);
     let spec = GridSpec {
         pitch,
@@ -50,12 +60,18 @@ pub fn random_grid(seed: u64, nx: usize, nz: usize, pitch: f64) -> HeightGrid {
     for j in 0..nz {
         for i in 0..nx {
             let (x, z) = (spec.x(i), spec.z(j));
-            let v = amp * (fx * x).sin() * (fz * z).cos() + 3.0 * rng.unit() + tilt * x;
+            let (gentle, noise) = if quantum < 0.5 {
+                (0.03, 0.004)
+            } else {
+                (1.0, 3.0)
+            };
+            let v =
+                gentle * (amp * (fx * x).sin() * (fz * z).cos() + tilt * x) + noise * rng.unit();
             let v = if rng.unit() < 0.02 { v - 8.0 } else { v };
             h.push(if rng.unit() < hole {
                 f64::INFINITY
             } else {
-                (v * 2.0).round() / 2.0
+                (v / quantum).round() * quantum
             });
         }
     }
@@ -94,57 +110,101 @@ fn distance_to_triangle(v: &[[f64; 2]; 3], x: f64, z: f64) -> f64 {
 /// SPEC's closed-set tolerance (mm).
 const TOL: f64 = 1e-9;
 
-/// The left end `a(dz)` of the footprint's row, by bisection on the
-/// distance function (independent of the engine's closed form), or `None`
-/// when the row misses the footprint.
+/// The left end `a(dz)` of the footprint's row, or `None` when the row
+/// misses it: the footprint `T (+) D_R` is the union of the triangle, the
+/// three discs at its corners and the three bands of half-width `R` along
+/// its edges, and each meets the row in an interval found from its own
+/// definition (independent of the engine's closed form). The discs' ends
+/// are taken as `vx - sqrt((R - |dz - vz|)(R + |dz - vz|))`, exact where
+/// the row is tangent to a disc: a distance test there (`distance <= R`)
+/// is flat along the row and would place the end only within sqrt(ulp),
+/// 2e-7 mm, which breaks SPEC's 1e-9 mm ties (measured: it did, at 30
+/// degrees, where an edge runs along x and a row grazes its band).
 fn row_start(v: &[[f64; 2]; 3], r: f64, dz: f64) -> Option<f64> {
-    // The distance along the row is convex; its minimum is near the
-    // triangle's x-range.
-    let xs = v.map(|p| p[0]);
-    let (mut lo, mut hi) = (
-        xs.iter().copied().fold(f64::INFINITY, f64::min),
-        xs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-    );
-    // Ternary search for the closest point of the row.
-    for _ in 0..200 {
-        let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
-        if distance_to_triangle(v, m1, dz) <= distance_to_triangle(v, m2, dz) {
-            hi = m2;
-        } else {
-            lo = m1;
+    // Intervals of x where lo <= c0 + c1 x <= hi, intersected into `iv`.
+    fn clip(iv: &mut (f64, f64), c0: f64, c1: f64, lo: f64, hi: f64) {
+        if c1 == 0.0 {
+            if !(lo..=hi).contains(&c0) {
+                *iv = (f64::INFINITY, f64::NEG_INFINITY);
+            }
+            return;
+        }
+        let (x0, x1) = ((lo - c0) / c1, (hi - c0) / c1);
+        let (x0, x1) = if x0 <= x1 { (x0, x1) } else { (x1, x0) };
+        *iv = (iv.0.max(x0), iv.1.min(x1));
+    }
+    let all = (f64::NEG_INFINITY, f64::INFINITY);
+    let mut left = f64::INFINITY;
+    let mut keep = |iv: (f64, f64)| {
+        if iv.0 <= iv.1 {
+            left = left.min(iv.0);
+        }
+    };
+    // The triangle: on the inner side of each edge (either orientation).
+    let area2 =
+        (v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[1][1] - v[0][1]) * (v[2][0] - v[0][0]);
+    let mut tri = all;
+    for k in 0..3 {
+        let (a, b) = (v[k], v[(k + 1) % 3]);
+        // cross(b - a, P - a) * sign(area) >= 0, linear in x.
+        let (ex, ez) = (b[0] - a[0], b[1] - a[1]);
+        let sign = area2.signum();
+        let c0 = sign * (ex * (dz - a[1]) + ez * a[0]);
+        let c1 = sign * -ez;
+        clip(&mut tri, c0, c1, 0.0, f64::INFINITY);
+    }
+    keep(tri);
+    for k in 0..3 {
+        // The band along edge a -> b: 0 <= (P - a).e <= |e|^2 and
+        // |(P - a).n| <= R |e|, with n = (-ez, ex) (not normalised).
+        let (a, b) = (v[k], v[(k + 1) % 3]);
+        let (ex, ez) = (b[0] - a[0], b[1] - a[1]);
+        let len2 = ex * ex + ez * ez;
+        let mut band = all;
+        clip(&mut band, -a[0] * ex + (dz - a[1]) * ez, ex, 0.0, len2);
+        let rl = r * len2.sqrt();
+        clip(&mut band, a[0] * ez + (dz - a[1]) * ex, -ez, -rl, rl);
+        keep(band);
+        // The disc at a.
+        let off = (dz - a[1]).abs();
+        if off <= r {
+            let half = ((r - off) * (r + off)).sqrt();
+            keep((a[0] - half, a[0] + half));
         }
     }
-    let centre = (lo + hi) / 2.0;
-    if distance_to_triangle(v, centre, dz) > r + TOL {
-        return None;
-    }
-    let (mut out, mut inn) = (centre - 4.0 * r - 1000.0, centre);
-    for _ in 0..200 {
-        let mid = (out + inn) / 2.0;
-        if distance_to_triangle(v, mid, dz) <= r {
-            inn = mid
-        } else {
-            out = mid
-        }
-    }
-    Some(inn)
+    left.is_finite().then_some(left)
 }
 
 /// SPEC's push and slide, transcribed per start: every node's membership
-/// from the distance to the footprint, every slide sorted in full. Returns
-/// the colliding mask and the number of placed starts.
+/// from the distance to the footprint, every slide sorted in full, each
+/// contact judged by SPEC's strike rule with rounding tolerance `e0` (mm)
+/// and deflection threshold `sigma` (a rate). Returns the colliding mask
+/// and the number of placed starts.
 pub fn brute_force(
     grid: &HeightGrid,
     knee: &KneeForm,
     angle_deg: f64,
-    eps: f64,
+    e0: f64,
+    sigma: f64,
 ) -> (Vec<u8>, usize) {
+    let (mut masks, placed) = brute_force_rules(grid, knee, angle_deg, &[(e0, sigma)]);
+    (masks.remove(0), placed)
+}
+
+/// [`brute_force`] for several rules `(e0, sigma)` at once (the geometry is
+/// the costly part): one mask per rule.
+pub fn brute_force_rules(
+    grid: &HeightGrid,
+    knee: &KneeForm,
+    angle_deg: f64,
+    rules: &[(f64, f64)],
+) -> (Vec<Vec<u8>>, usize) {
     let GridSpec {
         nx, nz, pitch: p, ..
     } = grid.spec;
     let v = triangle(knee, angle_deg);
     let r = knee.radius;
-    let mut mask = vec![0u8; nx * nz];
+    let mut masks = vec![vec![0u8; nx * nz]; rules.len()];
     let mut placed = 0;
     for j0 in 0..nz {
         // Row starts per row offset, shared by the starts of this row.
@@ -174,27 +234,43 @@ pub fn brute_force(
             }
             placed += 1;
             front.sort_by(|x, y| x.0.total_cmp(&y.0));
-            let mut f = yr;
-            let mut k = 0;
-            while k < front.len() {
-                let mut end = k + 1;
-                while end < front.len() && front[end].0 - front[end - 1].0 <= TOL {
-                    end += 1;
-                }
-                let mut gmin = f64::INFINITY;
-                for &(_, node) in &front[k..end] {
-                    let h = grid.h[node];
-                    if h < f - eps {
-                        mask[node] = 1;
+            for (&(e0, sigma), mask) in rules.iter().zip(&mut masks) {
+                let mut f = yr;
+                let mut k = 0;
+                while k < front.len() {
+                    let mut end = k + 1;
+                    while end < front.len() && front[end].0 - front[end - 1].0 <= TOL {
+                        end += 1;
                     }
-                    gmin = gmin.min(h);
+                    let mut gmin = f64::INFINITY;
+                    for &(_, node) in &front[k..end] {
+                        let h = grid.h[node];
+                        // SPEC rule 2: the rise of the surface from the node one
+                        // pitch behind (+x) in the same row; from the level where
+                        // that node is off the part.
+                        let i = node % nx;
+                        let behind = if i + 1 < nx {
+                            grid.h[node + 1]
+                        } else {
+                            f64::INFINITY
+                        };
+                        let rate = if behind.is_finite() {
+                            (behind - h) / p
+                        } else {
+                            (f - h) / p
+                        };
+                        if h < f - e0 && rate > sigma {
+                            mask[node] = 1;
+                        }
+                        gmin = gmin.min(h);
+                    }
+                    f = f.min(gmin);
+                    k = end;
                 }
-                f = f.min(gmin);
-                k = end;
             }
         }
     }
-    (mask, placed)
+    (masks, placed)
 }
 
 /// Renders a mask difference for an assertion message.

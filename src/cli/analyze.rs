@@ -87,7 +87,7 @@ pub fn run_engine(prepared: &Prepared, setup: &Setup) -> Vec<AngleMask> {
     );
     bar.set_prefix("push and slide");
     let options = EngineOptions {
-        eps: setup.eps,
+        rule: setup.rule,
         algorithm: setup.algorithm,
         start_rows: None,
     };
@@ -218,7 +218,10 @@ fn summarize(
         grid_size: [spec.nx, spec.nz],
         sampled_nodes: prepared.grid.finite_count(),
         angles_deg: setup.angles.clone(),
-        eps_mm: setup.eps,
+        deflection_deg: setup.rule.deflection_deg(),
+        sigma: setup.rule.sigma,
+        e0_mm: setup.rule.e0,
+        rate: "x-slope".into(),
         algorithm: setup.algorithm,
         threads: rayon::current_num_threads(),
         per_angle: masks

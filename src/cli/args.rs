@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, bail, ensure};
 use clap::{Args, Parser, Subcommand};
-use kneeform::{Algorithm, KneeForm, Side};
+use kneeform::{Algorithm, KneeForm, Side, StrikeRule};
 
 /// UN Regulation No. 21 knee-form inspection: which areas of an interior
 /// part a sliding knee-form strikes (push-and-slide on a height grid, after
@@ -81,11 +81,21 @@ pub struct SetupArgs {
         value_name = "ANGLES"
     )]
     pub angles: String,
-    /// Contact tolerance eps (mm): a grid point collides when it stands
-    /// more than this above the knee-form's face; it absorbs the rounding of
-    /// a flat wall.
-    #[arg(long, default_value_t = 1e-3, value_name = "MM")]
-    pub eps: f64,
+    /// Deflection threshold delta (degrees, 0 <= delta < 45): a point the
+    /// knee-form meets is a strike (a colliding point) only when the surface
+    /// there turns the knee-form aside by more than this angle (its rise
+    /// over one pitch from the point behind it). A surface it merely
+    /// brushes, nearly parallel to the slide, is not a strike. 0 is the
+    /// paper's literal rule (any point sticking out); larger values report
+    /// only steeper contacts.
+    #[arg(long, default_value_t = StrikeRule::DEFAULT_DEFLECTION_DEG, value_name = "DEG")]
+    pub deflection: f64,
+    /// Rounding tolerance e0 (mm, >= 0, at most 0.01): a point is a contact
+    /// only when it sticks out past the knee-form's face by more than this.
+    /// It only absorbs floating-point rounding (a flat wall); it is not an
+    /// engineering tolerance.
+    #[arg(long, default_value_t = StrikeRule::DEFAULT_E0, value_name = "MM")]
+    pub e0: f64,
     /// Grid origin X,Z (mm), snapped to multiples of the pitch. Default: the
     /// part's xz bounding box grown by the knee-form's extent.
     #[arg(
@@ -148,20 +158,50 @@ pub struct ReportArgs {
 #[derive(Debug, Args)]
 pub struct StartArgs {
     /// Starts to compare: `all` (every node whose start is placed at some
-    /// angle) or a number N for a seeded random sample of them.
-    #[arg(long, default_value = "100", value_name = "all|N")]
+    /// angle), a number N for a seeded random sample of them, or
+    /// `strip:Z0:Z1` for every placed start with Z0 <= z <= Z1 (mm): a
+    /// whole strip of start rows, whose area distance is the colliding
+    /// area a user sees there.
+    #[arg(long, default_value = "100", value_name = "all|N|strip:Z0:Z1")]
     pub starts: String,
     /// Seed of the start sample.
     #[arg(long, default_value_t = 1, value_name = "S")]
     pub seed: u64,
+    /// Growth of the tie band with the pitch (per mm): exact contacts whose
+    /// deflection rate is within a factor 1 + TIE_BAND x pitch of the
+    /// threshold are undecided (either answer is right at this pitch) and
+    /// never fail a comparison; they are counted and shown.
+    #[arg(long, default_value_t = kneeform::harness::TieBand::DEFAULT_PER_MM, value_name = "PER_MM")]
+    pub tie_band: f64,
 }
 
 impl StartArgs {
     /// Validates the flags.
     pub fn validate(&self) -> anyhow::Result<kneeform::harness::StartSelection> {
         use kneeform::harness::StartSelection;
+        ensure!(
+            self.tie_band.is_finite() && self.tie_band >= 0.0,
+            "--tie-band must be a finite number >= 0, got {}",
+            self.tie_band
+        );
         if self.starts == "all" {
             return Ok(StartSelection::All);
+        }
+        if let Some(range) = self.starts.strip_prefix("strip:") {
+            let (lo, hi) = range
+                .split_once(':')
+                .and_then(|(a, b)| {
+                    Some((a.trim().parse::<f64>().ok()?, b.trim().parse::<f64>().ok()?))
+                })
+                .with_context(|| {
+                    format!("--starts {:?}: expected strip:Z0:Z1 in mm", self.starts)
+                })?;
+            ensure!(
+                lo.is_finite() && hi.is_finite() && lo <= hi,
+                "--starts {:?}: expected Z0 <= Z1, both finite",
+                self.starts
+            );
+            return Ok(StartSelection::Strip { z: [lo, hi] });
         }
         let count: usize = self
             .starts
@@ -284,7 +324,7 @@ pub struct Setup {
     pub pitch: f64,
     pub knee: KneeForm,
     pub angles: Vec<f64>,
-    pub eps: f64,
+    pub rule: StrikeRule,
     pub grid: GridPlacement,
     pub algorithm: Algorithm,
     pub threads: Option<usize>,
@@ -300,9 +340,14 @@ impl SetupArgs {
         positive("--thickness", self.thickness)?;
         positive("--max-memory", self.max_memory)?;
         ensure!(
-            self.eps.is_finite() && self.eps >= 0.0,
-            "--eps must be a finite number >= 0, got {}",
-            self.eps
+            self.deflection.is_finite() && (0.0..45.0).contains(&self.deflection),
+            "--deflection must be a number of degrees in [0, 45), got {}",
+            self.deflection
+        );
+        ensure!(
+            self.e0.is_finite() && (0.0..=0.01).contains(&self.e0),
+            "--e0 must be a number of mm in [0, 0.01] (it only absorbs rounding), got {}",
+            self.e0
         );
         if let Some(n) = self.threads {
             ensure!(n >= 1, "--threads must be at least 1");
@@ -333,7 +378,7 @@ impl SetupArgs {
                 thickness: self.thickness,
             },
             angles: parse_angles(&self.angles)?,
-            eps: self.eps,
+            rule: StrikeRule::new(self.deflection, self.e0),
             grid,
             algorithm: self.algorithm,
             threads: self.threads,

@@ -130,7 +130,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
                 ]
             })
             .collect();
-        let options = super::verify::oracle_options(&knee, fast.eps, PAPER_PITCH, spec.x(0));
+        let options = super::verify::oracle_options(&knee, PAPER_PITCH, spec.x(0));
         let t = Instant::now();
         kneeform_oracle::evaluate(&part, &starts, &[0.0], &options)?;
         Some(t.elapsed().as_secs_f64() / starts.len() as f64)

@@ -53,6 +53,7 @@ pub fn converge(
     setup: &Setup,
     pitches: &[f64],
     selection: StartSelection,
+    tie_band_per_mm: f64,
 ) -> anyhow::Result<Vec<PitchResult>> {
     let part =
         kneeform::Part::from_triangles(input_file, triangles.to_vec(), 1.0, kneeform::Side::Left)?;
@@ -96,7 +97,7 @@ pub fn converge(
         .map(|&(i, j)| [coarse.x(i), coarse.z(j)])
         .collect();
     let finest = pitches[pitches.len() - 1];
-    let options = oracle_options(&setup.knee, setup.eps, finest, coarse.x(0));
+    let options = oracle_options(&setup.knee, finest, coarse.x(0));
     let (traces, oracle_s) = run_oracle(&part.triangles, &starts, &setup.angles, &options)?;
     eprintln!(
         "exact oracle: {} starts x {} angles in {oracle_s:.1} s",
@@ -105,7 +106,8 @@ pub fn converge(
     );
     let compare = CompareOptions {
         knee: setup.knee,
-        eps: setup.eps,
+        rule: setup.rule,
+        tie_band_per_mm,
         fault: None,
     };
     let mut results = Vec::new();
@@ -119,7 +121,7 @@ pub fn converge(
             &grid,
             &footprints,
             &EngineOptions {
-                eps: setup.eps,
+                rule: setup.rule,
                 ..EngineOptions::default()
             },
             &|| {},
@@ -149,7 +151,14 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
     super::set_threads(setup.threads)?;
     let (part, _) = super::load_part(&args.part.part, args.part.scale, args.part.side)?;
     let input = args.part.part.display().to_string();
-    let results = converge(&part.triangles, &input, &setup, &pitches, selection)?;
+    let results = converge(
+        &part.triangles,
+        &input,
+        &setup,
+        &pitches,
+        selection,
+        args.starts.tie_band,
+    )?;
     let fitted = fits(&results);
     let recommended = args.tolerance.and_then(|t| recommended_pitch(&results, t));
     let full_angles = 61.0 / setup.angles.len() as f64;
@@ -165,6 +174,9 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
         recommended_pitch_mm: recommended.map(|r| r.pitch),
         predicted_full_time_s: recommended.map(|r| r.seconds * full_angles),
         angles_deg: setup.angles.clone(),
+        deflection_deg: setup.rule.deflection_deg(),
+        e0_mm: setup.rule.e0,
+        tie_band_rule: super::verify::tie_band_rule(args.starts.tie_band),
         starts: results
             .first()
             .map_or(0, |r| r.comparison.rows.len() / setup.angles.len().max(1)),
@@ -209,17 +221,23 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
             .comparison
             .stats
             .iter()
+            .filter(|(m, _)| kneeform::harness::DECIDED_METRICS.contains(&m.as_str()))
             .map(|(m, s)| format!("{m} {:.3}", s.max))
             .collect();
         eprintln!(
-            "p = {:>6} mm: {} | IoU {:.3} | {:.2} s",
+            "p = {:>6} mm: {} | all strikes: area_distance {:.3} | IoU {:.3} | {} undecided | {:.2} s",
             r.pitch,
             maxes.join(", "),
+            r.comparison.stat("area_distance").max,
             r.comparison.area_iou,
+            r.comparison.counts.exact_undecided,
             r.seconds
         );
     }
     for (m, f) in &fitted {
+        if !kneeform::harness::DECIDED_METRICS.contains(&m.as_str()) {
+            continue;
+        }
         match f {
             Some(f) => eprintln!("{m:>22}: error ~ {:.3} p^{:.2}", f.c, f.alpha),
             None => eprintln!("{m:>22}: no fit (zero or too few errors)"),

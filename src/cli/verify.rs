@@ -30,14 +30,13 @@ pub fn spinner(message: &str) -> ProgressBar {
 
 /// The oracle's options for a study whose finest pitch is `pitch` and whose
 /// grid starts at `x_min` (mm).
-pub fn oracle_options(knee: &KneeForm, eps: f64, pitch: f64, x_min: f64) -> OracleOptions {
+pub fn oracle_options(knee: &KneeForm, pitch: f64, x_min: f64) -> OracleOptions {
     OracleOptions {
         knee_form: KneeFormDims {
             length: knee.triangle_side,
             radius: knee.radius,
             width: knee.thickness,
         },
-        eps,
         // SPEC: bisect where witnesses are further apart than a tenth of
         // the pitch checked.
         witness_tolerance: pitch / 10.0,
@@ -45,6 +44,13 @@ pub fn oracle_options(knee: &KneeForm, eps: f64, pitch: f64, x_min: f64) -> Orac
         x_min: x_min - pitch / 2.0,
         ..OracleOptions::default()
     }
+}
+
+/// The tie band's rule in words, for the summaries.
+pub fn tie_band_rule(per_mm: f64) -> String {
+    format!(
+        "an exact contact is undecided when its deflection rate, widened by its rate_error, overlaps [sigma / (1 + m), sigma * (1 + m)] with m = {per_mm} x pitch (mm)"
+    )
 }
 
 /// Runs the oracle on `starts` at `angles` with a spinner.
@@ -77,6 +83,7 @@ pub fn verify(
     input_file: &str,
     setup: &Setup,
     selection: StartSelection,
+    tie_band_per_mm: f64,
     tolerance: f64,
     fault: Option<Fault>,
 ) -> anyhow::Result<VerifyResult> {
@@ -98,11 +105,12 @@ pub fn verify(
         "no start is placed on this part: nothing to compare"
     );
     let starts: Vec<[f64; 2]> = nodes.iter().map(|&(i, j)| [spec.x(i), spec.z(j)]).collect();
-    let options = oracle_options(&setup.knee, setup.eps, setup.pitch, spec.x(0));
+    let options = oracle_options(&setup.knee, setup.pitch, spec.x(0));
     let (traces, oracle_s) = run_oracle(&part.triangles, &starts, &setup.angles, &options)?;
     let compare = CompareOptions {
         knee: setup.knee,
-        eps: setup.eps,
+        rule: setup.rule,
+        tie_band_per_mm,
         fault,
     };
     let comparison = harness::compare_grid(&grid, &footprints, &starts, &traces, &compare)?;
@@ -119,14 +127,31 @@ pub fn verify(
             setup.knee.radius,
             setup.knee.thickness,
         ],
-        eps_mm: setup.eps,
+        deflection_deg: setup.rule.deflection_deg(),
+        e0_mm: setup.rule.e0,
+        tie_band: comparison.band,
+        tie_band_rule: tie_band_rule(tie_band_per_mm),
+        area_distance_decided_mm: Some(comparison.stat("area_distance_decided").max).filter(|_| {
+            comparison
+                .area
+                .iter()
+                .all(|a| a.miss_decided.is_finite() && a.false_alarm_decided.is_finite())
+        }),
+        area_distance_mm: Some(comparison.stat("area_distance").max).filter(|_| {
+            comparison
+                .area
+                .iter()
+                .all(|a| a.miss.is_finite() && a.false_alarm.is_finite())
+        }),
+        area_distance: comparison.area.clone(),
         starts: match selection {
             StartSelection::All => "all".into(),
             StartSelection::Sample { count, .. } => count.to_string(),
+            StartSelection::Strip { z } => format!("strip:{}:{}", z[0], z[1]),
         },
         seed: match selection {
-            StartSelection::All => 0,
             StartSelection::Sample { seed, .. } => seed,
+            _ => 0,
         },
         metrics: comparison.stats.iter().cloned().collect(),
         area_iou: comparison.area_iou,
@@ -188,25 +213,42 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
         &args.part.part.display().to_string(),
         &setup,
         selection,
+        args.starts.tie_band,
         args.tolerance,
         None,
     )?;
     write(&args.out, &result)?;
     let s = &result.summary;
-    for (name, stats) in &s.metrics {
+    for name in kneeform::harness::METRICS {
+        let stats = &s.metrics[name];
         eprintln!(
-            "{name:>22}: max {:.4}  p95 {:.4}  mean {:.4} mm  (n = {})",
+            "{name:>29}: max {:.4}  p95 {:.4}  mean {:.4} mm  (n = {})",
             stats.max, stats.p95, stats.mean, stats.n
         );
     }
+    let c = &s.counts;
     eprintln!(
-        "{:>22}: {:.3}; {} start-angle pairs compared, {} oracle failures, {} exact contacts unmatched, {} grid points unmatched",
-        "area IoU",
-        s.area_iou,
-        s.counts.compared,
-        s.counts.oracle_failed,
-        s.counts.unmatched_exact,
-        s.counts.unmatched_grid
+        "{:>29}: {:.3}; {} start-angle pairs compared, {} oracle failures",
+        "area IoU", s.area_iou, c.compared, c.oracle_failed
+    );
+    eprintln!(
+        "{:>29}: {} exact strikes, {} contacts undecided (deflection rate in [{:.3}, {:.3}] deg); {} exact strikes with no grid strike in their start ({} decided); {} grid strikes with no exact one ({} decided)",
+        "strikes",
+        c.exact_strikes,
+        c.exact_undecided,
+        s.tie_band.bounds().0.atan().to_degrees(),
+        s.tie_band.bounds().1.atan().to_degrees(),
+        c.unmatched_exact,
+        c.unmatched_exact_decided,
+        c.unmatched_grid,
+        c.unmatched_grid_decided
+    );
+    let mm = |v: Option<f64>| v.map_or("infinite".to_string(), |v| format!("{v:.3} mm"));
+    eprintln!(
+        "{:>29}: decided {} (all strikes, undecided included: {})",
+        "area distance",
+        mm(s.area_distance_decided_mm),
+        mm(s.area_distance_mm)
     );
     if s.pass {
         eprintln!(

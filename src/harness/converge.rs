@@ -8,7 +8,7 @@ use std::path::Path;
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::metrics::METRICS;
+use super::metrics::{DECIDED_METRICS, METRICS};
 use super::verify::Comparison;
 
 /// One pitch of a convergence study.
@@ -109,14 +109,21 @@ pub struct ConvergeSummary {
     pub predicted_full_time_s: Option<f64>,
     /// Angles of the study (degrees).
     pub angles_deg: Vec<f64>,
+    /// Deflection threshold delta (degrees).
+    pub deflection_deg: f64,
+    /// Rounding tolerance e0 (mm).
+    pub e0_mm: f64,
+    /// The tie band's rule, in words.
+    pub tie_band_rule: String,
     /// Starts compared per angle.
     pub starts: usize,
     /// Per pitch: engine seconds for the study's angles.
     pub seconds: Vec<f64>,
 }
 
-/// Draws the log-log error plot (one series per metric, fitted order in
-/// the legend) and the time plot into `dir`.
+/// Draws the log-log error plot (one series per decided metric, fitted
+/// order in the legend: the guarantee a user reads) and the time plot into
+/// `dir`.
 pub fn write_plots(
     dir: &Path,
     results: &[PitchResult],
@@ -146,6 +153,8 @@ pub fn write_plots(
         RGBColor(214, 39, 40),
         RGBColor(44, 160, 44),
         RGBColor(148, 103, 189),
+        RGBColor(255, 127, 14),
+        RGBColor(140, 86, 75),
     ];
     {
         let path = dir.join("error_vs_pitch.png");
@@ -153,7 +162,7 @@ pub fn write_plots(
         root.fill(&WHITE).map_err(draw_error)?;
         let mut chart = ChartBuilder::on(&root)
             .caption(
-                "Grid vs exact: largest error against pitch (log-log)",
+                "Grid vs exact, decided strikes: largest error against pitch (log-log)",
                 ("sans-serif", 22),
             )
             .margin(16)
@@ -171,8 +180,12 @@ pub fn write_plots(
             .label_style(("sans-serif", 14))
             .draw()
             .map_err(draw_error)?;
-        for (k, (metric, fit)) in fits.iter().enumerate() {
-            let colour = colours[k % colours.len()];
+        let plotted = fits
+            .iter()
+            .enumerate()
+            .filter(|(_, (m, _))| DECIDED_METRICS.contains(&m.as_str()));
+        for (series, (k, (metric, fit))) in plotted.enumerate() {
+            let colour = colours[series % colours.len()];
             let points: Vec<(f64, f64)> = results
                 .iter()
                 .map(|r| (r.pitch, r.comparison.stats[k].1.max))

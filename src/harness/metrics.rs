@@ -7,14 +7,41 @@ use serde::{Deserialize, Serialize};
 use super::trace::GridTrace;
 
 /// The metric names, as the columns of `verify.csv` and the keys of
-/// `verify.json`.
-pub const METRICS: [&str; 5] = [
+/// `verify.json`: each over all strikes, then over the decided strikes
+/// (see [`TieBand`]), then the area distances.
+pub const METRICS: [&str; 11] = [
     "push_error",
     "first_contact_error",
     "miss_distance",
     "false_alarm_distance",
     "unmatched_deflection",
+    "first_contact_error_decided",
+    "miss_distance_decided",
+    "false_alarm_distance_decided",
+    "unmatched_deflection_decided",
+    "area_distance",
+    "area_distance_decided",
 ];
+
+/// The metrics a user's guarantee is made of (and `verify` passes or fails
+/// on): the push error, the decided strike metrics and the decided area
+/// distance. The others are shown beside them, never hidden.
+pub const DECIDED_METRICS: [&str; 6] = [
+    "push_error",
+    "first_contact_error_decided",
+    "miss_distance_decided",
+    "false_alarm_distance_decided",
+    "unmatched_deflection_decided",
+    "area_distance_decided",
+];
+
+/// The index of `name` in [`METRICS`].
+pub fn metric_index(name: &str) -> usize {
+    METRICS
+        .iter()
+        .position(|m| *m == name)
+        .expect("a metric name")
+}
 
 /// Max, 95th percentile and mean of absolute values, and their count.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -47,118 +74,229 @@ impl Stats {
     }
 }
 
-/// One start at one angle, grid against exact.
+/// SPEC's tie band around the deflection threshold: an exact contact whose
+/// rate lies in `[sigma / (1 + m), sigma * (1 + m)]` may fall either side
+/// on the grid, whose rate is a difference over one pitch (off from the
+/// slope by about curvature x pitch / 2).
+///
+/// **The rule:** `m = per_mm * p`, the band's relative half-width grows
+/// linearly with the pitch `p` (default `per_mm = 1` per mm: at 4 mm the
+/// band is `[sigma / 5, 5 sigma]`, at 0.5 mm `[sigma / 1.5, 1.5 sigma]`).
+/// A grid rate over one pitch differs from the surface's slope by about
+/// `kappa * p / 2` for a curvature `kappa`; with `sigma = tan 0.5 deg` that
+/// is within `m * sigma` up to `kappa = 2 sigma per_mm`, a radius of
+/// curvature of about 57 mm. The oracle's own uncertainty on a rate
+/// (`rate_error`) widens the band for that contact: a contact is decided
+/// only when its whole uncertainty interval lies outside the band.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TieBand {
+    /// The deflection threshold as a rate.
+    pub sigma: f64,
+    /// The band's relative half-width at this pitch.
+    pub m: f64,
+}
+
+/// How an exact contact stands against the threshold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Decision {
+    /// Steeper than the band: every correct grid strikes it (eventually).
+    Strike,
+    /// Gentler than the band: no correct grid strikes it.
+    NoStrike,
+    /// In the band: either answer is correct at this pitch.
+    Undecided,
+}
+
+impl TieBand {
+    /// The default growth of `m` with the pitch (per mm).
+    pub const DEFAULT_PER_MM: f64 = 1.0;
+
+    /// The band for threshold `sigma` at pitch `pitch` (mm), `m = per_mm *
+    /// pitch`.
+    pub fn new(sigma: f64, pitch: f64, per_mm: f64) -> TieBand {
+        TieBand {
+            sigma,
+            m: per_mm * pitch,
+        }
+    }
+
+    /// The band's lower and upper rates.
+    pub fn bounds(&self) -> (f64, f64) {
+        (self.sigma / (1.0 + self.m), self.sigma * (1.0 + self.m))
+    }
+
+    /// Decides a contact of rate `rate` known to within `error`.
+    pub fn decide(&self, rate: f64, error: f64) -> Decision {
+        let (lo, hi) = self.bounds();
+        if rate - error > hi {
+            Decision::Strike
+        } else if rate + error < lo {
+            Decision::NoStrike
+        } else {
+            Decision::Undecided
+        }
+    }
+}
+
+/// An exact contact's standing: a strike by SPEC's rule (`rate > sigma`),
+/// and its decision against the tie band.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExactStrike {
+    /// The contact.
+    pub contact: ContactPoint,
+    /// `rate > sigma`.
+    pub strike: bool,
+    /// Against the tie band.
+    pub decision: Decision,
+}
+
+/// The exact contacts of a placed start with their standing; empty for a
+/// start that is not placed or failed.
+pub fn classify(exact: &StartTrace, band: &TieBand) -> Vec<ExactStrike> {
+    if exact.status != StartStatus::Placed {
+        return Vec::new();
+    }
+    exact
+        .contacts
+        .iter()
+        .map(|&c| ExactStrike {
+            contact: c,
+            strike: c.rate > band.sigma,
+            decision: band.decide(c.rate, c.rate_error),
+        })
+        .collect()
+}
+
+/// One start at one angle, grid against exact. Distances are in xz, the
+/// grid's domain (SPEC, "What the harness measures").
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct StartComparison {
     /// `yr - yr*` (mm), when both are placed.
     pub push_error: Option<f64>,
-    /// Grid travel to the first colliding group minus the exact travel to
-    /// the first contact (mm), when both have one.
+    /// Grid travel to the first strike minus the exact travel to the first
+    /// strike (mm), when both have one.
     pub first_contact_error: Option<f64>,
-    /// For each exact contact, the distance to the nearest grid colliding
-    /// point of the same start (mm); `+inf` where the grid has none.
+    /// The same where the exact first possible strike (not gentler than the
+    /// band) is a decided one.
+    pub first_contact_error_decided: Option<f64>,
+    /// For each exact strike, the xz distance to the nearest grid strike of
+    /// the same start (mm); `+inf` where the grid has none.
     pub miss: Vec<f64>,
-    /// For each grid colliding point, the distance to the nearest exact
-    /// contact or to the exact push contact (mm).
+    /// The same for each decided exact strike.
+    pub miss_decided: Vec<f64>,
+    /// For each grid strike, the xz distance to the nearest exact strike or
+    /// to the exact push contact (mm); `+inf` where there is neither.
     pub false_alarm: Vec<f64>,
-    /// For each exact contact met when the grid strikes nothing in this
+    /// For each grid strike, the xz distance to the nearest exact contact
+    /// that is not a decided non-strike, or to the exact push contact.
+    pub false_alarm_decided: Vec<f64>,
+    /// For each exact strike met when the grid strikes nothing in this
     /// start: how far the exact knee-form had been deflected below the
     /// grid's level by then, `yr - f` (mm). The grid slid on at `yr`, so
     /// this is the part of the true path it missed.
     pub unmatched_deflection: Vec<f64>,
+    /// The same for decided exact strikes.
+    pub unmatched_deflection_decided: Vec<f64>,
+    /// Exact strikes (`rate > sigma`).
+    pub exact_strikes: usize,
+    /// Exact contacts in the tie band.
+    pub undecided: usize,
 }
 
-fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+fn xz(p: [f64; 3]) -> [f64; 2] {
+    [p[0], p[2]]
 }
 
-fn nearest(p: [f64; 3], set: impl Iterator<Item = [f64; 3]>) -> f64 {
-    set.map(|q| distance(p, q)).fold(f64::INFINITY, f64::min)
+fn nearest(p: [f64; 2], set: &[[f64; 2]]) -> f64 {
+    set.iter()
+        .map(|q| (p[0] - q[0]).hypot(p[1] - q[1]))
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Compares a grid trace with the exact trace of the same start and angle.
 ///
-/// The exact push contact counts as a point of the exact contact curve
-/// (its start, at travel 0) when measuring false alarms: where the grid's
-/// push level is above the exact one (its nodes miss the true highest
-/// point), the grid strikes, just after the push, the point the exact
-/// knee-form rests on. It does not count for misses: the grid's push
-/// contact is, by SPEC, not a colliding point.
+/// **Strikes on both sides.** The grid's strikes are SPEC's (rule 2 of the
+/// slide); the exact strikes are the contacts whose traced deflection rate
+/// exceeds `sigma` ([`classify`]). Over *all* strikes, a miss is an exact
+/// strike far from every grid strike, a false alarm a grid strike far from
+/// every exact strike. Over *decided* strikes, misses are counted only from
+/// exact contacts steeper than the tie band, and a grid strike is a false
+/// alarm only when it is far from every exact contact that is not gentler
+/// than the band: near the threshold either answer is right.
 ///
-/// **Strikes.** The grid counts a point only when it stands more than
-/// `eps` above the level the knee-form had when it was met; where the
-/// knee-form rides a nearly level surface, the exact trace records a
-/// contact at every step while the grid, rightly by SPEC's rule, strikes
-/// nothing until the surface has risen by `eps`. So misses (and the area
-/// IoU and unmatched deflection) are measured from the exact **strikes**:
-/// the contacts whose level is at least `eps` below the level of the
-/// previous strike (`yr*` for the first), the same tolerance carried over
-/// to the exact curve. False alarms are measured against every exact
-/// contact: a grid strike anywhere on the exact contact curve is no false
-/// alarm. Found on the tilted wave, where the exact knee-form rests on
-/// successive crests 0.2 um apart in height for 550 mm.
-pub fn compare(grid: &GridTrace, exact: &StartTrace, eps: f64) -> StartComparison {
+/// The exact push contact counts as a point of the exact curve for false
+/// alarms: where the grid's push level is above the exact one (its nodes
+/// miss the true highest point), the grid strikes, just after the push, the
+/// point the exact knee-form rests on. It does not count for misses: the
+/// grid's push contact is, by SPEC, not a colliding point.
+pub fn compare(grid: &GridTrace, exact: &StartTrace, band: &TieBand) -> StartComparison {
     let placed = exact.status == StartStatus::Placed;
-    let all_points: Vec<[f64; 3]> = if placed {
-        exact.contacts.iter().map(|c| c.witness).collect()
-    } else {
-        Vec::new()
-    };
-    let exact_or_push: Vec<[f64; 3]> = all_points
-        .iter()
-        .copied()
-        .chain(exact.push_witness.filter(|_| placed))
+    let classified = classify(exact, band);
+    let push: Vec<[f64; 2]> = exact
+        .push_witness
+        .filter(|_| placed)
+        .map(xz)
+        .into_iter()
         .collect();
-    let strikes = strikes(exact, eps);
-    let exact_points: Vec<[f64; 3]> = strikes.iter().map(|c| c.witness).collect();
-    let grid_points: Vec<[f64; 3]> = grid.colliding.iter().map(|c| c.point).collect();
-    let unmatched_deflection = if grid_points.is_empty() && grid.yr.is_finite() && placed {
-        strikes
+    let points = |keep: &dyn Fn(&ExactStrike) -> bool| -> Vec<[f64; 2]> {
+        classified
             .iter()
-            .map(|c| (grid.yr - c.face_level).max(0.0))
+            .filter(|c| keep(c))
+            .map(|c| xz(c.contact.witness))
             .collect()
-    } else {
-        Vec::new()
     };
+    let strikes = points(&|c| c.strike);
+    let decided = points(&|c| c.decision == Decision::Strike);
+    let possible: Vec<[f64; 2]> = points(&|c| c.decision != Decision::NoStrike)
+        .into_iter()
+        .chain(push.iter().copied())
+        .collect();
+    let strikes_or_push: Vec<[f64; 2]> = strikes.iter().chain(&push).copied().collect();
+    let grid_points: Vec<[f64; 2]> = grid.colliding.iter().map(|c| xz(c.point)).collect();
+    let deflection = |keep: &dyn Fn(&ExactStrike) -> bool| -> Vec<f64> {
+        if grid_points.is_empty() && grid.yr.is_finite() && placed {
+            classified
+                .iter()
+                .filter(|c| keep(c))
+                .map(|c| (grid.yr - c.contact.face_level).max(0.0))
+                .collect()
+        } else {
+            Vec::new()
+        }
+    };
+    let first_strike = classified.iter().find(|c| c.strike);
+    let first_possible = classified.iter().find(|c| c.decision != Decision::NoStrike);
+    let grid_first = grid.colliding.first().filter(|_| placed);
     StartComparison {
         push_error: match (grid.yr.is_finite(), exact.yr_star) {
             (true, Some(star)) if placed => Some(grid.yr - star),
             _ => None,
         },
-        first_contact_error: match (grid.colliding.first(), strikes.first()) {
-            (Some(g), Some(e)) if placed => Some(g.travel - e.travel),
+        first_contact_error: match (grid_first, first_strike) {
+            (Some(g), Some(e)) => Some(g.travel - e.contact.travel),
             _ => None,
         },
-        miss: exact_points
-            .iter()
-            .map(|&e| nearest(e, grid_points.iter().copied()))
-            .collect(),
+        first_contact_error_decided: match (grid_first, first_possible) {
+            (Some(g), Some(e)) if e.decision == Decision::Strike => {
+                Some(g.travel - e.contact.travel)
+            }
+            _ => None,
+        },
+        miss: strikes.iter().map(|&e| nearest(e, &grid_points)).collect(),
+        miss_decided: decided.iter().map(|&e| nearest(e, &grid_points)).collect(),
         false_alarm: grid_points
             .iter()
-            .map(|&g| nearest(g, exact_or_push.iter().copied()))
+            .map(|&g| nearest(g, &strikes_or_push))
             .collect(),
-        unmatched_deflection,
+        false_alarm_decided: grid_points.iter().map(|&g| nearest(g, &possible)).collect(),
+        unmatched_deflection: deflection(&|c| c.strike),
+        unmatched_deflection_decided: deflection(&|c| c.decision == Decision::Strike),
+        exact_strikes: strikes.len(),
+        undecided: classified
+            .iter()
+            .filter(|c| c.decision == Decision::Undecided)
+            .count(),
     }
-}
-
-/// The exact contacts that are strikes by SPEC's tolerance (see
-/// [`compare`]).
-pub fn strikes(exact: &StartTrace, eps: f64) -> Vec<ContactPoint> {
-    let (Some(mut level), StartStatus::Placed) = (exact.yr_star, exact.status) else {
-        return Vec::new();
-    };
-    exact
-        .contacts
-        .iter()
-        .filter(|c| {
-            let strike = c.face_level <= level - eps;
-            if strike {
-                level = c.face_level;
-            }
-            strike
-        })
-        .copied()
-        .collect()
 }
 
 #[cfg(test)]

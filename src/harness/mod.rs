@@ -16,14 +16,15 @@
 
 pub mod converge;
 pub mod metrics;
+pub mod nearest;
 pub mod trace;
 pub mod verify;
 
-pub use metrics::{METRICS, Stats};
+pub use metrics::{DECIDED_METRICS, METRICS, Stats, TieBand};
 pub use trace::{Fault, GridTrace, grid_trace};
 pub use verify::{
-    CompareOptions, Comparison, Counts, StartSelection, VerifyRow, compare_grid, exact_traces,
-    select_starts,
+    AreaDistance, CompareOptions, Comparison, Counts, StartSelection, VerifyRow, compare_grid,
+    exact_traces, select_starts,
 };
 
 use serde::{Deserialize, Serialize};
@@ -39,15 +40,27 @@ pub struct VerifySummary {
     pub pitch_mm: f64,
     /// The tolerance every metric's max is held to (mm).
     pub tolerance_mm: f64,
-    /// Whether everything is within tolerance, with nothing unmatched,
-    /// contradictory or failed.
+    /// Whether every decided metric is within tolerance, with nothing
+    /// contradictory or failed (undecided strikes never fail).
     pub pass: bool,
     /// Angles (degrees).
     pub angles_deg: Vec<f64>,
     /// Knee-form L, R, W (mm).
     pub knee_form_mm: [f64; 3],
-    /// Contact tolerance eps (mm).
-    pub eps_mm: f64,
+    /// Deflection threshold delta (degrees).
+    pub deflection_deg: f64,
+    /// Rounding tolerance e0 (mm).
+    pub e0_mm: f64,
+    /// The tie band at this pitch: `sigma`, `m`, and its bounds as rates.
+    pub tie_band: TieBand,
+    /// The tie band's rule, in words.
+    pub tie_band_rule: String,
+    /// The headline: the area distance, decided (mm; `null` if infinite).
+    pub area_distance_decided_mm: Option<f64>,
+    /// The area distance over all strikes (mm; `null` if infinite).
+    pub area_distance_mm: Option<f64>,
+    /// The area distance per angle.
+    pub area_distance: Vec<AreaDistance>,
     /// `all`, or the sample size.
     pub starts: String,
     /// The sample's seed.

@@ -8,6 +8,7 @@
 
 use crate::grid::HeightGrid;
 use crate::kneeform::{GridFootprint, NODE_TOL};
+use crate::strike::StrikeRule;
 
 /// A deliberate mistake in the grid side of a comparison, for the tests
 /// that show the harness catches a broken engine.
@@ -48,7 +49,7 @@ pub fn grid_trace(
     fp: &GridFootprint,
     i0: usize,
     j0: usize,
-    eps: f64,
+    rule: &StrikeRule,
     fault: Option<Fault>,
 ) -> GridTrace {
     let spec = grid.spec;
@@ -110,7 +111,12 @@ pub fn grid_trace(
         let mut gmin = f64::INFINITY;
         for &(d, i, j) in &front[k..end] {
             let hv = h(i, j);
-            if hv < f - eps {
+            let behind = if i + 1 < spec.nx {
+                h(i + 1, j)
+            } else {
+                f64::INFINITY
+            };
+            if rule.strikes(hv, behind, f, p) {
                 trace.colliding.push(GridContact {
                     node: (i, j),
                     point: [spec.x(i), hv, spec.z(j)],
@@ -159,7 +165,8 @@ mod tests {
             let mut union = vec![0u8; spec.len()];
             for j0 in 0..spec.nz {
                 for i0 in 0..spec.nx {
-                    for c in grid_trace(&grid, &fp, i0, j0, 1e-3, None).colliding {
+                    for c in grid_trace(&grid, &fp, i0, j0, &StrikeRule::default(), None).colliding
+                    {
                         union[c.node.1 * spec.nx + c.node.0] = 1;
                     }
                 }

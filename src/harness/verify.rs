@@ -8,14 +8,19 @@ use kneeform_oracle::{OracleOptions, StartStatus, StartTrace};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::metrics::{METRICS, StartComparison, Stats, compare};
+use super::metrics::{
+    DECIDED_METRICS, Decision, METRICS, StartComparison, Stats, TieBand, classify, compare,
+    metric_index,
+};
+use super::nearest::PointSet;
 use super::trace::{Fault, grid_trace};
 use crate::grid::HeightGrid;
 use crate::kneeform::{GridFootprint, KneeForm};
 use crate::mesh::Triangle;
+use crate::strike::StrikeRule;
 
 /// Which starts to compare.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum StartSelection {
     /// Every grid node whose start is placed at some angle.
     All,
@@ -26,6 +31,12 @@ pub enum StartSelection {
         /// The seed.
         seed: u64,
     },
+    /// Every one of those whose z lies in `[z[0], z[1]]` (mm): a strip of
+    /// whole start rows.
+    Strip {
+        /// The strip's z range (mm).
+        z: [f64; 2],
+    },
 }
 
 /// How to compare.
@@ -33,8 +44,10 @@ pub enum StartSelection {
 pub struct CompareOptions {
     /// The knee-form.
     pub knee: KneeForm,
-    /// Contact tolerance (mm).
-    pub eps: f64,
+    /// SPEC's strike rule, on both sides.
+    pub rule: StrikeRule,
+    /// The tie band's growth with the pitch ([`TieBand`], per mm).
+    pub tie_band_per_mm: f64,
     /// Test-only: a deliberate mistake on the grid side.
     pub fault: Option<Fault>,
 }
@@ -66,9 +79,14 @@ pub fn select_starts(
             *p |= y.is_finite();
         }
     }
-    let mut nodes: Vec<(usize, usize)> = (0..grid.spec.len())
+    let spec = grid.spec;
+    let mut nodes: Vec<(usize, usize)> = (0..spec.len())
         .filter(|&n| placed[n])
         .map(|n| (n % nx, n / nx))
+        .filter(|&(_, j)| match selection {
+            StartSelection::Strip { z } => (z[0]..=z[1]).contains(&spec.z(j)),
+            _ => true,
+        })
         .collect();
     if let StartSelection::Sample { count, seed } = selection {
         // A partial Fisher-Yates shuffle, then back to row-major order.
@@ -119,12 +137,23 @@ pub struct VerifyRow {
     /// Largest distance from a grid colliding point to the exact contacts
     /// and push contact (mm).
     pub false_alarm_distance: Option<f64>,
-    /// When the grid strikes nothing but the oracle has contacts: the
-    /// largest deflection of the exact knee-form below the grid's level.
+    /// When the grid strikes nothing but the oracle strikes: the largest
+    /// deflection of the exact knee-form below the grid's level.
     pub unmatched_deflection: Option<f64>,
-    /// Exact contact points traced.
-    pub exact_contacts: usize,
-    /// Grid colliding points.
+    /// `first_contact_error` where the exact first strike is decided.
+    pub first_contact_error_decided: Option<f64>,
+    /// `miss_distance` over decided exact strikes.
+    pub miss_distance_decided: Option<f64>,
+    /// Largest xz distance from a grid strike to the exact contacts that
+    /// are not decided non-strikes (and the push contact).
+    pub false_alarm_distance_decided: Option<f64>,
+    /// `unmatched_deflection` over decided exact strikes.
+    pub unmatched_deflection_decided: Option<f64>,
+    /// Exact strikes (contacts with a rate above sigma).
+    pub exact_strikes: usize,
+    /// Exact contacts in the tie band.
+    pub exact_undecided: usize,
+    /// Grid strikes.
     pub grid_colliding: usize,
 }
 
@@ -144,12 +173,44 @@ pub struct Counts {
     pub not_placed: usize,
     /// Oracle queries that failed.
     pub oracle_failed: usize,
-    /// Exact contacts in starts where the grid strikes nothing (their
+    /// Exact strikes in starts where the grid strikes nothing (their
     /// size is the `unmatched_deflection` metric).
     pub unmatched_exact: usize,
-    /// Grid colliding points in starts where the oracle has neither a
-    /// contact nor a push contact (a contradiction, counted as a failure).
+    /// The same, decided exact strikes only.
+    pub unmatched_exact_decided: usize,
+    /// Grid strikes in starts where the oracle has neither a strike nor a
+    /// push contact.
     pub unmatched_grid: usize,
+    /// Grid strikes in starts where the oracle has neither a possible
+    /// strike (a contact not gentler than the tie band) nor a push contact:
+    /// a decided disagreement, counted as a failure.
+    pub unmatched_grid_decided: usize,
+    /// Exact strikes (rate above sigma).
+    pub exact_strikes: usize,
+    /// Exact contacts in the tie band: either answer is right at this
+    /// pitch.
+    pub exact_undecided: usize,
+}
+
+/// The area distance at one angle: the two directed Hausdorff distances in
+/// xz between the union of the exact strikes and the union of the grid
+/// strikes over every compared start (mm; `+inf` where one side is empty
+/// and the other is not).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct AreaDistance {
+    /// The angle (degrees).
+    pub angle_deg: f64,
+    /// Largest distance from an exact strike to the grid's strikes: how
+    /// far the grid's area falls short.
+    pub miss: f64,
+    /// Largest distance from a grid strike to the exact strikes (or push
+    /// contacts): how far the grid's area overreaches.
+    pub false_alarm: f64,
+    /// `miss` from decided exact strikes only.
+    pub miss_decided: f64,
+    /// `false_alarm` against every exact contact not gentler than the tie
+    /// band.
+    pub false_alarm_decided: f64,
 }
 
 /// The metrics of one grid against the exact traces.
@@ -160,9 +221,13 @@ pub struct Comparison {
     /// Statistics per metric, in [`METRICS`] order (finite values only;
     /// infinite ones are the `unmatched` counts).
     pub stats: Vec<(String, Stats)>,
-    /// Grid colliding (angle, node) pairs against exact contacts snapped
+    /// Grid colliding (angle, node) pairs against exact strikes snapped
     /// to grid nodes, over the compared starts: intersection over union.
     pub area_iou: f64,
+    /// The area distance at each angle.
+    pub area: Vec<AreaDistance>,
+    /// The tie band at this pitch.
+    pub band: TieBand,
     /// Counts.
     pub counts: Counts,
     /// Seconds spent on the grid side.
@@ -170,13 +235,28 @@ pub struct Comparison {
 }
 
 /// One start-angle pair: its row, its comparison, the grid's colliding
-/// nodes and the exact contacts snapped to nodes.
+/// nodes, the exact strikes snapped to nodes, and the xz points of the
+/// area distance.
 type PairResult = (
     VerifyRow,
     StartComparison,
     Vec<(usize, usize)>,
     Vec<(usize, usize)>,
+    AreaPoints,
 );
+
+/// One start's contribution to the area distance: xz points of the grid's
+/// strikes, the exact strikes, the decided exact strikes, and the exact
+/// contacts not gentler than the band; the last three with the push
+/// contact where the false-alarm side needs it.
+#[derive(Debug, Clone, Default)]
+struct AreaPoints {
+    grid: Vec<[f64; 2]>,
+    strikes: Vec<[f64; 2]>,
+    decided: Vec<[f64; 2]>,
+    possible: Vec<[f64; 2]>,
+    push: Vec<[f64; 2]>,
+}
 
 /// Compares `grid` with `traces` (angle-major over `starts`, positions in
 /// mm that must be nodes of `grid`).
@@ -188,6 +268,7 @@ pub fn compare_grid(
     options: &CompareOptions,
 ) -> anyhow::Result<Comparison> {
     let spec = grid.spec;
+    let band = TieBand::new(options.rule.sigma, spec.pitch, options.tie_band_per_mm);
     let node_of = |x: f64, z: f64| -> Option<(usize, usize)> {
         let i = ((x - spec.x(0)) / spec.pitch).round();
         let j = ((z - spec.z(0)) / spec.pitch).round();
@@ -216,8 +297,8 @@ pub fn compare_grid(
             let (i, j) = nodes[s];
             let fp = &footprints[a];
             let trace = &traces[a * nodes.len() + s];
-            let g = grid_trace(grid, fp, i, j, options.eps, options.fault);
-            let cmp = compare(&g, trace, options.eps);
+            let g = grid_trace(grid, fp, i, j, &options.rule, options.fault);
+            let cmp = compare(&g, trace, &band);
             let grid_placed = g.yr.is_finite();
             let status = match (trace.status, grid_placed) {
                 (StartStatus::Failed { .. }, _) => "oracle_failed",
@@ -226,15 +307,31 @@ pub fn compare_grid(
                 (StartStatus::NotPlaced, true) => "oracle_not_placed",
                 (StartStatus::NotPlaced, false) => "not_placed",
             };
-            let worst = |v: &[f64]| v.iter().copied().reduce(f64::max);
-            let snapped: Vec<(usize, usize)> = if trace.status == StartStatus::Placed {
-                trace
-                    .contacts
+            let worst = |v: &[f64]| v.iter().copied().reduce(f64::max).filter(|v| v.is_finite());
+            let classified = classify(trace, &band);
+            let xz = |p: [f64; 3]| [p[0], p[2]];
+            let exact_xz = |keep: &dyn Fn(Decision, bool) -> bool| -> Vec<[f64; 2]> {
+                classified
                     .iter()
-                    .filter_map(|c| node_of(c.witness[0], c.witness[2]))
+                    .filter(|c| keep(c.decision, c.strike))
+                    .map(|c| xz(c.contact.witness))
                     .collect()
-            } else {
-                Vec::new()
+            };
+            let snapped: Vec<(usize, usize)> = exact_xz(&|_, strike| strike)
+                .iter()
+                .filter_map(|p| node_of(p[0], p[1]))
+                .collect();
+            let area = AreaPoints {
+                grid: g.colliding.iter().map(|c| xz(c.point)).collect(),
+                strikes: exact_xz(&|_, strike| strike),
+                decided: exact_xz(&|d, _| d == Decision::Strike),
+                possible: exact_xz(&|d, _| d != Decision::NoStrike),
+                push: trace
+                    .push_witness
+                    .filter(|_| trace.status == StartStatus::Placed)
+                    .map(xz)
+                    .into_iter()
+                    .collect(),
             };
             let row = VerifyRow {
                 i,
@@ -243,14 +340,19 @@ pub fn compare_grid(
                 status: status.into(),
                 push_error: cmp.push_error,
                 first_contact_error: cmp.first_contact_error,
-                miss_distance: worst(&cmp.miss).filter(|v| v.is_finite()),
-                false_alarm_distance: worst(&cmp.false_alarm).filter(|v| v.is_finite()),
+                miss_distance: worst(&cmp.miss),
+                false_alarm_distance: worst(&cmp.false_alarm),
                 unmatched_deflection: worst(&cmp.unmatched_deflection),
-                exact_contacts: cmp.miss.len(),
+                first_contact_error_decided: cmp.first_contact_error_decided,
+                miss_distance_decided: worst(&cmp.miss_decided),
+                false_alarm_distance_decided: worst(&cmp.false_alarm_decided),
+                unmatched_deflection_decided: worst(&cmp.unmatched_deflection_decided),
+                exact_strikes: cmp.exact_strikes,
+                exact_undecided: cmp.undecided,
                 grid_colliding: cmp.false_alarm.len(),
             };
             let grid_nodes = g.colliding.iter().map(|c| c.node).collect();
-            (row, cmp, grid_nodes, snapped)
+            (row, cmp, grid_nodes, snapped, area)
         })
         .collect();
     let grid_s = t.elapsed().as_secs_f64();
@@ -261,7 +363,8 @@ pub fn compare_grid(
     };
     let mut values: Vec<Vec<f64>> = vec![Vec::new(); METRICS.len()];
     let (mut grid_set, mut exact_set) = (HashSet::new(), HashSet::new());
-    for ((row, cmp, grid_nodes, snapped), &(a, _)) in results.iter().zip(&pairs) {
+    let mut area_points: Vec<AreaPoints> = vec![AreaPoints::default(); footprints.len()];
+    for ((row, cmp, grid_nodes, snapped, area), &(a, _)) in results.iter().zip(&pairs) {
         match row.status.as_str() {
             "compared" => counts.compared += 1,
             "grid_not_placed" => counts.grid_not_placed += 1,
@@ -269,20 +372,41 @@ pub fn compare_grid(
             "not_placed" => counts.not_placed += 1,
             _ => counts.oracle_failed += 1,
         }
-        values[0].extend(cmp.push_error);
-        values[1].extend(cmp.first_contact_error);
-        for (k, v) in [(2, &cmp.miss), (3, &cmp.false_alarm)] {
+        counts.exact_strikes += cmp.exact_strikes;
+        counts.exact_undecided += cmp.undecided;
+        let mut push = |name: &str, v: &[f64]| -> usize {
             let (finite, infinite): (Vec<f64>, Vec<f64>) = v.iter().partition(|x| x.is_finite());
-            values[k].extend(finite);
-            match k {
-                2 => counts.unmatched_exact += infinite.len(),
-                _ => counts.unmatched_grid += infinite.len(),
-            }
-        }
-        values[4].extend(&cmp.unmatched_deflection);
+            values[metric_index(name)].extend(finite);
+            infinite.len()
+        };
+        push("push_error", &Vec::from_iter(cmp.push_error));
+        push(
+            "first_contact_error",
+            &Vec::from_iter(cmp.first_contact_error),
+        );
+        push(
+            "first_contact_error_decided",
+            &Vec::from_iter(cmp.first_contact_error_decided),
+        );
+        counts.unmatched_exact += push("miss_distance", &cmp.miss);
+        counts.unmatched_exact_decided += push("miss_distance_decided", &cmp.miss_decided);
+        counts.unmatched_grid += push("false_alarm_distance", &cmp.false_alarm);
+        counts.unmatched_grid_decided +=
+            push("false_alarm_distance_decided", &cmp.false_alarm_decided);
+        push("unmatched_deflection", &cmp.unmatched_deflection);
+        push(
+            "unmatched_deflection_decided",
+            &cmp.unmatched_deflection_decided,
+        );
         if row.status == "compared" || row.status == "grid_not_placed" {
             grid_set.extend(grid_nodes.iter().map(|&n| (a, n)));
             exact_set.extend(snapped.iter().map(|&n| (a, n)));
+            let to = &mut area_points[a];
+            to.grid.extend(&area.grid);
+            to.strikes.extend(&area.strikes);
+            to.decided.extend(&area.decided);
+            to.possible.extend(&area.possible);
+            to.push.extend(&area.push);
         }
     }
     let union = grid_set.union(&exact_set).count();
@@ -291,6 +415,16 @@ pub fn compare_grid(
     } else {
         grid_set.intersection(&exact_set).count() as f64 / union as f64
     };
+    let area: Vec<AreaDistance> = area_points
+        .into_par_iter()
+        .zip(footprints)
+        .map(|(pts, fp)| area_distance(fp.angle_deg, pts))
+        .collect();
+    for a in &area {
+        values[metric_index("area_distance")].push(a.miss.max(a.false_alarm));
+        values[metric_index("area_distance_decided")]
+            .push(a.miss_decided.max(a.false_alarm_decided));
+    }
     Ok(Comparison {
         rows: results.into_iter().map(|r| r.0).collect(),
         stats: METRICS
@@ -299,23 +433,59 @@ pub fn compare_grid(
             .map(|(m, v)| (m.to_string(), Stats::of(v)))
             .collect(),
         area_iou,
+        area,
+        band,
         counts,
         grid_s,
     })
 }
 
+/// The area distance of one angle's unions of points (see
+/// [`AreaDistance`]).
+fn area_distance(angle_deg: f64, pts: AreaPoints) -> AreaDistance {
+    let grid = PointSet::new(pts.grid.clone());
+    let with_push =
+        |v: &[[f64; 2]]| -> Vec<[f64; 2]> { v.iter().chain(&pts.push).copied().collect() };
+    // A set with no point is infinitely far from any point, and no point
+    // is any distance from anything: PointSet's Hausdorff says both.
+    let from_grid = |to: Vec<[f64; 2]>| PointSet::new(to).hausdorff_from(&pts.grid);
+    AreaDistance {
+        angle_deg,
+        miss: grid.hausdorff_from(&pts.strikes),
+        false_alarm: from_grid(with_push(&pts.strikes)),
+        miss_decided: grid.hausdorff_from(&pts.decided),
+        false_alarm_decided: from_grid(with_push(&pts.possible)),
+    }
+}
+
 impl Comparison {
-    /// Whether every metric is within `tolerance` (mm) and nothing is
-    /// contradictory or failed.
+    /// Whether every decided metric ([`DECIDED_METRICS`]) is within
+    /// `tolerance` (mm) and nothing is contradictory or failed. Undecided
+    /// strikes (in the tie band) never fail a comparison; they are counted
+    /// and their metrics shown beside the decided ones.
     pub fn passes(&self, tolerance: f64) -> bool {
         let c = &self.counts;
-        self.stats.iter().all(|(_, s)| s.max <= tolerance)
+        let area_finite = self
+            .area
+            .iter()
+            .all(|a| a.miss_decided.is_finite() && a.false_alarm_decided.is_finite());
+        self.stats
+            .iter()
+            .filter(|(m, _)| DECIDED_METRICS.contains(&m.as_str()))
+            .all(|(_, s)| s.max <= tolerance)
+            && area_finite
             && c.oracle_not_placed == 0
             && c.oracle_failed == 0
-            && c.unmatched_grid == 0
+            && c.unmatched_grid_decided == 0
     }
 
-    /// The worst start-angle pairs by their largest metric, at most `n`.
+    /// The statistics of metric `name`.
+    pub fn stat(&self, name: &str) -> Stats {
+        self.stats[metric_index(name)].1
+    }
+
+    /// The worst start-angle pairs by their largest decided metric, at most
+    /// `n`.
     pub fn worst(&self, n: usize) -> Vec<(VerifyRow, String, f64)> {
         let mut scored: Vec<(VerifyRow, String, f64)> = self
             .rows
@@ -323,10 +493,16 @@ impl Comparison {
             .filter_map(|r| {
                 let candidates = [
                     ("push_error", r.push_error),
-                    ("first_contact_error", r.first_contact_error),
-                    ("miss_distance", r.miss_distance),
-                    ("false_alarm_distance", r.false_alarm_distance),
-                    ("unmatched_deflection", r.unmatched_deflection),
+                    ("first_contact_error_decided", r.first_contact_error_decided),
+                    ("miss_distance_decided", r.miss_distance_decided),
+                    (
+                        "false_alarm_distance_decided",
+                        r.false_alarm_distance_decided,
+                    ),
+                    (
+                        "unmatched_deflection_decided",
+                        r.unmatched_deflection_decided,
+                    ),
                 ];
                 let (name, v) = candidates
                     .into_iter()

@@ -315,8 +315,18 @@ fn method_section(out: &mut String, run: &Run) {
     );
     row(
         out,
-        "Contact tolerance eps",
-        &format!("{} mm", c("/eps_mm")),
+        "Deflection threshold",
+        &format!(
+            "{} degrees (sigma = tan delta = {}; rate estimated as {}): a point the knee-form meets is a strike only when the surface there turns it aside by more than this angle",
+            c("/deflection_deg"),
+            c("/sigma"),
+            c("/rate")
+        ),
+    );
+    row(
+        out,
+        "Rounding tolerance e0",
+        &format!("{} mm (absorbs floating-point rounding only)", c("/e0_mm")),
     );
     row(out, "Side", &c("/side"));
     row(out, "Algorithm", &c("/algorithm"));
@@ -528,14 +538,29 @@ fn verify_block(out: &mut String, k: usize, json: &Value, verdict: Verdict) {
         c("/pitch_mm"),
         c("/pass")
     );
+    if json.get("area_distance_decided_mm").is_some() {
+        let _ = writeln!(
+            out,
+            "<p class=\"headline\">Area distance (decided strikes: the grid's colliding area against the exact one, both ways, in xz): <b>{} mm</b>; over all strikes, undecided included: {} mm. Deflection threshold {} degrees; {} exact contacts undecided (rate within the tie band: {}).</p>",
+            c("/area_distance_decided_mm"),
+            c("/area_distance_mm"),
+            c("/deflection_deg"),
+            c("/counts/exact_undecided"),
+            c("/tie_band_rule")
+        );
+    }
     if let Some(Value::Object(metrics)) = json.get("metrics") {
         out.push_str("<table class=\"metrics\">\n<tr><th>metric (mm)</th><th class=\"num\">max</th><th class=\"num\">p95</th><th class=\"num\">mean</th><th class=\"num\">n</th><th>max within tolerance</th></tr>\n");
         for (name, m) in metrics {
+            // Only decided metrics decide a verdict; the others (all
+            // strikes, undecided included) are shown beside them.
+            let decides = json.get("area_distance_decided_mm").is_none() || kneeform_decides(name);
             let base = format!("/metrics/{}", escape_pointer(name));
             let cells: String = ["max", "p95", "mean", "n"]
                 .map(|f| format!("<td class=\"num\">{}</td>", c(&format!("{base}/{f}"))))
                 .concat();
             let within = match (m.get("max").and_then(Value::as_f64), tolerance) {
+                _ if !decides => "<td>shown, not a criterion</td>",
                 (Some(max), Some(tol)) if max.abs() <= tol => "<td class=\"pass-cell\">yes</td>",
                 (Some(_), Some(_)) => "<td class=\"fail-cell\"><b>no</b></td>",
                 _ => "<td>—</td>",
@@ -556,6 +581,11 @@ fn verify_block(out: &mut String, k: usize, json: &Value, verdict: Verdict) {
         }
         out.push_str("</table>\n");
     }
+}
+
+/// Whether a metric of `verify.json` is one a verdict rests on.
+fn kneeform_decides(name: &str) -> bool {
+    crate::harness::DECIDED_METRICS.contains(&name)
 }
 
 fn converge_block(out: &mut String, k: usize, json: &Value) {
