@@ -9,7 +9,9 @@
 //! * [`kneeform`]: the knee-form, its footprint per angle and row intervals;
 //! * [`push`] and [`slide`]: step 2, the fast path; [`paper`]: the
 //!   paper-literal reference;
-//! * [`engine`]: every angle and start, the colliding masks and composite.
+//! * [`engine`]: every angle and start, the colliding masks and composite;
+//! * [`sanity`]: the checks that warn of a part in the wrong units or
+//!   facing the wrong way, and of a result with nothing struck.
 //!
 //! All lengths are mm and all angles degrees.
 
@@ -24,6 +26,7 @@ pub mod padded;
 pub mod paper;
 pub mod push;
 pub mod report;
+pub mod sanity;
 pub mod scenario;
 mod simd;
 pub mod slide;

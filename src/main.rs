@@ -17,7 +17,7 @@ fn main() -> ExitCode {
             if is_broken_pipe(&err) {
                 return ExitCode::SUCCESS;
             }
-            eprintln!("kneeform: error: {err:#}");
+            eprintln!("kneeform: error: {}", cli::one_line(&err));
             ExitCode::from(2)
         }
     }
@@ -25,7 +25,7 @@ fn main() -> ExitCode {
 
 fn run(cli: &Cli) -> anyhow::Result<ExitCode> {
     match &cli.command {
-        Command::Analyze(args) => cli::analyze::run(args)?,
+        Command::Analyze(args) => return cli::analyze::run(args),
         Command::Scenario(args) => cli::scenario::run(args)?,
         Command::Bench(args) => {
             cli::set_threads(args.threads)?;

@@ -96,4 +96,9 @@ pub struct Summary {
     pub composite_area_mm2: f64,
     /// Time per stage.
     pub timings: Timings,
+    /// The sanity checks' warnings (one line each), as printed on stderr:
+    /// a part in the wrong units or facing the wrong way, angles beyond the
+    /// regulation's, nothing struck. Absent in runs of earlier versions.
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }

@@ -4,6 +4,7 @@
 mod analytic;
 mod cli;
 mod engine;
+mod first_hour;
 mod harness;
 mod oracle;
 mod report;

@@ -107,6 +107,26 @@ fn verification_fixtures(dir: &Path) -> [PathBuf; 2] {
         "pitch_mm,push_error_max\n4,1.2\n2,0.31\n1,0.08\n",
     )
     .unwrap();
+    // Of this run: its part, knee-form and strike rule, as verify and
+    // converge record them.
+    let summary = read_json(&dir.join("run/summary.json"));
+    let stamp = |path: &Path| {
+        let mut json = read_json(path);
+        json["input_sha256"] = summary["sha256"].clone();
+        json["knee_form_mm"] = Value::from(
+            ["triangle_side_mm", "radius_mm", "thickness_mm"]
+                .map(|k| summary[k].clone())
+                .to_vec(),
+        );
+        for key in kneeform::report::verify::STRIKE_RULE_KEYS {
+            if let Some(v) = summary.get(key) {
+                json[key] = v.clone();
+            }
+        }
+        std::fs::write(path, json.to_string()).unwrap();
+    };
+    stamp(&failing.join("verify.json"));
+    stamp(&failing.join("converge.json"));
     write_png(&failing.join("error_vs_pitch.png"));
     write_png(&failing.join("time_vs_pitch.png"));
     let passing = dir.join("verify-pass");
@@ -117,6 +137,7 @@ fn verification_fixtures(dir: &Path) -> [PathBuf; 2] {
             "metrics": {"push_error": {"max": 0.31, "p95": 0.2, "mean": 0.05, "n": 120}}}"#,
     )
     .unwrap();
+    stamp(&passing.join("verify.json"));
     [failing, passing]
 }
 

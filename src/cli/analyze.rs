@@ -6,10 +6,13 @@ use std::io::BufWriter;
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::Context;
+use std::process::ExitCode;
+
+use anyhow::{Context, bail, ensure};
 use indicatif::{ProgressBar, ProgressStyle};
 use kneeform::grid::GridSpec;
 use kneeform::output::{self, OutputDir};
+use kneeform::sanity::{self, Warning};
 use kneeform::summary::{AngleSummary, Summary, Timings};
 use kneeform::{
     AngleMask, EngineOptions, Footprint, GridFootprint, HeightGrid, KneeForm, Part, Side,
@@ -26,6 +29,8 @@ pub struct Prepared {
     pub footprints: Vec<GridFootprint>,
     pub read_s: f64,
     pub sample_s: f64,
+    /// The part's sanity warnings, printed once read, before sampling.
+    pub warnings: Vec<Warning>,
 }
 
 /// Reads the part, lays the grid and samples it.
@@ -33,6 +38,8 @@ pub fn prepare(path: &Path, scale: f64, side: Side, setup: &Setup) -> anyhow::Re
     let t = Instant::now();
     let (part, sha256) = super::load_part(path, scale, side)?;
     let read_s = t.elapsed().as_secs_f64();
+    let warnings = sanity::part_warnings(&part, side, &setup.knee);
+    warn(&warnings);
 
     let t = Instant::now();
     let footprints: Vec<Footprint> = setup
@@ -55,6 +62,7 @@ pub fn prepare(path: &Path, scale: f64, side: Side, setup: &Setup) -> anyhow::Re
         footprints,
         read_s,
         sample_s: t.elapsed().as_secs_f64(),
+        warnings,
     })
 }
 
@@ -98,22 +106,34 @@ pub fn run_engine(prepared: &Prepared, setup: &Setup) -> Vec<AngleMask> {
     masks
 }
 
-pub fn run(args: &AnalyzeArgs) -> anyhow::Result<()> {
+/// Exit code of `analyze --report` when the analysis is written but its
+/// report is not.
+pub const REPORT_FAILED: u8 = 3;
+
+pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
     args.part.validate()?;
     let setup = args.setup.validate()?;
+    // Before any work: where the results go, so that an unwritable or
+    // occupied --out is said now, not after the computation.
+    let out = stage_output(&args.out, args.force)?;
+    let mut warnings = sanity::angle_warnings(&setup.angles);
+    warn(&warnings);
     super::set_threads(setup.threads)?;
     let started = Instant::now();
     let prepared = prepare(&args.part.part, args.part.scale, args.part.side, &setup)?;
+    warnings.extend(prepared.warnings.iter().cloned());
     let t = Instant::now();
     let masks = run_engine(&prepared, &setup);
     let push_slide_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
     let counts = composite(&masks);
+    let composite_nodes = counts.iter().filter(|&&c| c > 0).count();
+    let nothing = sanity::result_warnings(composite_nodes);
+    warn(&nothing);
+    warnings.extend(nothing);
     let side = args.part.side;
     let grid = &prepared.grid;
-    let out = OutputDir::stage(&args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
     let create = |name: &str| -> anyhow::Result<BufWriter<std::fs::File>> {
         Ok(BufWriter::new(std::fs::File::create(out.path(name))?))
     };
@@ -127,7 +147,7 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<()> {
         masks.len(),
         side,
     )?;
-    output::write_depth_png(&out.path("depth.png"), grid)?;
+    output::write_depth_png(&out.path("depth.png"), grid, side)?;
     let title = format!(
         "Composite colliding area, {} angles (L = {} mm)",
         masks.len(),
@@ -139,8 +159,10 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<()> {
         &counts,
         masks.len(),
         &title,
+        side,
     )?;
     let mut summary = summarize(args, &setup, &prepared, &masks, &counts);
+    summary.warnings = warnings.iter().map(ToString::to_string).collect();
     summary.timings = Timings {
         read_s: prepared.read_s,
         sample_s: prepared.sample_s,
@@ -152,17 +174,6 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<()> {
         out.path("summary.json"),
         serde_json::to_string_pretty(&summary)? + "\n",
     )?;
-    if args.report {
-        // Written from the staged files, so report.html appears with them
-        // or not at all.
-        let options = kneeform::report::ReportOptions {
-            part: Some(args.part.part.clone()),
-            run_name: Some(args.out.clone()),
-            ..kneeform::report::ReportOptions::new(out.path(""))
-        };
-        let shown_as = args.out.join("report.html");
-        super::report::write(&options, &out.path("report.html"), &shown_as)?;
-    }
     out.commit()
         .with_context(|| format!("cannot move results into {}", args.out.display()))?;
     eprintln!(
@@ -179,7 +190,65 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<()> {
         setup.knee.radius,
         args.out.display()
     );
-    Ok(())
+    if args.report {
+        // From the committed run, so the analysis stands whatever the
+        // report meets; report.html itself appears whole or not at all.
+        let options = kneeform::report::ReportOptions {
+            part: Some(args.part.part.clone()),
+            ..kneeform::report::ReportOptions::new(&args.out)
+        };
+        let report = args.out.join("report.html");
+        if let Err(err) = super::report::write(&options, &report, &report) {
+            eprintln!(
+                "kneeform: error: {}; the analysis is complete and kept in {}, only its report is missing",
+                super::one_line(&err),
+                args.out.display()
+            );
+            return Ok(ExitCode::from(REPORT_FAILED));
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Prints each warning as one line on stderr.
+pub fn warn(warnings: &[Warning]) {
+    for w in warnings {
+        eprintln!("kneeform: warning: {w}");
+    }
+}
+
+/// Checks `out` before any work and stages the run's files beside it. An
+/// existing directory is replaced only with `force`, and only when it is
+/// an earlier run's (it holds `summary.json`) or empty: --force must not
+/// remove a directory of someone else's files. Staging creates a directory
+/// beside `out`, so an unwritable place fails here.
+pub fn stage_output(out: &Path, force: bool) -> anyhow::Result<OutputDir> {
+    match std::fs::metadata(out) {
+        Ok(meta) if !meta.is_dir() => {
+            bail!("--out {} is a file, not a directory", out.display())
+        }
+        Ok(_) => {
+            ensure!(
+                force,
+                "--out {} already exists: pass --force to replace it, or choose another --out",
+                out.display()
+            );
+            let is_run = out.join("summary.json").is_file();
+            let is_empty = std::fs::read_dir(out)
+                .with_context(|| format!("cannot read --out {}", out.display()))?
+                .next()
+                .is_none();
+            ensure!(
+                is_run || is_empty,
+                "--out {} is not a kneeform run directory (no summary.json), so --force will not replace it: choose another --out",
+                out.display()
+            );
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err(e).with_context(|| format!("cannot use --out {}", out.display())),
+    }
+    OutputDir::stage_replacing(out)
+        .with_context(|| format!("cannot write the results to {}", out.display()))
 }
 
 fn summarize(
@@ -236,5 +305,6 @@ fn summarize(
         composite_nodes,
         composite_area_mm2: composite_nodes as f64 * area,
         timings: Timings::default(),
+        warnings: Vec::new(),
     }
 }

@@ -128,11 +128,17 @@ pub struct AnalyzeArgs {
     pub part: PartArgs,
     #[command(flatten)]
     pub setup: SetupArgs,
-    /// Output directory (created; files are written whole or not at all).
+    /// Output directory (created; it appears whole or not at all). An
+    /// existing one is refused unless --force is given.
     #[arg(long, default_value = "kneeform-out", value_name = "DIR")]
     pub out: PathBuf,
+    /// Replace an existing --out directory of an earlier run (one holding
+    /// summary.json, or empty) with this run's results, whole.
+    #[arg(long)]
+    pub force: bool,
     /// Also write the evidence report, `report.html`, into the output
-    /// directory (as `kneeform report DIR` would).
+    /// directory (as `kneeform report DIR` would). The analysis is kept if
+    /// only the report fails (exit code 3).
     #[arg(long)]
     pub report: bool,
 }

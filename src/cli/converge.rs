@@ -149,7 +149,7 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
         ensure!(t.is_finite() && t > 0.0, "--tolerance must be > 0");
     }
     super::set_threads(setup.threads)?;
-    let (part, _) = super::load_part(&args.part.part, args.part.scale, args.part.side)?;
+    let (part, sha256) = super::load_part(&args.part.part, args.part.scale, args.part.side)?;
     let input = args.part.part.display().to_string();
     let results = converge(
         &part.triangles,
@@ -165,6 +165,15 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
     let summary = ConvergeSummary {
         kneeform_version: env!("CARGO_PKG_VERSION").into(),
         input_file: input,
+        input_sha256: sha256,
+        scale: args.part.scale,
+        side: args.part.side,
+        knee_form_mm: [
+            setup.knee.triangle_side,
+            setup.knee.radius,
+            setup.knee.thickness,
+        ],
+        eps_mm: setup.eps,
         pitches_mm: pitches.clone(),
         fits: fitted
             .iter()

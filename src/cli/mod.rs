@@ -33,6 +33,27 @@ pub fn load_part(path: &Path, scale: f64, side: Side) -> anyhow::Result<(Part, S
     Ok((part, sha256))
 }
 
+/// The error and its causes as one line, `outer: inner: ...`, each cause
+/// said once: a layer that already quotes its cause (`{path}: {source}`,
+/// as thiserror messages often do) is not followed by the cause again, so
+/// an OS error never reads `(os error 2): No such file or directory (os
+/// error 2)`. Line breaks inside a message become spaces.
+pub fn one_line(err: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in err.chain() {
+        let text = cause.to_string();
+        let text = text.split_whitespace().collect::<Vec<_>>().join(" ");
+        if text.is_empty() || line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    line
+}
+
 /// Sizes rayon's global pool (default: one thread per CPU).
 pub fn set_threads(threads: Option<usize>) -> anyhow::Result<()> {
     if let Some(n) = threads {
@@ -42,4 +63,39 @@ pub fn set_threads(threads: Option<usize>) -> anyhow::Result<()> {
             .build_global()?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Debug, thiserror::Error)]
+    #[error("{path}: {source}")]
+    struct Quoting {
+        path: String,
+        source: std::io::Error,
+    }
+
+    #[test]
+    fn a_cause_already_quoted_is_said_once() {
+        let io = std::io::Error::from_raw_os_error(2);
+        let io_text = io.to_string();
+        let err = anyhow::Error::new(Quoting {
+            path: "run/summary.json".into(),
+            source: io,
+        })
+        .context("cannot write the report");
+        let line = one_line(&err);
+        assert_eq!(line.matches(&io_text).count(), 1, "{line}");
+        assert_eq!(
+            line,
+            format!("cannot write the report: run/summary.json: {io_text}")
+        );
+    }
+
+    #[test]
+    fn causes_not_quoted_are_chained_on_one_line() {
+        let err = anyhow::anyhow!("no such\nfile").context("cannot read part.stl");
+        assert_eq!(one_line(&err), "cannot read part.stl: no such file");
+    }
 }

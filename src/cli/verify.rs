@@ -118,6 +118,10 @@ pub fn verify(
     let summary = VerifySummary {
         kneeform_version: env!("CARGO_PKG_VERSION").into(),
         input_file: input_file.into(),
+        // The file's identity and units: set by `run`, which read the file.
+        input_sha256: String::new(),
+        scale: 1.0,
+        side: kneeform::Side::Left,
         pitch_mm: setup.pitch,
         tolerance_mm: tolerance,
         pass,
@@ -207,8 +211,8 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
         "--tolerance must be > 0"
     );
     super::set_threads(setup.threads)?;
-    let (part, _) = super::load_part(&args.part.part, args.part.scale, args.part.side)?;
-    let result = verify(
+    let (part, sha256) = super::load_part(&args.part.part, args.part.scale, args.part.side)?;
+    let mut result = verify(
         &part.triangles,
         &args.part.part.display().to_string(),
         &setup,
@@ -217,6 +221,9 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
         args.tolerance,
         None,
     )?;
+    result.summary.input_sha256 = sha256;
+    result.summary.scale = args.part.scale;
+    result.summary.side = args.part.side;
     write(&args.out, &result)?;
     let s = &result.summary;
     for name in kneeform::harness::METRICS {

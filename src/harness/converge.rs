@@ -96,6 +96,22 @@ pub struct ConvergeSummary {
     pub kneeform_version: String,
     /// The part as given.
     pub input_file: String,
+    /// SHA-256 of the part file's bytes (hex), as `summary.json`'s
+    /// `sha256`: what `kneeform report` matches a study to its run by.
+    #[serde(default)]
+    pub input_sha256: String,
+    /// Factor from the file's units to mm.
+    #[serde(default = "super::unit_scale")]
+    pub scale: f64,
+    /// `left` or `right`.
+    #[serde(default = "super::left_side")]
+    pub side: crate::Side,
+    /// Knee-form L, R, W (mm).
+    #[serde(default)]
+    pub knee_form_mm: [f64; 3],
+    /// Contact tolerance eps (mm): the strike rule of every pitch.
+    #[serde(default)]
+    pub eps_mm: f64,
     /// The pitches, coarsest first (mm).
     pub pitches_mm: Vec<f64>,
     /// Per metric, the fit of its max error, where it has one.

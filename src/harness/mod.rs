@@ -36,6 +36,16 @@ pub struct VerifySummary {
     pub kneeform_version: String,
     /// The part (STL or scenario file) as given.
     pub input_file: String,
+    /// SHA-256 of the part file's bytes (hex), as `summary.json`'s
+    /// `sha256`: what `kneeform report` matches a verification to its run by.
+    #[serde(default)]
+    pub input_sha256: String,
+    /// Factor from the file's units to mm.
+    #[serde(default = "unit_scale")]
+    pub scale: f64,
+    /// `left` or `right`.
+    #[serde(default = "left_side")]
+    pub side: crate::Side,
     /// Grid pitch (mm).
     pub pitch_mm: f64,
     /// The tolerance every metric's max is held to (mm).
@@ -75,6 +85,16 @@ pub struct VerifySummary {
     pub worst_starts: Vec<WorstStart>,
     /// Seconds on each side.
     pub timings: VerifyTimings,
+}
+
+/// `scale` of files written before it was recorded.
+pub(crate) fn unit_scale() -> f64 {
+    1.0
+}
+
+/// `side` of files written before it was recorded.
+pub(crate) fn left_side() -> crate::Side {
+    crate::Side::Left
 }
 
 /// One of the worst start-angle pairs.

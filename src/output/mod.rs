@@ -30,7 +30,10 @@ pub use self::csv::{write_colliding_points, write_composite};
 pub use self::ply::write_colliding_area_ply;
 pub(crate) use self::png::count_colour;
 pub(crate) use self::png::register_font;
-pub use self::png::{PngError, write_composite_png, write_depth_png};
+pub use self::png::{
+    CROP_MARGIN, NO_PART, PngError, RING_BELOW, RING_COLOUR, Window, composite_key, crop_window,
+    depth_bar_ends, view_line, write_composite_png, write_depth_png,
+};
 pub(crate) use self::stl::to_stl_triangle;
 pub use self::stl::write_colliding_area;
 
@@ -46,6 +49,7 @@ pub struct OutputDir {
     final_dir: PathBuf,
     staging: PathBuf,
     committed: bool,
+    replace: bool,
 }
 
 impl OutputDir {
@@ -79,7 +83,20 @@ impl OutputDir {
             final_dir: final_dir.to_path_buf(),
             staging,
             committed: false,
+            replace: false,
         })
+    }
+
+    /// As [`OutputDir::stage`], but [`OutputDir::commit`] replaces the
+    /// final directory whole: the staging directory is renamed to the final
+    /// name, and a directory already there (an earlier run, which the
+    /// caller has agreed to replace) is moved aside first and removed
+    /// after, so no file of it survives beside the new results. A fresh
+    /// final directory thus appears complete, in one rename.
+    pub fn stage_replacing(final_dir: &Path) -> io::Result<OutputDir> {
+        let mut out = OutputDir::stage(final_dir)?;
+        out.replace = true;
+        Ok(out)
     }
 
     /// Where to write the file `file_name`: inside the staging directory.
@@ -97,6 +114,11 @@ impl OutputDir {
     /// staging directory. Entries are moved in name order, so a failure
     /// part way leaves a predictable prefix.
     pub fn commit(mut self) -> io::Result<()> {
+        if self.replace {
+            self.replace_final()?;
+            self.committed = true;
+            return Ok(());
+        }
         std::fs::create_dir_all(&self.final_dir)?;
         let mut names: Vec<_> = std::fs::read_dir(&self.staging)?
             .map(|entry| entry.map(|e| e.file_name()))
@@ -107,6 +129,31 @@ impl OutputDir {
         }
         std::fs::remove_dir(&self.staging)?;
         self.committed = true;
+        Ok(())
+    }
+}
+
+impl OutputDir {
+    /// The replacing commit: old directory aside, staging in, old removed;
+    /// on failure the old directory is put back.
+    fn replace_final(&self) -> io::Result<()> {
+        let mut aside_name = self.staging.file_name().unwrap_or_default().to_os_string();
+        aside_name.push(".old");
+        let aside = self.staging.with_file_name(aside_name);
+        let moved = match std::fs::rename(&self.final_dir, &aside) {
+            Ok(()) => true,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => false,
+            Err(e) => return Err(e),
+        };
+        if let Err(e) = std::fs::rename(&self.staging, &self.final_dir) {
+            if moved {
+                let _ = std::fs::rename(&aside, &self.final_dir);
+            }
+            return Err(e);
+        }
+        if moved {
+            std::fs::remove_dir_all(&aside)?;
+        }
         Ok(())
     }
 }
@@ -188,6 +235,30 @@ mod tests {
             "new"
         );
         assert_eq!(entries(&final_dir), ["a.csv", "keep.txt"]);
+        std::fs::remove_dir_all(root).unwrap();
+    }
+
+    #[test]
+    fn a_replacing_commit_leaves_no_file_of_the_earlier_run() {
+        let root = temp_dir("replace-whole");
+        let final_dir = root.join("run");
+        // Fresh: the directory appears with its files.
+        let out = OutputDir::stage_replacing(&final_dir).unwrap();
+        std::fs::write(out.path("a.csv"), "first").unwrap();
+        std::fs::write(out.path("report.html"), "old report").unwrap();
+        assert!(!final_dir.exists());
+        out.commit().unwrap();
+        assert_eq!(entries(&final_dir), ["a.csv", "report.html"]);
+        // Replaced: only the new run's files, nothing staged or aside left.
+        let out = OutputDir::stage_replacing(&final_dir).unwrap();
+        std::fs::write(out.path("a.csv"), "second").unwrap();
+        out.commit().unwrap();
+        assert_eq!(entries(&final_dir), ["a.csv"]);
+        assert_eq!(
+            std::fs::read_to_string(final_dir.join("a.csv")).unwrap(),
+            "second"
+        );
+        assert_eq!(entries(&root), ["run"]);
         std::fs::remove_dir_all(root).unwrap();
     }
 

@@ -1,11 +1,17 @@
 //! Images of the height grid and of the composite, with axes in mm.
 //!
-//! The plot shows the grid as seen by the knee (from -y): x to the right
-//! with the vehicle front (-x) on the left, z up, one square of pixels per
-//! node. Small grids are enlarged by a whole factor; grids too large for
-//! [`MAX_PLOT_W`] x [`MAX_PLOT_H`] pixels are reduced by a whole factor,
-//! each pixel taking the largest count and the smallest height of the nodes
-//! it covers, so a single colliding node is never lost.
+//! The plot shows the part as the knee sees it, named in the title: the
+//! left side from -y (x to the right, the vehicle front, -x, on the left),
+//! the right side from +y (x reversed, the front on the right); z up, one
+//! square of pixels per node. It is cropped to the nodes that hit the part
+//! (and any struck node) with a margin of [`CROP_MARGIN`], not the whole
+//! grid with its knee-form margin. Small windows are enlarged by a whole
+//! factor; windows too large for [`MAX_PLOT_W`] x [`MAX_PLOT_H`] pixels are
+//! reduced by a whole factor, each pixel taking the largest count and the
+//! smallest height of the nodes it covers, so a single colliding node is
+//! never lost; when few pixels are struck, each is also circled
+//! ([`RING_BELOW`]), so that a one-node result stays visible. Every colour
+//! is in a key: the colour bar, and a line of swatches under the plot.
 //!
 //! Text uses DejaVu Sans, embedded by the `dejavu` crate and registered with
 //! plotters once per process: no system font is needed.
@@ -18,7 +24,8 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
-use crate::grid::HeightGrid;
+use crate::grid::{GridSpec, HeightGrid};
+use crate::mesh::Side;
 
 /// Largest plot area width (pixels); the whole image stays under 1600.
 const MAX_PLOT_W: usize = 1300;
@@ -30,7 +37,11 @@ const MIN_PLOT: usize = 480;
 /// Space around the plot area (pixels): title above, axis labels left and
 /// below, the colour bar on the right.
 const MARGIN: usize = 10;
-const TITLE_H: usize = 40;
+/// Two lines (what is shown, and from where it is seen), then the colour
+/// bar's label and, on the depth image, the word at its top end.
+const TITLE_H: usize = 90;
+/// The line of colour swatches under the x axis.
+const KEY_H: usize = 26;
 const Y_LABELS: usize = 80;
 const X_LABELS: usize = 50;
 const BAR_AREA_W: usize = 170;
@@ -41,7 +52,22 @@ const MIN_IMAGE_H: usize = 320;
 const FONT: &str = "sans-serif";
 
 /// Colour of nodes whose line misses the part (`h = +inf`).
-const NO_PART: RGBColor = RGBColor(250, 250, 250);
+pub const NO_PART: RGBColor = RGBColor(250, 250, 250);
+
+/// Nodes of margin kept around the part's nodes when cropping, at least;
+/// or a twentieth of the window's size, whichever is more.
+pub const CROP_MARGIN: usize = 3;
+
+/// When fewer nodes than this are struck, each is circled in
+/// [`RING_COLOUR`]: a single node of a 1300-node-wide grid is one pixel.
+pub const RING_BELOW: usize = 32;
+
+/// The circles around few struck pixels: a red that neither the count
+/// ramp (viridis) nor the grey of the part takes.
+pub const RING_COLOUR: RGBColor = RGBColor(228, 26, 28);
+
+/// Radius of those circles (pixels).
+const RING_RADIUS: i32 = 9;
 
 /// Why an image could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -75,18 +101,21 @@ pub enum PngError {
     },
 }
 
-/// Writes the height grid as a PNG: colour by height `h` (mm, analysis
-/// frame y: small = near the knee, drawn bright), nodes that miss the part
-/// in a pale neutral, a colour bar in mm, mm axes and a title with the grid
-/// size and pitch.
-pub fn write_depth_png(path: &Path, grid: &HeightGrid) -> Result<(), PngError> {
+/// Writes the height grid as a PNG: colour by closeness to the knee
+/// (bright = small `h`, the first to meet the knee; the bar's ends say
+/// which is closer), in the part's own y (mm), nodes that miss the part in
+/// a pale neutral (in the key), mm axes, the side and viewing direction in
+/// the title, cropped to the part (see the module docs).
+pub fn write_depth_png(path: &Path, grid: &HeightGrid, side: Side) -> Result<(), PngError> {
     let (h_lo, h_hi) = finite_range(&grid.h);
+    let window = crop_window(grid, None);
+    let shown = window.crop(grid);
     let title = format!(
-        "Height grid (y in the analysis frame): {} x {} nodes at {} mm pitch",
+        "Height grid (depth buffer seen from the knee): {} x {} nodes at {} mm pitch",
         grid.spec.nx, grid.spec.nz, grid.spec.pitch
     );
-    let raster = Raster::plan(grid.spec.nx, grid.spec.nz)?;
-    let heights = raster.reduce(grid.spec.nx, &grid.h, f64::INFINITY, f64::min);
+    let raster = Raster::plan(shown.spec.nx, shown.spec.nz)?;
+    let heights = raster.reduce(shown.spec.nx, &shown.h, f64::INFINITY, f64::min);
     let colour = |h: f64| {
         if h.is_finite() {
             viridis((h_hi - h) / (h_hi - h_lo))
@@ -95,8 +124,23 @@ pub fn write_depth_png(path: &Path, grid: &HeightGrid) -> Result<(), PngError> {
         }
     };
     let pixels: Vec<RGBColor> = heights.into_iter().map(colour).collect();
-    draw_plot(path, grid, &raster, &pixels, &title, |area| {
-        let mut bar = colour_bar(area, "y (mm)", h_lo..h_hi)?;
+    // The bar is in the part's y: on the right side, -h.
+    let (y_lo, y_hi) = match side {
+        Side::Left => (h_lo, h_hi),
+        Side::Right => (-h_hi, -h_lo),
+    };
+    let [top, bottom] = depth_bar_ends(side);
+    let plot = Plot {
+        grid: &shown,
+        raster: &raster,
+        pixels: &pixels,
+        title: &title,
+        side,
+        key: &[(NO_PART, "no part (the node's line misses it)")],
+        rings: &[],
+    };
+    draw_plot(path, &plot, |area, bar_top, bar_bottom| {
+        let mut bar = colour_bar(area, "y (mm, part frame)", y_lo..y_hi)?;
         bar.configure_mesh()
             .disable_mesh()
             .disable_x_axis()
@@ -106,25 +150,58 @@ pub fn write_depth_png(path: &Path, grid: &HeightGrid) -> Result<(), PngError> {
         // A smooth bar: enough bands that neighbours differ by under one
         // colour step.
         const BANDS: usize = 256;
-        let dh = (h_hi - h_lo) / BANDS as f64;
+        let dy = (y_hi - y_lo) / BANDS as f64;
         bar.draw_series((0..BANDS).map(|k| {
-            let lo = h_lo + k as f64 * dh;
-            Rectangle::new([(0.0, lo), (1.0, lo + dh)], colour(lo + 0.5 * dh).filled())
+            let lo = y_lo + k as f64 * dy;
+            let h = side.to_part(lo + 0.5 * dy);
+            Rectangle::new([(0.0, lo), (1.0, lo + dy)], colour(h).filled())
         }))?;
+        let style = (FONT, 13).into_text_style(area);
+        area.draw_text(top, &style, (20, bar_top - 18))?;
+        area.draw_text(bottom, &style, (20, bar_bottom + 4))?;
         Ok(())
     })
+}
+
+/// The words at the top and bottom ends of the depth bar: the bright end
+/// (small `h`) is the one closer to the knee, at the bottom of the bar for
+/// the left side (part y = h) and at its top for the right (part y = -h).
+pub fn depth_bar_ends(side: Side) -> [&'static str; 2] {
+    const CLOSER: &str = "closer to the knee";
+    const FARTHER: &str = "farther from the knee";
+    match side {
+        Side::Left => [FARTHER, CLOSER],
+        Side::Right => [CLOSER, FARTHER],
+    }
+}
+
+/// The key of the composite image, beside its colour bar of counts: the
+/// grey of the part not struck, the pale of no part, and the circles when
+/// there are any.
+pub fn composite_key(ringed: bool) -> Vec<(RGBColor, &'static str)> {
+    let mut key = vec![
+        (grey(0.5), "part, not struck (lighter = closer to the knee)"),
+        (NO_PART, "no part"),
+    ];
+    if ringed {
+        key.push((RING_COLOUR, "circled: struck (few nodes)"));
+    }
+    key
 }
 
 /// Writes the composite as a PNG: nodes counted by at least one angle in a
 /// colour per count (a viridis-like ramp, 1 dark to `n_angles` bright, with
 /// a discrete legend) over the height grid in grey (pale neutral where the
-/// part is missed), mm axes and `title`.
+/// part is missed), both in the key, mm axes, `title` with the side and
+/// viewing direction under it, cropped to the part and what was struck;
+/// few struck pixels are circled.
 pub fn write_composite_png(
     path: &Path,
     grid: &HeightGrid,
     composite: &[u16],
     n_angles: usize,
     title: &str,
+    side: Side,
 ) -> Result<(), PngError> {
     if composite.len() != grid.spec.len() {
         return Err(PngError::Length {
@@ -135,9 +212,24 @@ pub fn write_composite_png(
     let max_count = composite.iter().copied().max().unwrap_or(0);
     let n = n_angles.max(usize::from(max_count)).max(1);
     let (h_lo, h_hi) = finite_range(&grid.h);
-    let raster = Raster::plan(grid.spec.nx, grid.spec.nz)?;
-    let counts = raster.reduce(grid.spec.nx, composite, 0u16, u16::max);
-    let heights = raster.reduce(grid.spec.nx, &grid.h, f64::INFINITY, f64::min);
+    let window = crop_window(grid, Some(composite));
+    let shown = window.crop(grid);
+    let shown_counts = window.crop_values(grid.spec.nx, composite);
+    let raster = Raster::plan(shown.spec.nx, shown.spec.nz)?;
+    let counts = raster.reduce(shown.spec.nx, &shown_counts, 0u16, u16::max);
+    let heights = raster.reduce(shown.spec.nx, &shown.h, f64::INFINITY, f64::min);
+    let struck: Vec<usize> = (0..shown_counts.len())
+        .filter(|&k| shown_counts[k] > 0)
+        .collect();
+    let mut rings: Vec<usize> = if struck.len() < RING_BELOW {
+        struck
+            .iter()
+            .map(|&k| raster.pixel_of(k % shown.spec.nx, k / shown.spec.nx))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    rings.dedup();
     let pixels: Vec<RGBColor> = counts
         .into_iter()
         .zip(heights)
@@ -147,9 +239,19 @@ pub fn write_composite_png(
             (0, false) => NO_PART,
         })
         .collect();
-    draw_plot(path, grid, &raster, &pixels, title, |area| {
+    let key = composite_key(!rings.is_empty());
+    let plot = Plot {
+        grid: &shown,
+        raster: &raster,
+        pixels: &pixels,
+        title,
+        side,
+        key: &key,
+        rings: &rings,
+    };
+    draw_plot(path, &plot, |area, _, _| {
         let top = n as f64 + 0.5;
-        let mut bar = colour_bar(area, "angles", 0.5..top)?;
+        let mut bar = colour_bar(area, "struck at N angles", 0.5..top)?;
         let whole = |v: &f64| {
             if (v - v.round()).abs() < 1e-9 {
                 format!("{}", v.round())
@@ -173,6 +275,77 @@ pub fn write_composite_png(
         }))?;
         Ok(())
     })
+}
+
+/// The nodes an image shows: columns `i` and rows `j` of the grid.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Window {
+    /// Node columns.
+    pub i: Range<usize>,
+    /// Node rows.
+    pub j: Range<usize>,
+}
+
+impl Window {
+    /// The grid inside the window.
+    fn crop(&self, grid: &HeightGrid) -> HeightGrid {
+        let spec = GridSpec {
+            pitch: grid.spec.pitch,
+            i_origin: grid.spec.i_origin + self.i.start as i64,
+            j_origin: grid.spec.j_origin + self.j.start as i64,
+            nx: self.i.len(),
+            nz: self.j.len(),
+        };
+        HeightGrid {
+            spec,
+            h: self.crop_values(grid.spec.nx, &grid.h),
+        }
+    }
+
+    /// The values of a row-major grid `nx` wide inside the window.
+    fn crop_values<T: Copy>(&self, nx: usize, values: &[T]) -> Vec<T> {
+        self.j
+            .clone()
+            .flat_map(|j| {
+                values[j * nx + self.i.start..j * nx + self.i.end]
+                    .iter()
+                    .copied()
+            })
+            .collect()
+    }
+}
+
+/// The part plus what was struck: the smallest window holding every node
+/// whose line meets the part and every node with a count in `composite`,
+/// grown by [`CROP_MARGIN`] nodes (or a twentieth of its size) on every
+/// side within the grid. The whole grid when no node meets the part.
+pub fn crop_window(grid: &HeightGrid, composite: Option<&[u16]>) -> Window {
+    let (nx, nz) = (grid.spec.nx, grid.spec.nz);
+    let (mut i0, mut i1, mut j0, mut j1) = (usize::MAX, 0, usize::MAX, 0);
+    for j in 0..nz {
+        for i in 0..nx {
+            let k = j * nx + i;
+            let shown = grid.h[k].is_finite()
+                || composite.is_some_and(|c| c.get(k).is_some_and(|&v| v > 0));
+            if shown {
+                i0 = i0.min(i);
+                i1 = i1.max(i);
+                j0 = j0.min(j);
+                j1 = j1.max(j);
+            }
+        }
+    }
+    if i0 > i1 {
+        return Window { i: 0..nx, j: 0..nz };
+    }
+    let grow = |lo: usize, hi: usize, n: usize| {
+        let m = CROP_MARGIN.max((hi - lo + 1) / 20);
+        lo.saturating_sub(m)..(hi + 1 + m).min(n)
+    };
+    Window {
+        i: grow(i0, i1, nx),
+        j: grow(j0, j1, nz),
+    }
 }
 
 /// The smallest and largest finite value, widened to a non-empty range
@@ -238,6 +411,18 @@ impl Raster {
         lo.min(n)..hi.min(n)
     }
 
+    /// The pixel (row-major from the top row) at the centre of node
+    /// `(i, j)`.
+    fn pixel_of(&self, i: usize, j: usize) -> usize {
+        let along = |k: usize| k * self.up + self.up / 2;
+        let (c, r) = if self.block > 1 {
+            (i / self.block, j / self.block)
+        } else {
+            (along(i), along(j))
+        };
+        (self.h - 1 - r) * self.w + c
+    }
+
     /// Nodes spanned by `pixels` pixels (mm = this times the pitch).
     fn span(&self, pixels: usize) -> f64 {
         (pixels * self.block) as f64 / self.up as f64
@@ -275,67 +460,134 @@ type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 type DrawError = DrawingAreaErrorKind<<BitMapBackend<'static> as DrawingBackend>::ErrorType>;
 type DrawResult = Result<(), DrawError>;
 
-/// Draws the title, the pixels (row-major from the top) in a plot with mm
-/// axes, and, through `legend`, the colour bar on the right; then encodes.
+/// What [`draw_plot`] draws.
+struct Plot<'a> {
+    /// The nodes shown (already cropped).
+    grid: &'a HeightGrid,
+    raster: &'a Raster,
+    /// Row-major from the top, x increasing to the right.
+    pixels: &'a [RGBColor],
+    title: &'a str,
+    /// Which way the knee looks: the right side is drawn with x reversed.
+    side: Side,
+    /// Swatches under the plot: colour and meaning.
+    key: &'a [(RGBColor, &'a str)],
+    /// Pixels (indices into `pixels`) to circle.
+    rings: &'a [usize],
+}
+
+/// The second line of every title: the side and where it is seen from.
+pub fn view_line(side: Side) -> &'static str {
+    match side {
+        Side::Left => {
+            "Left side, seen from the knee (looking +y): vehicle front (-x) on the left, z up"
+        }
+        Side::Right => {
+            "Right side, seen from the knee (looking -y): vehicle front (-x) on the right, z up"
+        }
+    }
+}
+
+/// Draws the title and view line, the pixels in a plot with mm axes (x
+/// reversed for the right side), the rings, the key and, through `legend`
+/// (given the bar's top and bottom pixel rows), the colour bar on the
+/// right; then encodes.
 fn draw_plot(
     path: &Path,
-    grid: &HeightGrid,
-    raster: &Raster,
-    pixels: &[RGBColor],
-    title: &str,
-    legend: impl FnOnce(&Area) -> DrawResult,
+    plot: &Plot,
+    legend: impl FnOnce(&Area, i32, i32) -> DrawResult,
 ) -> Result<(), PngError> {
     register_font()?;
     let failed = |e: &dyn std::fmt::Display| PngError::Draw {
         path: path.to_path_buf(),
         reason: e.to_string(),
     };
+    let raster = plot.raster;
     let chart_w = MARGIN + Y_LABELS + raster.w + MARGIN;
-    let height = (TITLE_H + raster.h + X_LABELS + MARGIN).max(MIN_IMAGE_H);
+    let height = (TITLE_H + raster.h + X_LABELS + KEY_H + MARGIN).max(MIN_IMAGE_H);
     let size = ((chart_w + BAR_AREA_W) as u32, height as u32);
     let root = BitMapBackend::new(path, size).into_drawing_area();
+    let reversed = plot.side == Side::Right;
     let draw = || -> DrawResult {
         root.fill(&WHITE)?;
         root.draw_text(
-            title,
+            plot.title,
             &(FONT, 20).into_text_style(&root),
             (MARGIN as i32, 10),
         )?;
+        root.draw_text(
+            view_line(plot.side),
+            &(FONT, 15).into_text_style(&root),
+            (MARGIN as i32, 36),
+        )?;
         let (chart_area, bar_area) = root.split_horizontally(chart_w as u32);
-        let p = grid.spec.pitch;
-        let x0 = grid.spec.x(0) - 0.5 * p;
-        let z0 = grid.spec.z(0) - 0.5 * p;
+        let spec = plot.grid.spec;
+        let p = spec.pitch;
+        let x0 = spec.x(0) - 0.5 * p;
+        let x1 = x0 + raster.span(raster.w) * p;
+        let z0 = spec.z(0) - 0.5 * p;
+        // The right side's axis runs over -x, labelled with x.
+        let x_axis = if reversed { -x1..-x0 } else { x0..x1 };
+        let bottom = (height - TITLE_H - raster.h - X_LABELS) as u32;
         let mut chart = ChartBuilder::on(&chart_area)
             .margin_top(TITLE_H as u32)
             .margin_left(MARGIN as u32)
             .margin_right(MARGIN as u32)
-            .margin_bottom((height - TITLE_H - raster.h - X_LABELS) as u32)
+            .margin_bottom(bottom)
             .x_label_area_size(X_LABELS as u32)
             .y_label_area_size(Y_LABELS as u32)
-            .build_cartesian_2d(
-                x0..x0 + raster.span(raster.w) * p,
-                z0..z0 + raster.span(raster.h) * p,
-            )?;
+            .build_cartesian_2d(x_axis, z0..z0 + raster.span(raster.h) * p)?;
         let (px, py) = chart.plotting_area().get_pixel_range();
         debug_assert_eq!(
             ((px.end - px.start) as usize, (py.end - py.start) as usize),
             (raster.w, raster.h)
         );
-        for (k, colour) in pixels.iter().enumerate() {
-            let (c, r) = ((k % raster.w) as i32, (k / raster.w) as i32);
-            root.draw_pixel((px.start + c, py.start + r), colour)?;
+        let at = |k: usize| -> (i32, i32) {
+            let (c, r) = (k % raster.w, k / raster.w);
+            let c = if reversed { raster.w - 1 - c } else { c };
+            (px.start + c as i32, py.start + r as i32)
+        };
+        for (k, colour) in plot.pixels.iter().enumerate() {
+            root.draw_pixel(at(k), colour)?;
         }
+        for &k in plot.rings {
+            root.draw(&Circle::new(
+                at(k),
+                RING_RADIUS,
+                RING_COLOUR.stroke_width(2),
+            ))?;
+        }
+        let x_label = |v: &f64| tick(&if reversed { -v } else { *v });
+        let x_desc = if reversed {
+            "x (mm), vehicle front \u{2192}"
+        } else {
+            "x (mm), vehicle front \u{2190}"
+        };
         chart
             .configure_mesh()
             .disable_mesh()
-            .x_label_formatter(&tick)
+            .x_label_formatter(&x_label)
             .y_label_formatter(&tick)
-            .x_desc("x (mm), vehicle front \u{2190}")
+            .x_desc(x_desc)
             .y_desc("z (mm), up")
             .label_style((FONT, 13))
             .axis_desc_style((FONT, 14))
             .draw()?;
-        legend(&bar_area)?;
+        // The key: a swatch (framed, so the pale one shows) and its words.
+        let key_y = (height - MARGIN - KEY_H + 6) as i32;
+        let mut x = (MARGIN + Y_LABELS) as i32;
+        let style = (FONT, 13).into_text_style(&root);
+        for (colour, words) in plot.key {
+            root.draw(&Rectangle::new(
+                [(x, key_y), (x + 14, key_y + 14)],
+                colour.filled(),
+            ))?;
+            root.draw(&Rectangle::new([(x, key_y), (x + 14, key_y + 14)], BLACK))?;
+            root.draw_text(words, &style, (x + 20, key_y))?;
+            let (w, _) = root.estimate_text_size(words, &style)?;
+            x += 20 + w as i32 + 24;
+        }
+        legend(&bar_area, py.start, py.end)?;
         root.present()
     };
     draw().map_err(|e| failed(&e))
@@ -354,11 +606,11 @@ fn colour_bar<'a, 'b>(
     area.draw_text(
         label,
         &(FONT, 14).into_text_style(area),
-        (20, TITLE_H as i32 - 20),
+        (20, TITLE_H as i32 - 34),
     )?;
     ChartBuilder::on(area)
         .margin_top(TITLE_H as u32)
-        .margin_bottom((MARGIN + X_LABELS) as u32)
+        .margin_bottom((MARGIN + X_LABELS + KEY_H) as u32)
         .margin_left(20)
         .margin_right(MARGIN as u32)
         .set_label_area_size(LabelAreaPosition::Right, 70)
@@ -463,21 +715,31 @@ mod tests {
         let mut composite = vec![0u16; g.spec.len()];
         composite[30 * 120 + 60] = 3;
         composite[10 * 120 + 20] = 61;
-        write_depth_png(&dir.join("depth.png"), &g).unwrap();
+        write_depth_png(&dir.join("depth.png"), &g, Side::Left).unwrap();
         write_composite_png(
             &dir.join("composite.png"),
             &g,
             &composite,
             61,
             "Composite, 61 angles",
+            Side::Left,
         )
         .unwrap();
-        // 120 x 60 nodes, enlarged 4 times to reach MIN_PLOT.
+        // The part meets columns 5..120: grown by a twentieth of that
+        // (5 nodes), the window is the whole grid, 120 x 60 nodes, enlarged
+        // 4 times to reach MIN_PLOT.
+        assert_eq!(
+            crop_window(&g, None),
+            Window {
+                i: 0..120,
+                j: 0..60
+            }
+        );
         let plot = Raster::plan(120, 60).unwrap();
         assert_eq!((plot.w, plot.h, plot.up), (480, 240, 4));
         let want = (
             (MARGIN + Y_LABELS + 480 + MARGIN + BAR_AREA_W) as u32,
-            MIN_IMAGE_H.max(TITLE_H + 240 + X_LABELS + MARGIN) as u32,
+            MIN_IMAGE_H.max(TITLE_H + 240 + X_LABELS + KEY_H + MARGIN) as u32,
         );
         assert_eq!(png_size(&dir.join("depth.png")), want);
         assert_eq!(png_size(&dir.join("composite.png")), want);
@@ -490,7 +752,15 @@ mod tests {
         let g = grid(1538, 801, |i, j| (i + j) as f64 * 0.01);
         let r = Raster::plan(1538, 801).unwrap();
         assert_eq!((r.w, r.h, r.block), (769, 401, 2));
-        write_composite_png(&dir.join("c.png"), &g, &vec![1; g.spec.len()], 1, "all").unwrap();
+        write_composite_png(
+            &dir.join("c.png"),
+            &g,
+            &vec![1; g.spec.len()],
+            1,
+            "all",
+            Side::Left,
+        )
+        .unwrap();
         assert!(png_size(&dir.join("c.png")).0 <= 1600);
         std::fs::remove_dir_all(dir).unwrap();
     }
@@ -533,6 +803,149 @@ mod tests {
             Raster::plan(0, 4),
             Err(PngError::EmptyGrid { .. })
         ));
+    }
+
+    /// Decodes a PNG written here (RGB, 8 bits).
+    fn decode(path: &Path) -> (usize, usize, Vec<[u8; 3]>) {
+        let decoder =
+            ::png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        let channels = info.line_size / info.width as usize;
+        let pixels = buf[..info.buffer_size()]
+            .chunks(channels)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
+        (info.width as usize, info.height as usize, pixels)
+    }
+
+    fn count_of(pixels: &[[u8; 3]], colour: RGBColor) -> usize {
+        pixels
+            .iter()
+            .filter(|p| **p == [colour.0, colour.1, colour.2])
+            .count()
+    }
+
+    #[test]
+    fn the_image_is_cropped_to_the_part_and_what_was_struck() {
+        // A 20 x 10-node part in the middle of a 400 x 300-node grid (the
+        // knee-form margin), and a struck node outside it.
+        let g = grid(400, 300, |i, j| {
+            if (190..210).contains(&i) && (145..155).contains(&j) {
+                1.0
+            } else {
+                f64::INFINITY
+            }
+        });
+        assert_eq!(
+            crop_window(&g, None),
+            Window {
+                i: 187..213,
+                j: 142..158
+            }
+        );
+        let mut composite = vec![0u16; g.spec.len()];
+        composite[150 * 400 + 230] = 1;
+        let w = crop_window(&g, Some(&composite));
+        assert_eq!(
+            w,
+            Window {
+                i: 187..234,
+                j: 142..158
+            }
+        );
+        // Nothing meets the part: the whole grid.
+        let empty = grid(40, 30, |_, _| f64::INFINITY);
+        assert_eq!(crop_window(&empty, None), Window { i: 0..40, j: 0..30 });
+        // The cropped grid keeps its nodes' coordinates.
+        let c = w.crop(&g);
+        assert_eq!((c.spec.x(0), c.spec.z(0)), (g.spec.x(187), g.spec.z(142)));
+        assert_eq!(c.at(3, 3), g.at(190, 145));
+    }
+
+    #[test]
+    fn a_single_struck_node_of_a_large_grid_is_circled_and_in_the_key() {
+        let dir = temp_dir("png-one");
+        // Wider than the plot: 2 nodes per pixel, so the node is under one
+        // pixel of its own.
+        let (nx, nz) = (2400, 600);
+        let g = grid(nx, nz, |i, _| i as f64 * 0.01);
+        let mut composite = vec![0u16; nx * nz];
+        composite[300 * nx + 1000] = 5;
+        let path = dir.join("one.png");
+        write_composite_png(&path, &g, &composite, 61, "one node", Side::Left).unwrap();
+        let (_, _, pixels) = decode(&path);
+        // The ring: 2 px wide, radius 9: well over 50 pixels.
+        assert!(count_of(&pixels, RING_COLOUR) > 50, "no ring");
+        assert!(count_of(&pixels, count_colour(5, 61)) >= 1, "no node");
+        // The grey of the part is in the key: its swatch's colour is drawn.
+        let swatch = composite_key(true)[0].0;
+        assert!(count_of(&pixels, swatch) >= 14 * 14 - 4 * 14);
+        // Many struck nodes: no rings.
+        let many = vec![1u16; nx * nz];
+        write_composite_png(&path, &g, &many, 61, "all", Side::Left).unwrap();
+        let (_, _, pixels) = decode(&path);
+        assert_eq!(count_of(&pixels, RING_COLOUR), 0);
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn the_right_side_is_drawn_as_its_knee_sees_it_with_x_reversed() {
+        let dir = temp_dir("png-side");
+        let g = grid(100, 50, |_, _| 0.0);
+        // Struck: the node column of lowest x (the vehicle front).
+        let composite: Vec<u16> = (0..100 * 50).map(|k| u16::from(k % 100 == 0)).collect();
+        let struck = count_colour(1, 1);
+        let mut first_column = Vec::new();
+        for side in [Side::Left, Side::Right] {
+            let path = dir.join("side.png");
+            write_composite_png(&path, &g, &composite, 1, "side", side).unwrap();
+            let (w, _, pixels) = decode(&path);
+            let cols: Vec<usize> = (0..pixels.len())
+                .filter(|&k| pixels[k] == [struck.0, struck.1, struck.2])
+                .map(|k| k % w)
+                .collect();
+            first_column.push((*cols.iter().min().unwrap(), *cols.iter().max().unwrap()));
+        }
+        // Left: the front column is at the plot's left edge; right: at its
+        // right edge (the bar, in the same colour, is further right still).
+        let plot_left = MARGIN + Y_LABELS;
+        assert!(first_column[0].0 <= plot_left + 10, "{first_column:?}");
+        assert!(first_column[1].0 > plot_left + 300, "{first_column:?}");
+        assert!(view_line(Side::Left).contains("looking +y"));
+        assert!(view_line(Side::Right).contains("looking -y"));
+        assert!(view_line(Side::Right).contains("front (-x) on the right"));
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn the_depth_bar_says_which_end_is_closer_to_the_knee() {
+        // The bright end of the bar is small h: the bottom for the left
+        // side (part y = h), the top for the right (part y = -h).
+        assert_eq!(depth_bar_ends(Side::Left)[1], "closer to the knee");
+        assert_eq!(depth_bar_ends(Side::Right)[0], "closer to the knee");
+        let dir = temp_dir("png-depth");
+        let g = grid(60, 60, |i, _| i as f64);
+        for side in [Side::Left, Side::Right] {
+            let path = dir.join("depth.png");
+            write_depth_png(&path, &g, side).unwrap();
+            let (w, h, pixels) = decode(&path);
+            // The bar: the image's right strip; its brightest (closest)
+            // colour nearest the end the words say.
+            // viridis(1) is (253, 231, 37); the bar's end band is within a
+            // step of it.
+            let bright = |p: [u8; 3]| p[0] > 240 && p[1] > 220 && p[2] < 60;
+            let rows: Vec<usize> = (0..pixels.len())
+                .filter(|&k| k % w > w - BAR_AREA_W && bright(pixels[k]))
+                .map(|k| k / w)
+                .collect();
+            assert!(!rows.is_empty(), "{side:?}");
+            let mean = rows.iter().sum::<usize>() as f64 / rows.len() as f64;
+            let closer_at_top = depth_bar_ends(side)[0] == "closer to the knee";
+            assert_eq!(mean < h as f64 / 2.0, closer_at_top, "{side:?}: {mean}");
+        }
+        std::fs::remove_dir_all(dir).unwrap();
     }
 
     #[test]

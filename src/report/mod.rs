@@ -25,7 +25,7 @@ pub mod views;
 
 pub use self::document::{MAIN_BORDER, SUMMARY, verify_label};
 pub use self::render::{Camera, DepthImage, RgbImage, View};
-pub use self::run::{NodeCounts, Run, read_part_file};
+pub use self::run::{NodeCounts, Run, grid_spec, read_part_file};
 pub use self::verify::{Verdict, Verification};
 pub use self::views::{Views, render_views, small_multiple_angles};
 
@@ -98,6 +98,16 @@ pub enum ReportError {
         /// The directory.
         dir: PathBuf,
     },
+    /// A verification directory is not of the run reported on.
+    #[error("{} is not a verification of this run ({file}): {reason}", dir.display())]
+    Mismatch {
+        /// The directory.
+        dir: PathBuf,
+        /// The file that says so.
+        file: String,
+        /// What differs.
+        reason: String,
+    },
     /// An image could not be encoded.
     #[error("cannot encode a PNG: {0}")]
     Png(#[from] png::EncodingError),
@@ -149,6 +159,11 @@ pub fn build_report(options: &ReportOptions) -> Result<Report, ReportError> {
         .iter()
         .map(|d| Verification::read(d))
         .collect::<Result<Vec<_>, _>>()?;
+    // Refused before any rendering: another part's accuracy must never
+    // appear as this run's.
+    for v in &verifications {
+        v.check_against(&run.summary_json)?;
+    }
     let angles = small_multiple_angles(&run.summary.angles_deg);
     let masks = run.angle_masks(&angles)?;
     let masks: Vec<(f64, NodeCounts)> = angles.into_iter().zip(masks).collect();

@@ -171,21 +171,49 @@ impl Run {
     }
 }
 
-/// The run's grid: nodes on multiples of the pitch, as [`GridSpec`] lays
-/// them; `None` when the summary's origin is not on such a multiple.
-fn grid_spec(s: &Summary) -> Option<GridSpec> {
+/// The run's grid, identified by its integer node indices: SPEC puts the
+/// nodes on multiples of the pitch, so the origin's index `round(x0 / p)`
+/// and the pitch say exactly where every node is. `None` when the summary
+/// is not such a grid: a size of zero, a pitch that is not a positive
+/// number, or an origin further than [`ORIGIN_TOL`] (relative) from the
+/// multiple it rounds to.
+///
+/// The origin is not compared with `==`: it was written as `p * I0`, and
+/// a reader without correctly rounded float parsing may get it back one
+/// unit in the last place off (the run at the default 1.24 mm pitch whose
+/// origin z is `1.24 * -189 = -234.35999999999999`).
+pub fn grid_spec(s: &Summary) -> Option<GridSpec> {
     let p = s.pitch_mm;
     if !(p.is_finite() && p > 0.0) || s.grid_size[0] == 0 || s.grid_size[1] == 0 {
         return None;
     }
-    let spec = GridSpec {
+    let index = |origin: f64| -> Option<i64> {
+        let k = (origin / p).round();
+        let on_node = origin.is_finite()
+            && k.abs() < 1e15
+            && (origin - k * p).abs() <= ORIGIN_TOL * origin.abs().max(p);
+        on_node.then_some(k as i64)
+    };
+    Some(GridSpec {
         pitch: p,
-        i_origin: (s.grid_origin[0] / p).round() as i64,
-        j_origin: (s.grid_origin[1] / p).round() as i64,
+        i_origin: index(s.grid_origin[0])?,
+        j_origin: index(s.grid_origin[1])?,
         nx: s.grid_size[0],
         nz: s.grid_size[1],
-    };
-    (spec.x(0) == s.grid_origin[0] && spec.z(0) == s.grid_origin[1]).then_some(spec)
+    })
+}
+
+/// How far (relative to the coordinate, or to the pitch near 0) a grid
+/// coordinate read back from a file may be from the node it names: a few
+/// units in the last place of an f64 (2.2e-16 each), far below the 1e-6
+/// relative spacing of nodes of any grid of fewer than a million nodes.
+pub const ORIGIN_TOL: f64 = 1e-12;
+
+/// Whether the coordinate `v` (mm) read from a run file is the grid
+/// coordinate `node` (mm), within [`ORIGIN_TOL`] relative to the larger of
+/// the coordinate and `pitch`.
+pub fn same_coordinate(v: f64, node: f64, pitch: f64) -> bool {
+    (v - node).abs() <= ORIGIN_TOL * node.abs().max(pitch)
 }
 
 fn read_composite(path: &Path, spec: GridSpec) -> Result<NodeCounts, ReportError> {
@@ -282,7 +310,11 @@ impl CsvRows {
         let j: usize = self.parse(row, col("j"))?;
         let x: f64 = self.parse(row, col("x"))?;
         let z: f64 = self.parse(row, col("z"))?;
-        if i >= spec.nx || j >= spec.nz || x != spec.x(i) || z != spec.z(j) {
+        if i >= spec.nx
+            || j >= spec.nz
+            || !same_coordinate(x, spec.x(i), spec.pitch)
+            || !same_coordinate(z, spec.z(j), spec.pitch)
+        {
             return Err(self.bad(format!(
                 "node ({i}, {j}) at x = {x}, z = {z} is not a node of the run's {} x {} grid",
                 spec.nx, spec.nz
@@ -368,6 +400,42 @@ mod tests {
         c.count[2 * 5 + 2] = 5;
         c.y[2 * 5 + 2] = -2.0;
         c
+    }
+
+    fn summary_with(origin: [f64; 2], pitch: f64) -> Summary {
+        serde_json::from_value(serde_json::json!({
+            "kneeform_version": "0", "run_unix_time": 0, "input_file": "p.stl",
+            "sha256": "", "triangles": 1, "degenerate_triangles": 0,
+            "bbox_min": [0.0, 0.0, 0.0], "bbox_max": [1.0, 1.0, 1.0], "scale": 1.0,
+            "side": "left", "triangle_side_mm": 200.0, "triangle_side_assumed": true,
+            "radius_mm": 60.0, "thickness_mm": 120.0, "pitch_mm": pitch,
+            "grid_origin": origin, "grid_size": [3, 4], "sampled_nodes": 1,
+            "angles_deg": [0.0], "eps_mm": 0.001, "algorithm": "fast", "threads": 1,
+            "per_angle": [], "composite_nodes": 0, "composite_area_mm2": 0.0,
+            "timings": {"read_s": 0.0, "sample_s": 0.0, "push_slide_s": 0.0,
+                        "write_s": 0.0, "total_s": 0.0}
+        }))
+        .unwrap()
+    }
+
+    #[test]
+    fn the_readme_runs_origin_is_a_grid_even_a_last_place_off() {
+        // The README's console at 1.24 mm: z0 = 1.24 * -189, written as
+        // -234.35999999999999; read back by a parser that is one unit in
+        // the last place off, or exactly.
+        let z0: f64 = 1.24 * -189.0;
+        for z in [
+            z0,
+            f64::from_bits(z0.to_bits() + 1),
+            f64::from_bits(z0.to_bits() - 1),
+        ] {
+            let spec = grid_spec(&summary_with([1.24 * -210.0, z], 1.24)).expect("a grid");
+            assert_eq!((spec.i_origin, spec.j_origin), (-210, -189));
+        }
+        // Between nodes, or not a number: not a grid.
+        assert!(grid_spec(&summary_with([0.5, 0.0], 1.0)).is_none());
+        assert!(grid_spec(&summary_with([1.0 + 1e-9, 0.0], 1.0)).is_none());
+        assert!(grid_spec(&summary_with([0.0, 0.0], 0.0)).is_none());
     }
 
     #[test]

@@ -90,6 +90,152 @@ impl Verification {
     }
 }
 
+/// The keys of a strike rule, in `summary.json`, `verify.json` and
+/// `converge.json` alike: today's contact tolerance and the deflection
+/// rule's parameters. A key present in one file must be in the other, with
+/// the same value.
+pub const STRIKE_RULE_KEYS: [&str; 5] = ["eps_mm", "deflection_deg", "sigma", "e0_mm", "rate"];
+
+/// Relative tolerance of the numbers compared between a run and a
+/// verification: both were written from the same flags, so they agree to
+/// the last bits; this only forgives a reader's last-place rounding.
+const SAME_NUMBER: f64 = 1e-12;
+
+impl Verification {
+    /// Checks that this verification is of the run whose `summary.json` is
+    /// `run`: the same part (SHA-256 of the file, scale, side), knee-form,
+    /// pitch (in `verify.json`; in `converge.json`, the run's pitch among
+    /// the pitches studied) and strike rule. Fields are compared where
+    /// both files have them, except the part's SHA-256, which must be
+    /// there: without it the verification could be of any part.
+    pub fn check_against(&self, run: &Value) -> Result<(), ReportError> {
+        for (file, json) in [
+            ("verify.json", &self.verify),
+            ("converge.json", &self.converge),
+        ] {
+            if let Some(json) = json {
+                self.check_file(file, json, run)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn check_file(&self, file: &str, json: &Value, run: &Value) -> Result<(), ReportError> {
+        let refuse = |reason: String| ReportError::Mismatch {
+            dir: self.dir.clone(),
+            file: file.to_string(),
+            reason,
+        };
+        match (json.get("input_sha256"), run.get("sha256")) {
+            (Some(Value::String(a)), Some(Value::String(b))) if a == b => {}
+            (Some(Value::String(a)), Some(Value::String(b))) => {
+                return Err(refuse(format!(
+                    "it verified another part (SHA-256 {}..., the run's {}...)",
+                    short(a),
+                    short(b)
+                )));
+            }
+            _ => {
+                return Err(refuse(
+                    "it does not record the part's SHA-256 (input_sha256; written by an earlier kneeform), so it may be of another part: run it again".into(),
+                ));
+            }
+        }
+        for key in ["scale", "side"] {
+            if let (Some(a), Some(b)) = (json.get(key), run.get(key))
+                && !same(a, b)
+            {
+                return Err(refuse(format!("its {key} is {a}, the run's {b}")));
+            }
+        }
+        if let Some(knee) = json.get("knee_form_mm") {
+            let run_knee = Value::from(
+                ["triangle_side_mm", "radius_mm", "thickness_mm"]
+                    .iter()
+                    .map(|k| run.get(*k).cloned().unwrap_or(Value::Null))
+                    .collect::<Vec<_>>(),
+            );
+            if !same(knee, &run_knee) {
+                return Err(refuse(format!(
+                    "its knee-form L, R, W is {knee} mm, the run's {run_knee} mm"
+                )));
+            }
+        }
+        let run_pitch = run.get("pitch_mm").and_then(Value::as_f64);
+        if let (Some(p), Some(run_p)) = (json.get("pitch_mm").and_then(Value::as_f64), run_pitch)
+            && !close(p, run_p)
+        {
+            return Err(refuse(format!("its pitch is {p} mm, the run's {run_p} mm")));
+        }
+        if let (Some(Value::Array(ladder)), Some(run_p)) = (json.get("pitches_mm"), run_pitch)
+            && !ladder
+                .iter()
+                .filter_map(Value::as_f64)
+                .any(|p| close(p, run_p))
+        {
+            let ladder: Vec<String> = ladder.iter().map(Value::to_string).collect();
+            return Err(refuse(format!(
+                "its pitch ladder {} mm does not include the run's {run_p} mm",
+                ladder.join(", ")
+            )));
+        }
+        let rule = |v: &Value| -> Vec<&str> {
+            STRIKE_RULE_KEYS
+                .iter()
+                .copied()
+                .filter(|k| v.get(*k).is_some())
+                .collect()
+        };
+        let (mine, theirs) = (rule(json), rule(run));
+        if mine != theirs {
+            return Err(refuse(format!(
+                "its strike rule has {}, the run's {}",
+                list(&mine),
+                list(&theirs)
+            )));
+        }
+        for key in mine {
+            let (a, b) = (&json[key], &run[key]);
+            if !same(a, b) {
+                return Err(refuse(format!(
+                    "its strike rule differs: {key} is {a}, the run's {b}"
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Equal JSON values, numbers within [`SAME_NUMBER`] (relative).
+fn same(a: &Value, b: &Value) -> bool {
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => match (x.as_f64(), y.as_f64()) {
+            (Some(x), Some(y)) => close(x, y),
+            _ => false,
+        },
+        (Value::Array(x), Value::Array(y)) => {
+            x.len() == y.len() && x.iter().zip(y).all(|(a, b)| same(a, b))
+        }
+        _ => a == b,
+    }
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= SAME_NUMBER * a.abs().max(b.abs())
+}
+
+fn short(sha: &str) -> &str {
+    sha.get(..12).unwrap_or(sha)
+}
+
+fn list(keys: &[&str]) -> String {
+    if keys.is_empty() {
+        "none of its fields".into()
+    } else {
+        keys.join(", ")
+    }
+}
+
 fn optional_text(path: &Path) -> Result<Option<String>, ReportError> {
     match std::fs::read_to_string(path) {
         Ok(text) => Ok(Some(text)),
@@ -149,6 +295,89 @@ pub fn escape_pointer(key: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn run_json() -> Value {
+        serde_json::json!({
+            "sha256": "ab".repeat(32), "scale": 1.0, "side": "left",
+            "triangle_side_mm": 200.0, "radius_mm": 60.0, "thickness_mm": 120.0,
+            "pitch_mm": 1.24, "eps_mm": 0.001
+        })
+    }
+
+    fn verification(verify: Option<Value>, converge: Option<Value>) -> Verification {
+        Verification {
+            dir: PathBuf::from("v"),
+            verify,
+            verify_csv: None,
+            converge,
+            converge_csv: None,
+            figures: Vec::new(),
+        }
+    }
+
+    fn matching_verify() -> Value {
+        serde_json::json!({
+            "input_sha256": "ab".repeat(32), "scale": 1.0, "side": "left",
+            "knee_form_mm": [200.0, 60.0, 120.0], "pitch_mm": 1.24, "eps_mm": 0.001
+        })
+    }
+
+    #[test]
+    fn a_verification_of_the_same_run_setup_is_accepted() {
+        let run = run_json();
+        verification(Some(matching_verify()), None)
+            .check_against(&run)
+            .unwrap();
+        let converge = serde_json::json!({
+            "input_sha256": "ab".repeat(32), "knee_form_mm": [200.0, 60.0, 120.0],
+            "pitches_mm": [4.96, 2.48, 1.24], "eps_mm": 0.001
+        });
+        verification(None, Some(converge))
+            .check_against(&run)
+            .unwrap();
+    }
+
+    #[test]
+    fn every_kind_of_mismatch_is_refused_with_its_reason() {
+        let run = run_json();
+        let refused = |change: &dyn Fn(&mut Value)| -> String {
+            let mut v = matching_verify();
+            change(&mut v);
+            let err = verification(Some(v), None).check_against(&run).unwrap_err();
+            let text = err.to_string();
+            assert!(!text.contains('\n'), "{text}");
+            text
+        };
+        assert!(refused(&|v| v["input_sha256"] = "cd".repeat(32).into()).contains("another part"));
+        assert!(
+            refused(&|v| {
+                v.as_object_mut().unwrap().remove("input_sha256");
+            })
+            .contains("SHA-256")
+        );
+        assert!(refused(&|v| v["scale"] = 1000.0.into()).contains("scale"));
+        assert!(refused(&|v| v["side"] = "right".into()).contains("side"));
+        assert!(refused(&|v| v["knee_form_mm"][0] = 190.0.into()).contains("knee-form"));
+        assert!(refused(&|v| v["pitch_mm"] = 2.0.into()).contains("pitch"));
+        assert!(refused(&|v| v["eps_mm"] = 0.01.into()).contains("eps_mm"));
+        // A different rule altogether (the deflection rule's keys).
+        let text = refused(&|v| {
+            v.as_object_mut().unwrap().remove("eps_mm");
+            v["deflection_deg"] = 0.5.into();
+        });
+        assert!(
+            text.contains("deflection_deg") && text.contains("eps_mm"),
+            "{text}"
+        );
+        // A ladder without the run's pitch.
+        let converge = serde_json::json!({
+            "input_sha256": "ab".repeat(32), "pitches_mm": [8.0, 4.0, 2.0, 1.0], "eps_mm": 0.001
+        });
+        let err = verification(None, Some(converge))
+            .check_against(&run)
+            .unwrap_err();
+        assert!(err.to_string().contains("pitch ladder"), "{err}");
+    }
 
     #[test]
     fn scalars_walk_objects_and_keep_number_arrays_whole() {

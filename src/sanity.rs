@@ -1,0 +1,299 @@
+//! Sanity checks of a run's inputs and result: the mistakes a new user
+//! makes that would otherwise end in exit 0 with a wrong answer.
+//!
+//! * [`part_warnings`]: a part far smaller or larger than a knee-form (its
+//!   units: `--scale`), a surface that faces the other way (`--side`);
+//! * [`angle_warnings`]: angles outside the regulation's -30..+30 degrees;
+//! * [`result_warnings`]: a result with no colliding node at all.
+//!
+//! Each is a [`Warning`], one line of text, printed by the CLI before the
+//! work it concerns and recorded in `summary.json` (`warnings`), so that a
+//! reader of the results sees it too. None stops a run: every one of them
+//! can be what the user meant.
+//!
+//! **Invariant:** the checks read the inputs and the result; they change
+//! neither.
+
+use crate::kneeform::{Footprint, KneeForm};
+use crate::mesh::{Part, Side};
+
+/// The regulation's knee-form angles: -30..+30 degrees (SPEC, "The
+/// knee-form").
+pub const REGULATION_ANGLE_DEG: f64 = 30.0;
+
+/// A part whose larger xz extent is below the knee-form's divided by this
+/// is "much smaller than a knee-form". The knee-form's default footprint
+/// is about 320 mm across, so this is 16 mm: a console side read in metres
+/// (1.5 "mm") is caught, a small real switch or trim part (30 mm and up) is
+/// not.
+pub const SMALL_FACTOR: f64 = 20.0;
+
+/// A part whose larger xz extent is above the knee-form's times this is
+/// "much larger than a knee-form": with the default knee-form, 9.6 m, more
+/// than any car's interior (a part in micrometres, or scaled twice).
+pub const LARGE_FACTOR: f64 = 30.0;
+
+/// The part "faces +y" when the area of its triangles facing +y (by their
+/// winding, the STL convention) is more than this times the area facing
+/// -y. A closed solid has as much of each (ratio 1) and is not flagged; an
+/// open surface exported for the analysis is nearly all one way.
+pub const FACING_RATIO: f64 = 3.0;
+
+/// One finding, as one line of text.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Warning {
+    /// The part is much smaller than the knee-form.
+    #[error(
+        "the part is {extent_mm:.3} mm across, much smaller than the {knee_mm:.0} mm knee-form: if its file is in metres, pass --scale 1000 (in cm, --scale 10)"
+    )]
+    TooSmall {
+        /// The part's larger extent in x and z (mm, after `--scale`).
+        extent_mm: f64,
+        /// The knee-form footprint's larger extent (mm).
+        knee_mm: f64,
+    },
+    /// The part is much larger than the knee-form.
+    #[error(
+        "the part is {extent_mm:.0} mm across, {ratio:.0} times the {knee_mm:.0} mm knee-form: is its file in micrometres, or --scale applied twice?"
+    )]
+    TooLarge {
+        /// The part's larger extent in x and z (mm, after `--scale`).
+        extent_mm: f64,
+        /// The knee-form footprint's larger extent (mm).
+        knee_mm: f64,
+        /// `extent_mm / knee_mm`.
+        ratio: f64,
+    },
+    /// Most of the surface faces away from the side analysed.
+    #[error(
+        "{percent:.0}% of the part's surface (area-weighted normals) faces {faces}, but --side {side} analyses the face towards {analysed}: if the knee comes from {faces}, pass --side {other}"
+    )]
+    WrongSide {
+        /// The side analysed.
+        side: &'static str,
+        /// The other side.
+        other: &'static str,
+        /// Where the analysed face points (`-y` or `+y`).
+        analysed: &'static str,
+        /// Where most of the surface points.
+        faces: &'static str,
+        /// The share of the surface facing that way (%).
+        percent: f64,
+    },
+    /// Some angles are beyond the regulation's range.
+    #[error(
+        "angles {angles} degrees are outside the regulation's -30..+30: their results are not the regulation's"
+    )]
+    AnglesOutsideRegulation {
+        /// The angles, listed.
+        angles: String,
+    },
+    /// Nothing is struck.
+    #[error(
+        "no grid node is struck at any angle: if the part should be struck, check its units (--scale) and which face the knee meets (--side)"
+    )]
+    NothingStruck,
+}
+
+/// The knee-form footprint's larger extent in x or z at angle 0 (mm):
+/// `L sqrt(3)/2 + 2R` by `L + 2R`.
+pub fn knee_extent(knee: &KneeForm) -> f64 {
+    let fp = Footprint::new(knee, 0.0);
+    let (x0, x1) = fp.x_range();
+    let (z0, z1) = fp.z_range();
+    (x1 - x0).max(z1 - z0)
+}
+
+/// The areas of the part's surface facing +y and -y in the part's own
+/// frame (mm^2): each triangle's area times the y component of its unit
+/// normal by winding (counter-clockwise seen from outside), summed by sign.
+///
+/// Mirroring the right side (y -> -y) reverses a triangle's winding as it
+/// mirrors it, so the y component of the winding normal is the same in the
+/// analysis frame as in the part's: the sums read the part as it is.
+pub fn facing_areas(part: &Part) -> (f64, f64) {
+    let (mut plus, mut minus) = (0.0, 0.0);
+    for t in &part.triangles {
+        let (a, b, c) = (t[0], t[1], t[2]);
+        let (u, v) = (
+            [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+            [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+        );
+        // Half the y component of u x v: the projected area, signed.
+        let ny = 0.5 * (u[2] * v[0] - u[0] * v[2]);
+        if ny > 0.0 {
+            plus += ny;
+        } else {
+            minus -= ny;
+        }
+    }
+    (plus, minus)
+}
+
+/// The checks of a part read for `side` against `knee`: its size and its
+/// facing (see [`SMALL_FACTOR`], [`LARGE_FACTOR`], [`FACING_RATIO`]).
+pub fn part_warnings(part: &Part, side: Side, knee: &KneeForm) -> Vec<Warning> {
+    let mut warnings = Vec::new();
+    let bbox = part.bbox();
+    let extent_mm = (bbox.max[0] - bbox.min[0]).max(bbox.max[2] - bbox.min[2]);
+    let knee_mm = knee_extent(knee);
+    if extent_mm < knee_mm / SMALL_FACTOR {
+        warnings.push(Warning::TooSmall { extent_mm, knee_mm });
+    } else if extent_mm > knee_mm * LARGE_FACTOR {
+        warnings.push(Warning::TooLarge {
+            extent_mm,
+            knee_mm,
+            ratio: extent_mm / knee_mm,
+        });
+    }
+    let (plus, minus) = facing_areas(part);
+    let (analysed_area, away_area) = match side {
+        Side::Left => (minus, plus),
+        Side::Right => (plus, minus),
+    };
+    if away_area > FACING_RATIO * analysed_area {
+        let (side, other, analysed, faces) = match side {
+            Side::Left => ("left", "right", "-y", "+y"),
+            Side::Right => ("right", "left", "+y", "-y"),
+        };
+        warnings.push(Warning::WrongSide {
+            side,
+            other,
+            analysed,
+            faces,
+            percent: 100.0 * away_area / (plus + minus),
+        });
+    }
+    warnings
+}
+
+/// The angles (degrees) beyond the regulation's range, as one warning.
+pub fn angle_warnings(angles_deg: &[f64]) -> Vec<Warning> {
+    // Within rounding of a range's step arithmetic, 30 is 30.
+    let outside: Vec<String> = angles_deg
+        .iter()
+        .filter(|a| a.abs() > REGULATION_ANGLE_DEG + 1e-9)
+        .map(|a| a.to_string())
+        .collect();
+    if outside.is_empty() {
+        return Vec::new();
+    }
+    vec![Warning::AnglesOutsideRegulation {
+        angles: outside.join(", "),
+    }]
+}
+
+/// The checks of a result: `composite_nodes` is the number of nodes
+/// struck at some angle.
+pub fn result_warnings(composite_nodes: usize) -> Vec<Warning> {
+    if composite_nodes == 0 {
+        vec![Warning::NothingStruck]
+    } else {
+        Vec::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::Triangle;
+
+    /// A w x w square in the plane y = 0, wound to face -y (`toward_minus`)
+    /// or +y, plus `back` times its area wound the other way (at y = 50).
+    fn sheet(w: f64, toward_minus: bool, back: f64) -> Vec<Triangle> {
+        // (0,0,0) -> (w,0,0) -> (0,0,w): u x v = (0, -w^2, 0), facing -y.
+        let face = |y: f64, s: f64, minus: bool| -> Vec<Triangle> {
+            let a = [0.0, y, 0.0];
+            let b = [s, y, 0.0];
+            let c = [0.0, y, s];
+            let d = [s, y, s];
+            if minus {
+                vec![[a, b, c], [b, d, c]]
+            } else {
+                vec![[a, c, b], [b, c, d]]
+            }
+        };
+        let mut t = face(0.0, w, toward_minus);
+        if back > 0.0 {
+            t.extend(face(50.0, w * back.sqrt(), !toward_minus));
+        }
+        t
+    }
+
+    fn part(t: Vec<Triangle>, side: Side) -> Part {
+        Part::from_triangles("sheet", t, 1.0, side).unwrap()
+    }
+
+    #[test]
+    fn facing_areas_follow_the_winding_in_the_parts_own_frame() {
+        let (plus, minus) = facing_areas(&part(sheet(10.0, true, 0.0), Side::Left));
+        assert_eq!((plus, minus), (0.0, 100.0));
+        // Read as the right side (mirrored), the same file still faces -y.
+        let (plus, minus) = facing_areas(&part(sheet(10.0, true, 0.0), Side::Right));
+        assert_eq!((plus, minus), (0.0, 100.0));
+        let (plus, minus) = facing_areas(&part(sheet(10.0, false, 0.25), Side::Left));
+        assert!((plus - 100.0).abs() < 1e-9 && (minus - 25.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_surface_facing_away_from_the_side_is_flagged_and_a_solid_is_not() {
+        let knee = KneeForm::default();
+        let wrong = |w: &Warning| matches!(w, Warning::WrongSide { .. });
+        // Facing +y, analysed as left: flagged, and the message says what to do.
+        let w = part_warnings(
+            &part(sheet(400.0, false, 0.0), Side::Left),
+            Side::Left,
+            &knee,
+        );
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(w[0].to_string().contains("--side right"), "{}", w[0]);
+        // The same file as the right side: fine.
+        let p = part(sheet(400.0, false, 0.0), Side::Right);
+        assert!(part_warnings(&p, Side::Right, &knee).is_empty());
+        // Facing -y read as the right side: flagged the other way.
+        let p = part(sheet(400.0, true, 0.0), Side::Right);
+        let w = part_warnings(&p, Side::Right, &knee);
+        assert!(w.iter().any(wrong) && w[0].to_string().contains("--side left"));
+        // Just under the ratio (a back face of a third of the front): not
+        // flagged; a closed solid (equal areas): not flagged.
+        let p = part(sheet(400.0, false, 0.34), Side::Left);
+        assert!(!part_warnings(&p, Side::Left, &knee).iter().any(wrong));
+        let p = part(sheet(400.0, false, 0.32), Side::Left);
+        assert!(part_warnings(&p, Side::Left, &knee).iter().any(wrong));
+        let p = part(sheet(400.0, false, 1.0), Side::Left);
+        assert!(part_warnings(&p, Side::Left, &knee).is_empty());
+    }
+
+    #[test]
+    fn parts_far_from_a_knee_forms_size_are_flagged() {
+        let knee = KneeForm::default();
+        assert!((knee_extent(&knee) - 320.0).abs() < 1e-9);
+        let size =
+            |w: f64| part_warnings(&part(sheet(w, true, 0.0), Side::Left), Side::Left, &knee);
+        // A 1.5 m console read in metres.
+        let w = size(1.5);
+        assert!(matches!(w[..], [Warning::TooSmall { .. }]), "{w:?}");
+        assert!(w[0].to_string().contains("--scale 1000"));
+        assert!(size(15.9).len() == 1 && size(16.1).is_empty());
+        assert!(size(1500.0).is_empty() && size(9_500.0).is_empty());
+        assert!(matches!(size(1.5e6)[..], [Warning::TooLarge { .. }]));
+        // A smaller knee-form moves the bounds.
+        let small = KneeForm {
+            triangle_side: 20.0,
+            radius: 6.0,
+            thickness: 12.0,
+        };
+        let p = part(sheet(10.0, true, 0.0), Side::Left);
+        assert!(part_warnings(&p, Side::Left, &small).is_empty());
+    }
+
+    #[test]
+    fn angles_beyond_thirty_degrees_and_an_empty_result_are_flagged() {
+        assert!(angle_warnings(&[-30.0, 0.0, 30.0, 30.0 + 1e-12]).is_empty());
+        let w = angle_warnings(&[-45.0, 0.0, 30.5]);
+        assert_eq!(w.len(), 1);
+        assert!(w[0].to_string().contains("-45, 30.5"), "{}", w[0]);
+        assert_eq!(result_warnings(0), [Warning::NothingStruck]);
+        assert!(result_warnings(1).is_empty());
+    }
+}
