@@ -81,8 +81,10 @@ pub struct Summary {
     /// Rounding tolerance e0 (mm): a point is a contact when it sticks out
     /// past the face level by more than this.
     pub e0_mm: f64,
-    /// How a contact's deflection rate is estimated: `x-slope`, SPEC's
-    /// baseline (the rise from the node one pitch behind it).
+    /// How a contact's deflection rate is estimated: `x-slope` (the
+    /// default, SPEC's baseline: the rise from the node one pitch behind
+    /// it) or `capped` (that rise capped by the node's drop below the face
+    /// level over one pitch).
     pub rate: String,
     /// `fast` or `paper`.
     pub algorithm: crate::Algorithm,

@@ -1,6 +1,7 @@
 //! The fast path and the paper-literal path against a brute-force
 //! transcription of SPEC, on seeded random grids.
 
+use kneeform::strike::RateEstimate;
 use kneeform::{
     Algorithm, EngineOptions, Footprint, GridFootprint, HeightGrid, KneeForm, StrikeRule,
     colliding_masks,
@@ -47,9 +48,15 @@ fn check_against_brute_force(nx: usize, nz: usize, pitch: f64, knee: &KneeForm) 
     check_rules(nx, nz, pitch, knee, &default_rules())
 }
 
-/// SPEC's three thresholds with the default rounding tolerance.
-fn default_rules() -> [StrikeRule; 3] {
-    DEFLECTIONS_DEG.map(|d| StrikeRule::new(d, StrikeRule::DEFAULT_E0))
+/// SPEC's three thresholds with the default rounding tolerance, under
+/// SPEC's baseline rate and the capped one.
+fn default_rules() -> Vec<StrikeRule> {
+    [RateEstimate::XSlope, RateEstimate::Capped]
+        .iter()
+        .flat_map(|&r| {
+            DEFLECTIONS_DEG.map(|d| StrikeRule::new(d, StrikeRule::DEFAULT_E0).with_rate(r))
+        })
+        .collect()
 }
 
 /// Both implementations equal brute force under each of `rules`, on
@@ -69,7 +76,10 @@ fn check_rules(
     let fine = SEEDS[..2]
         .iter()
         .map(|&seed| random_grid_quantised(seed ^ pitch.to_bits(), nx, nz, pitch, 0.001));
-    let pairs: Vec<(f64, f64)> = rules.iter().map(|r| (r.e0, r.sigma)).collect();
+    let pairs: Vec<(f64, f64, bool)> = rules
+        .iter()
+        .map(|r| (r.e0, r.sigma, r.rate == RateEstimate::Capped))
+        .collect();
     let mut collisions = vec![0; rules.len()];
     let mut contacts_not_struck = vec![0; rules.len()];
     for (s, grid) in coarse.chain(fine).enumerate() {
@@ -78,10 +88,7 @@ fn check_rules(
             knee,
             &ANGLES,
             Algorithm::Fast,
-            StrikeRule {
-                e0: StrikeRule::DEFAULT_E0,
-                sigma: 0.0,
-            },
+            StrikeRule::new(0.0, StrikeRule::DEFAULT_E0),
         );
         let brute: Vec<(Vec<Vec<u8>>, usize)> = ANGLES
             .iter()
@@ -201,10 +208,17 @@ fn fast_and_paper_equal_brute_force_at_exact_thresholds() {
         StrikeRule {
             e0: 0.5,
             sigma: 0.0,
+            rate: RateEstimate::XSlope,
         },
         StrikeRule {
             e0: 1e-6,
             sigma: 0.125,
+            rate: RateEstimate::XSlope,
+        },
+        StrikeRule {
+            e0: 1e-6,
+            sigma: 0.125,
+            rate: RateEstimate::Capped,
         },
     ];
     let counts = check_rules(50, 40, 4.0, &KneeForm::default(), &rules);

@@ -187,17 +187,18 @@ pub fn brute_force(
     e0: f64,
     sigma: f64,
 ) -> (Vec<u8>, usize) {
-    let (mut masks, placed) = brute_force_rules(grid, knee, angle_deg, &[(e0, sigma)]);
+    let (mut masks, placed) = brute_force_rules(grid, knee, angle_deg, &[(e0, sigma, false)]);
     (masks.remove(0), placed)
 }
 
-/// [`brute_force`] for several rules `(e0, sigma)` at once (the geometry is
-/// the costly part): one mask per rule.
+/// [`brute_force`] for several rules `(e0, sigma, capped)` at once (the
+/// geometry is the costly part): one mask per rule; `capped` takes the
+/// rate as `min(x-slope, (f - h) / p)`.
 pub fn brute_force_rules(
     grid: &HeightGrid,
     knee: &KneeForm,
     angle_deg: f64,
-    rules: &[(f64, f64)],
+    rules: &[(f64, f64, bool)],
 ) -> (Vec<Vec<u8>>, usize) {
     let GridSpec {
         nx, nz, pitch: p, ..
@@ -234,7 +235,7 @@ pub fn brute_force_rules(
             }
             placed += 1;
             front.sort_by(|x, y| x.0.total_cmp(&y.0));
-            for (&(e0, sigma), mask) in rules.iter().zip(&mut masks) {
+            for (&(e0, sigma, capped), mask) in rules.iter().zip(&mut masks) {
                 let mut f = yr;
                 let mut k = 0;
                 while k < front.len() {
@@ -254,10 +255,17 @@ pub fn brute_force_rules(
                         } else {
                             f64::INFINITY
                         };
-                        let rate = if behind.is_finite() {
+                        let x_slope = if behind.is_finite() {
                             (behind - h) / p
                         } else {
                             (f - h) / p
+                        };
+                        // The capped estimate: no more than the node's drop
+                        // below the level over one pitch.
+                        let rate = if capped {
+                            x_slope.min((f - h) / p)
+                        } else {
+                            x_slope
                         };
                         if h < f - e0 && rate > sigma {
                             mask[node] = 1;

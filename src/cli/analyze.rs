@@ -290,7 +290,7 @@ fn summarize(
         deflection_deg: setup.rule.deflection_deg(),
         sigma: setup.rule.sigma,
         e0_mm: setup.rule.e0,
-        rate: "x-slope".into(),
+        rate: setup.rule.rate.name().into(),
         algorithm: setup.algorithm,
         threads: rayon::current_num_threads(),
         per_angle: masks

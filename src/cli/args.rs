@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, bail, ensure};
 use clap::{Args, Parser, Subcommand};
+use kneeform::strike::RateEstimate;
 use kneeform::{Algorithm, KneeForm, Side, StrikeRule};
 
 /// UN Regulation No. 21 knee-form inspection: which areas of an interior
@@ -96,6 +97,15 @@ pub struct SetupArgs {
     /// engineering tolerance.
     #[arg(long, default_value_t = StrikeRule::DEFAULT_E0, value_name = "MM")]
     pub e0: f64,
+    /// How a contact's deflection rate is estimated on the grid: `x-slope`
+    /// (default, SPEC's baseline): the surface's rise over one pitch from
+    /// the point behind it; `capped`: that rise capped by how far the point
+    /// sticks out past the knee-form's face over one pitch, so that a point
+    /// the knee-form crosses nearly level is no strike however steep the
+    /// surface behind it (fewer false alarms on near-level crests, later
+    /// strikes where footprint rows interleave: results/README.md).
+    #[arg(long, value_enum, default_value_t = RateEstimate::XSlope, value_name = "RATE")]
+    pub rate: RateEstimate,
     /// Grid origin X,Z (mm), snapped to multiples of the pitch. Default: the
     /// part's xz bounding box grown by the knee-form's extent.
     #[arg(
@@ -384,7 +394,7 @@ impl SetupArgs {
                 thickness: self.thickness,
             },
             angles: parse_angles(&self.angles)?,
-            rule: StrikeRule::new(self.deflection, self.e0),
+            rule: StrikeRule::new(self.deflection, self.e0).with_rate(self.rate),
             grid,
             algorithm: self.algorithm,
             threads: self.threads,

@@ -173,7 +173,8 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
             setup.knee.radius,
             setup.knee.thickness,
         ],
-        eps_mm: setup.eps,
+        sigma: setup.rule.sigma,
+        rate: setup.rule.rate.name().into(),
         pitches_mm: pitches.clone(),
         fits: fitted
             .iter()

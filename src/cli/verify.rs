@@ -46,6 +46,30 @@ pub fn oracle_options(knee: &KneeForm, pitch: f64, x_min: f64) -> OracleOptions 
     }
 }
 
+/// What would resolve a failure, in words: the pitch a first-order error
+/// (`error ~ C p`, what the evidence in `results/` shows for push, miss and
+/// first contact on smooth parts) would need; a disagreement where the grid
+/// strikes nothing, or one that is not first order, may need more, which
+/// `kneeform converge` measures.
+fn resolving_pitch(pitch: f64, tolerance: f64, metric: &str, value: f64) -> String {
+    if !(value.is_finite() && value > tolerance) {
+        return String::new();
+    }
+    let mut p = pitch;
+    while p * value / pitch > tolerance && p > pitch / 64.0 {
+        p /= 2.0;
+    }
+    let what = if metric.starts_with("unmatched_deflection") {
+        "the grid strikes nothing where the exact knee-form is deflected: a feature narrower than the pitch (a rib, an edge, a boss) that no node samples; "
+    } else {
+        ""
+    };
+    format!(
+        "; {what}if the error is first order in the pitch, {p} mm would bring it within {tolerance} mm (`kneeform converge --pitches {pitch},{}` measures it)",
+        p
+    )
+}
+
 /// The tie band's rule in words, for the summaries.
 pub fn tie_band_rule(per_mm: f64) -> String {
     format!(
@@ -132,7 +156,9 @@ pub fn verify(
             setup.knee.thickness,
         ],
         deflection_deg: setup.rule.deflection_deg(),
+        sigma: setup.rule.sigma,
         e0_mm: setup.rule.e0,
+        rate: setup.rule.rate.name().into(),
         tie_band: comparison.band,
         tie_band_rule: tie_band_rule(tie_band_per_mm),
         area_distance_decided_mm: Some(comparison.stat("area_distance_decided").max).filter(|_| {
@@ -171,6 +197,7 @@ pub fn verify(
                 angle_deg: row.angle_deg,
                 metric,
                 value,
+                at: row.worst_x.zip(row.worst_z).map(|(x, z)| [x, z]),
             })
             .collect(),
         timings: VerifyTimings {
@@ -266,9 +293,17 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
         Ok(ExitCode::SUCCESS)
     } else {
         let worst = s.worst_starts.first().map_or(String::new(), |w| {
+            let at = w.at.map_or(String::new(), |[x, z]| {
+                format!(" (the disagreement lies at x = {x:.1}, z = {z:.1} mm)")
+            });
             format!(
-                "; worst: {} = {:.3} mm at start ({}, {}) angle {}",
-                w.metric, w.value, w.x, w.z, w.angle_deg
+                "; worst: {} = {:.3} mm, start ({}, {}) angle {}{at}{}",
+                w.metric,
+                w.value,
+                w.x,
+                w.z,
+                w.angle_deg,
+                resolving_pitch(s.pitch_mm, s.tolerance_mm, &w.metric, w.value)
             )
         });
         eprintln!(

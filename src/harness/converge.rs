@@ -109,9 +109,11 @@ pub struct ConvergeSummary {
     /// Knee-form L, R, W (mm).
     #[serde(default)]
     pub knee_form_mm: [f64; 3],
-    /// Contact tolerance eps (mm): the strike rule of every pitch.
-    #[serde(default)]
-    pub eps_mm: f64,
+    /// The strike rule of every pitch, as in `summary.json`: sigma =
+    /// tan(deflection) and how the grid's rate is estimated.
+    pub sigma: f64,
+    /// `capped` or `x-slope` (`summary.json`'s `rate`).
+    pub rate: String,
     /// The pitches, coarsest first (mm).
     pub pitches_mm: Vec<f64>,
     /// Per metric, the fit of its max error, where it has one.

@@ -201,6 +201,25 @@ pub struct StartComparison {
     pub exact_strikes: usize,
     /// Exact contacts in the tie band.
     pub undecided: usize,
+    /// The decided exact strikes, xz (mm), in the order of `miss_decided`.
+    pub decided_points: Vec<[f64; 2]>,
+    /// The grid strikes, xz (mm), in the order of `false_alarm`.
+    pub grid_points: Vec<[f64; 2]>,
+}
+
+impl StartComparison {
+    /// Where the worst decided disagreement of this start lies (xz, mm)
+    /// and how large it is: the decided exact strike furthest from the
+    /// grid's strikes or the grid strike furthest from every possible exact
+    /// one, whichever is further (infinite distances first).
+    pub fn worst_decided_point(&self) -> Option<([f64; 2], f64)> {
+        self.decided_points
+            .iter()
+            .zip(&self.miss_decided)
+            .chain(self.grid_points.iter().zip(&self.false_alarm_decided))
+            .map(|(&p, &d)| (p, d))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+    }
 }
 
 fn xz(p: [f64; 3]) -> [f64; 2] {
@@ -292,6 +311,8 @@ pub fn compare(grid: &GridTrace, exact: &StartTrace, band: &TieBand) -> StartCom
         unmatched_deflection: deflection(&|c| c.strike),
         unmatched_deflection_decided: deflection(&|c| c.decision == Decision::Strike),
         exact_strikes: strikes.len(),
+        decided_points: decided.clone(),
+        grid_points: grid_points.clone(),
         undecided: classified
             .iter()
             .filter(|c| c.decision == Decision::Undecided)

@@ -59,8 +59,12 @@ pub struct VerifySummary {
     pub knee_form_mm: [f64; 3],
     /// Deflection threshold delta (degrees).
     pub deflection_deg: f64,
+    /// The same threshold as a rate, `sigma = tan(delta)`.
+    pub sigma: f64,
     /// Rounding tolerance e0 (mm).
     pub e0_mm: f64,
+    /// How the grid's deflection rate is estimated (`capped` or `x-slope`).
+    pub rate: String,
     /// The tie band at this pitch: `sigma`, `m`, and its bounds as rates.
     pub tie_band: TieBand,
     /// The tie band's rule, in words.
@@ -114,6 +118,9 @@ pub struct WorstStart {
     pub metric: String,
     /// Its value (mm).
     pub value: f64,
+    /// Where the disagreement lies, `[x, z]` (mm, analysis frame): the
+    /// missed exact strike or the false-alarm grid strike.
+    pub at: Option<[f64; 2]>,
 }
 
 /// Seconds spent by each side.

@@ -155,6 +155,12 @@ pub struct VerifyRow {
     pub exact_undecided: usize,
     /// Grid strikes.
     pub grid_colliding: usize,
+    /// x of the worst decided disagreement of this start (mm, analysis
+    /// frame): the decided exact strike the grid missed furthest, or the
+    /// grid strike furthest from any possible exact one.
+    pub worst_x: Option<f64>,
+    /// Its z (mm).
+    pub worst_z: Option<f64>,
 }
 
 /// Counts of a comparison.
@@ -350,6 +356,8 @@ pub fn compare_grid(
                 exact_strikes: cmp.exact_strikes,
                 exact_undecided: cmp.undecided,
                 grid_colliding: cmp.false_alarm.len(),
+                worst_x: cmp.worst_decided_point().map(|(p, _)| p[0]),
+                worst_z: cmp.worst_decided_point().map(|(p, _)| p[1]),
             };
             let grid_nodes = g.colliding.iter().map(|c| c.node).collect();
             (row, cmp, grid_nodes, snapped, area)

@@ -410,7 +410,8 @@ mod tests {
             "side": "left", "triangle_side_mm": 200.0, "triangle_side_assumed": true,
             "radius_mm": 60.0, "thickness_mm": 120.0, "pitch_mm": pitch,
             "grid_origin": origin, "grid_size": [3, 4], "sampled_nodes": 1,
-            "angles_deg": [0.0], "eps_mm": 0.001, "algorithm": "fast", "threads": 1,
+            "angles_deg": [0.0], "deflection_deg": 0.5, "sigma": 0.008726867790758,
+            "e0_mm": 1e-6, "rate": "x-slope", "algorithm": "fast", "threads": 1,
             "per_angle": [], "composite_nodes": 0, "composite_area_mm2": 0.0,
             "timings": {"read_s": 0.0, "sample_s": 0.0, "push_slide_s": 0.0,
                         "write_s": 0.0, "total_s": 0.0}
