@@ -88,47 +88,10 @@ fn quick<'a>(part: &'a str, out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     args
 }
 
-/// Headless Chromium, when installed.
-fn chromium() -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    ["chromium", "chromium-browser"].iter().find_map(|name| {
-        std::env::split_paths(&path)
-            .map(|d| d.join(name))
-            .find(|p| p.is_file())
-    })
-}
-
 /// Screenshots `page` in headless Chromium; the RGB pixels, or `None` when
 /// Chromium is not installed.
 fn screenshot(page: &Path, dir: &Path) -> Option<(usize, usize, Vec<[u8; 3]>)> {
-    let Some(browser) = chromium() else {
-        eprintln!("skipped the browser check: chromium not installed (CI installs it in .ci/run)");
-        return None;
-    };
-    let shot = dir.join("shot.png");
-    let out = Command::new(browser)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--hide-scrollbars",
-            "--window-size=1200,1600",
-        ])
-        .arg(format!(
-            "--user-data-dir={}",
-            dir.join("chromium-profile").display()
-        ))
-        .arg(format!("--screenshot={}", shot.display()))
-        .arg(format!("file://{}", page.display()))
-        .output()
-        .expect("chromium runs");
-    assert!(shot.is_file(), "no screenshot: {}", stderr(&out));
-    Some(decode_png(&std::fs::read(&shot).unwrap()))
+    crate::util::screenshot(page, dir).map(|png| decode_png(&png))
 }
 
 fn decode_png(bytes: &[u8]) -> (usize, usize, Vec<[u8; 3]>) {

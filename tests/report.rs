@@ -611,53 +611,17 @@ fn a_changed_part_is_refused_with_a_clear_message() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
-/// Headless Chromium, when installed.
-fn chromium() -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    ["chromium", "chromium-browser"].iter().find_map(|name| {
-        std::env::split_paths(&path)
-            .map(|d| d.join(name))
-            .find(|p| p.is_file())
-    })
-}
-
 #[test]
 fn the_report_renders_in_headless_chromium() {
-    let Some(browser) = chromium() else {
-        eprintln!("skipped: chromium not installed (CI installs it in .ci/run)");
-        return;
-    };
     let dir = step_run("report-chromium", "left");
     ok(
         kneeform(&dir, &["report", "run", "--out", "report.html"]),
         "report",
     );
-    let profile = dir.join("chromium-profile");
-    let shot = dir.join("shot.png");
-    let out = Command::new(&browser)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--hide-scrollbars",
-        ])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .arg(format!("--screenshot={}", shot.display()))
-        .arg("--window-size=1200,1600")
-        .arg(format!("file://{}", dir.join("report.html").display()))
-        .output()
-        .expect("chromium runs");
-    assert!(
-        shot.is_file(),
-        "no screenshot: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let img = Image::decode(&std::fs::read(&shot).unwrap());
+    let Some(png) = crate::util::screenshot(&dir.join("report.html"), &dir) else {
+        return;
+    };
+    let img = Image::decode(&png);
     assert_eq!((img.width, img.height), (1200, 1600));
 
     // Not blank: text, the part's shading and the colour ramp give many

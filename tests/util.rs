@@ -375,3 +375,51 @@ pub fn lines(from: f64, to: f64, step: f64, extra: &[f64]) -> Vec<f64> {
     v.dedup();
     v
 }
+
+/// Headless Chromium, when installed.
+fn chromium() -> Option<std::path::PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    ["chromium", "chromium-browser"].iter().find_map(|name| {
+        std::env::split_paths(&path)
+            .map(|d| d.join(name))
+            .find(|p| p.is_file())
+    })
+}
+
+/// Screenshots the page `page` in headless Chromium at 1200 x 1600, with
+/// its profile and the shot in `dir`; the PNG's bytes, or `None` (said on
+/// stderr) when Chromium is not installed (CI installs it in .ci/run).
+pub fn screenshot(page: &std::path::Path, dir: &std::path::Path) -> Option<Vec<u8>> {
+    let Some(browser) = chromium() else {
+        eprintln!("skipped the browser check: chromium not installed (CI installs it in .ci/run)");
+        return None;
+    };
+    let shot = dir.join("shot.png");
+    let out = std::process::Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--hide-scrollbars",
+            "--window-size=1200,1600",
+        ])
+        .arg(format!(
+            "--user-data-dir={}",
+            dir.join("chromium-profile").display()
+        ))
+        .arg(format!("--screenshot={}", shot.display()))
+        .arg(format!("file://{}", page.display()))
+        .output()
+        .expect("chromium runs");
+    assert!(
+        shot.is_file(),
+        "no screenshot: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    Some(std::fs::read(&shot).expect("the screenshot"))
+}

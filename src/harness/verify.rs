@@ -396,11 +396,19 @@ pub fn compare_grid(
             "first_contact_error_decided",
             &Vec::from_iter(cmp.first_contact_error_decided),
         );
-        counts.unmatched_exact += push("miss_distance", &cmp.miss);
-        counts.unmatched_exact_decided += push("miss_distance_decided", &cmp.miss_decided);
-        counts.unmatched_grid += push("false_alarm_distance", &cmp.false_alarm);
-        counts.unmatched_grid_decided +=
-            push("false_alarm_distance_decided", &cmp.false_alarm_decided);
+        // A start the oracle failed on has no exact answer: it is counted
+        // as a failure, not as grid strikes without an exact one.
+        let judged = row.status != "oracle_failed";
+        let unmatched_exact = push("miss_distance", &cmp.miss);
+        let unmatched_exact_decided = push("miss_distance_decided", &cmp.miss_decided);
+        let unmatched_grid = push("false_alarm_distance", &cmp.false_alarm);
+        let unmatched_grid_decided = push("false_alarm_distance_decided", &cmp.false_alarm_decided);
+        if judged {
+            counts.unmatched_exact += unmatched_exact;
+            counts.unmatched_exact_decided += unmatched_exact_decided;
+            counts.unmatched_grid += unmatched_grid;
+            counts.unmatched_grid_decided += unmatched_grid_decided;
+        }
         push("unmatched_deflection", &cmp.unmatched_deflection);
         push(
             "unmatched_deflection_decided",
@@ -485,6 +493,44 @@ impl Comparison {
             && c.oracle_not_placed == 0
             && c.oracle_failed == 0
             && c.unmatched_grid_decided == 0
+    }
+
+    /// Why a comparison fails `tolerance`, one phrase per reason (empty
+    /// when it passes).
+    pub fn failures(&self, tolerance: f64) -> Vec<String> {
+        let c = &self.counts;
+        let mut why: Vec<String> = self
+            .stats
+            .iter()
+            .filter(|(m, s)| DECIDED_METRICS.contains(&m.as_str()) && s.max > tolerance)
+            .map(|(m, s)| format!("{m} {:.3} mm", s.max))
+            .collect();
+        if self
+            .area
+            .iter()
+            .any(|a| !(a.miss_decided.is_finite() && a.false_alarm_decided.is_finite()))
+        {
+            why.push("area distance infinite (one side strikes nothing)".into());
+        }
+        for (n, what) in [
+            (
+                c.oracle_failed,
+                "oracle failures (no exact answer for those starts)",
+            ),
+            (
+                c.oracle_not_placed,
+                "starts placed by the grid but not by the oracle",
+            ),
+            (
+                c.unmatched_grid_decided,
+                "grid strikes with no possible exact one in their start",
+            ),
+        ] {
+            if n > 0 {
+                why.push(format!("{n} {what}"));
+            }
+        }
+        why
     }
 
     /// The statistics of metric `name`.
