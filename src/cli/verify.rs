@@ -284,6 +284,11 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
         c.unmatched_grid,
         c.unmatched_grid_decided
     );
+    if c.exact_strikes == 0 && result.comparison.rows.iter().all(|r| r.grid_colliding == 0) {
+        eprintln!(
+            "kneeform: warning: neither the grid nor the exact knee-form strikes anything on these starts: a pass here proves only that (a part smaller than the knee-form, or its surface on the other side: see --scale and --side)"
+        );
+    }
     let mm = |v: Option<f64>| v.map_or("infinite".to_string(), |v| format!("{v:.3} mm"));
     eprintln!(
         "{:>29}: decided {} (all strikes, undecided included: {})",
