@@ -335,3 +335,35 @@ fn part_mirrored_in_z_gives_the_composite_mirrored_with_angles_swapped() {
     assert_ne!(at(-30), at(30));
     std::fs::remove_dir_all(&scratch).unwrap();
 }
+
+/// A verification where neither side strikes anything passes, but says so:
+/// a pass on nothing is no evidence. The ramp, where everything in front
+/// strikes, passes at 4 mm without that warning.
+#[test]
+fn verify_warns_when_nothing_is_struck_on_either_side() {
+    let dir = scratch_dir("verify-nothing");
+    let scenarios = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    let run = |part: &str, out: &str| {
+        kneeform(&[
+            "verify",
+            scenarios.join(part).to_str().unwrap(),
+            "--pitch",
+            "4",
+            "--angles=0",
+            "--starts",
+            "10",
+            "--tolerance",
+            "10",
+            "--out",
+            dir.join(out).to_str().unwrap(),
+        ])
+    };
+    let flat = run("flat-wall.toml", "flat");
+    let stderr = String::from_utf8_lossy(&flat.stderr);
+    assert_eq!(flat.status.code(), Some(0), "{stderr}");
+    assert!(stderr.contains("strikes anything"), "{stderr}");
+    let ramp = run("ramp.toml", "ramp");
+    let stderr = String::from_utf8_lossy(&ramp.stderr);
+    assert!(!stderr.contains("strikes anything"), "{stderr}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
