@@ -613,6 +613,14 @@ fn report_refuses_a_verification_of_another_part_or_setup() {
         ],
     );
     assert!(converge.status.success(), "{}", stderr(&converge));
+    // Each pitch's per-start rows: a header and one row per start and
+    // angle (3 starts, one angle).
+    for pitch in [16, 8] {
+        let rows = std::fs::read_to_string(dir.join(format!("ladder/verify_{pitch}mm.csv")))
+            .expect("the pitch's per-start rows");
+        assert_eq!(rows.lines().count(), 1 + 3, "{rows}");
+        assert!(rows.starts_with("i,j,angle_deg,status"), "{rows}");
+    }
     check("ladder", "pitch ladder");
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -218,6 +218,15 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
         }
     }
     csv.flush()?;
+    // Every pitch's per-start rows, as `verify.csv` has them: where each
+    // figure of converge.csv comes from.
+    for r in &results {
+        let mut rows = csv::Writer::from_path(out.path(format!("verify_{}mm.csv", r.pitch)))?;
+        for row in &r.comparison.rows {
+            rows.serialize(row)?;
+        }
+        rows.flush()?;
+    }
     std::fs::write(
         out.path("converge.json"),
         serde_json::to_string_pretty(&summary)? + "\n",
