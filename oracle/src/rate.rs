@@ -48,14 +48,16 @@
 //!    error is about twice the actual one. Where `-df/ds` has a local
 //!    maximum between the chords, both chords fall short of it by a second
 //!    order amount, `|f'''| ds^2 / 6`.
-//! 3. *Next to a jump.* The run's side is exact; the other side's chord
+//! 3. *Next to a jump.* The run's side is exact up to rounding; the other side's chord
 //!    stands for its one-sided rate with an error estimated by its
 //!    difference to the next short chord further out, which measures
 //!    `K (ds + ds') / 2 >= K ds / 2`. A contact with no such chord (a
 //!    touch isolated between runs) has its chord slope as its error.
 //! 4. *Rounding.* A cast's travel carries parry's gap error
 //!    (`jump_tolerance`) along the contact normal, which moves a chord
-//!    slope by up to `2 jump_tolerance sqrt(1 + c^2) / ds`: added.
+//!    slope by up to `2 jump_tolerance sqrt(1 + c^2) / ds`: added, to every
+//!    chord, runs and witness switches included (a switch at nearly the
+//!    same travel has a tiny `ds`, so its slope is mostly rounding).
 //!
 //! `rate_error` is the half-width of the interval around `rate` that then
 //! holds SPEC's rate (the larger one-sided one): each side `i` gives
@@ -105,8 +107,10 @@ enum Chord {
     /// A piece of the curve along one surface: its slope and the slope's
     /// rounding error.
     Short { slope: f64, rounding: f64 },
-    /// A straight run: its slope is its rate.
-    Long { slope: f64 },
+    /// A straight run, or a switch of the witness between features at
+    /// nearly the same travel: its slope is its rate, known to within the
+    /// casts' rounding over its travel.
+    Long { slope: f64, rounding: f64 },
 }
 
 impl Chord {
@@ -120,11 +124,11 @@ impl Chord {
             .map(|i| (b.witness[i] - a.witness[i]).powi(2))
             .sum::<f64>()
             .sqrt();
+        let rounding = 2.0 * options.jump_tolerance * slope.hypot(1.0) / ds.abs();
         if ds <= options.witness_tolerance && witness_gap <= options.witness_tolerance {
-            let rounding = 2.0 * options.jump_tolerance * slope.hypot(1.0) / ds.abs();
             Chord::Short { slope, rounding }
         } else {
-            Chord::Long { slope }
+            Chord::Long { slope, rounding }
         }
     }
 
@@ -142,7 +146,12 @@ impl Chord {
 fn one_sided(near: Chord, across: Option<Chord>, outer: Option<Chord>) -> Option<(f64, f64)> {
     match near {
         Chord::Riser => None,
-        Chord::Long { slope } => Some((slope, 0.0)),
+        // Rounding matters here too: where the witness switches between
+        // facets at nearly the same travel, the bisection stops with the
+        // levels `jump_tolerance` apart over microns of travel, and the
+        // chord's slope is that rounding over its travel (measured: 0.047,
+        // eight times the surface's slope, on a crease of a faceted bulge).
+        Chord::Long { slope, rounding } => Some((slope, rounding)),
         Chord::Short { slope, rounding } => {
             let probe = Chord::short_slope(across).or(Chord::short_slope(outer));
             let curvature = probe.map_or(slope, |p| (slope - p).abs());
@@ -375,6 +384,49 @@ mod tests {
         for c in &contacts[2..] {
             assert!((c.rate - 0.2).abs() <= c.rate_error + 1e-12, "{c:?}");
             assert!(c.rate_error < 1e-4, "{c:?}");
+        }
+    }
+
+    #[test]
+    fn a_witness_switch_at_nearly_constant_travel_states_its_rounding() {
+        // A climb at 0.0056 whose witness jumps 0.16 mm sideways between
+        // two contacts 2e-5 mm apart in travel and one jump_tolerance apart
+        // in level (where the bisection stops): measured on a crease of a
+        // faceted bulge. The chord's slope, 0.05, is rounding: it must come
+        // with an error at least as large, never as a decided strike.
+        let options = OracleOptions {
+            witness_tolerance: 0.05,
+            ..OracleOptions::default()
+        };
+        let g = 0.0056;
+        let point = |s: f64, level: f64, w: [f64; 3]| ContactPoint {
+            travel: s,
+            face_level: level,
+            witness: w,
+            rate: f64::NAN,
+            rate_error: f64::NAN,
+        };
+        let mut contacts = vec![
+            point(10.0, -g * 10.0, [-10.0, 0.0, 0.0]),
+            point(10.02, -g * 10.02, [-10.02, 0.0, 0.0]),
+            point(
+                10.02002,
+                -g * 10.02 - options.jump_tolerance,
+                [-10.135, 0.0, -0.08],
+            ),
+            point(
+                10.04,
+                -g * 10.04 - options.jump_tolerance,
+                [-10.155, 0.0, -0.08],
+            ),
+        ];
+        deflection_rates(0.0, [0.0, 0.0, 0.0], &mut contacts, &options);
+        for c in &contacts[1..3] {
+            assert!(c.rate > 0.04, "{c:?}");
+            assert!(
+                c.rate - c.rate_error <= 2.0 * g,
+                "rounding taken for a rate: {c:?}"
+            );
         }
     }
 }
