@@ -29,7 +29,9 @@ pub enum Command {
     /// 1538 x 801 grid at 1.24 mm, 61 angles) against the paper algorithm.
     Bench(BenchArgs),
     /// Compare the grid engine with the exact oracle on the same starts.
-    /// Exit 0 when every metric is within --tolerance, 1 when not, 2 on error.
+    /// Exit 0 when every decided metric is within --tolerance (undecided
+    /// strikes, near the deflection threshold, are shown but never fail),
+    /// 1 when not or when the oracle failed on a start, 2 on error.
     Verify(VerifyArgs),
     /// Compare grid and oracle at several pitches: errors, fitted orders of
     /// convergence, and the coarsest pitch meeting --tolerance.
@@ -240,7 +242,9 @@ pub struct VerifyArgs {
     pub setup: SetupArgs,
     #[command(flatten)]
     pub starts: StartArgs,
-    /// Largest error allowed for every metric (mm).
+    /// Largest error allowed for every decided metric (mm): push, first
+    /// contact, miss, false alarm and the area distance, over decided
+    /// strikes.
     #[arg(long, default_value_t = 1.0, value_name = "MM")]
     pub tolerance: f64,
     /// Output directory for verify.csv and verify.json.
@@ -261,7 +265,8 @@ pub struct ConvergeArgs {
     /// nest, e.g. 8,4,2,1,0.5. Overrides --pitch.
     #[arg(long, default_value = "8,4,2,1", value_name = "MM,MM,...")]
     pub pitches: String,
-    /// Name the coarsest pitch whose errors are all within this (mm).
+    /// Name the coarsest pitch whose decided errors (as verify's) are all
+    /// within this (mm).
     #[arg(long, value_name = "MM")]
     pub tolerance: Option<f64>,
     /// Output directory for converge.csv, converge.json and the plots.
