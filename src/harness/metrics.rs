@@ -201,10 +201,43 @@ pub struct StartComparison {
     pub exact_strikes: usize,
     /// Exact contacts in the tie band.
     pub undecided: usize,
-    /// The decided exact strikes, xz (mm), in the order of `miss_decided`.
-    pub decided_points: Vec<[f64; 2]>,
-    /// The grid strikes, xz (mm), in the order of `false_alarm`.
-    pub grid_points: Vec<[f64; 2]>,
+    /// The points compared, xz (mm).
+    pub points: StartPoints,
+}
+
+/// The points of one start that its metrics compare, in xz (mm): the
+/// grid's strikes and the exact side's by standing. The area distance
+/// compares their unions over many starts.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct StartPoints {
+    /// The grid strikes, in the order of `false_alarm`.
+    pub grid: Vec<[f64; 2]>,
+    /// The exact strikes (`rate > sigma`), in the order of `miss`.
+    pub strikes: Vec<[f64; 2]>,
+    /// The decided exact strikes, in the order of `miss_decided`.
+    pub decided: Vec<[f64; 2]>,
+    /// The exact contacts that are not decided non-strikes.
+    pub possible: Vec<[f64; 2]>,
+    /// The exact push contact, when placed: a point of the exact curve for
+    /// false alarms (see [`compare`]).
+    pub push: Vec<[f64; 2]>,
+}
+
+impl StartPoints {
+    /// Appends `other`'s points to these.
+    pub fn extend(&mut self, other: &StartPoints) {
+        self.grid.extend(&other.grid);
+        self.strikes.extend(&other.strikes);
+        self.decided.extend(&other.decided);
+        self.possible.extend(&other.possible);
+        self.push.extend(&other.push);
+    }
+
+    /// `exact`'s points with the push contacts: what a grid strike's false
+    /// alarm is measured against.
+    pub fn with_push(&self, exact: &[[f64; 2]]) -> Vec<[f64; 2]> {
+        exact.iter().chain(&self.push).copied().collect()
+    }
 }
 
 impl StartComparison {
@@ -213,10 +246,11 @@ impl StartComparison {
     /// grid's strikes or the grid strike furthest from every possible exact
     /// one, whichever is further (infinite distances first).
     pub fn worst_decided_point(&self) -> Option<([f64; 2], f64)> {
-        self.decided_points
+        self.points
+            .decided
             .iter()
             .zip(&self.miss_decided)
-            .chain(self.grid_points.iter().zip(&self.false_alarm_decided))
+            .chain(self.points.grid.iter().zip(&self.false_alarm_decided))
             .map(|(&p, &d)| (p, d))
             .max_by(|a, b| a.1.total_cmp(&b.1))
     }
@@ -264,14 +298,16 @@ pub fn compare(grid: &GridTrace, exact: &StartTrace, band: &TieBand) -> StartCom
             .map(|c| xz(c.contact.witness))
             .collect()
     };
-    let strikes = points(&|c| c.strike);
-    let decided = points(&|c| c.decision == Decision::Strike);
-    let possible: Vec<[f64; 2]> = points(&|c| c.decision != Decision::NoStrike)
-        .into_iter()
-        .chain(push.iter().copied())
-        .collect();
-    let strikes_or_push: Vec<[f64; 2]> = strikes.iter().chain(&push).copied().collect();
-    let grid_points: Vec<[f64; 2]> = grid.colliding.iter().map(|c| xz(c.point)).collect();
+    let pts = StartPoints {
+        grid: grid.colliding.iter().map(|c| xz(c.point)).collect(),
+        strikes: points(&|c| c.strike),
+        decided: points(&|c| c.decision == Decision::Strike),
+        possible: points(&|c| c.decision != Decision::NoStrike),
+        push,
+    };
+    let strikes_or_push = pts.with_push(&pts.strikes);
+    let possible_or_push = pts.with_push(&pts.possible);
+    let grid_points = &pts.grid;
     let deflection = |keep: &dyn Fn(&ExactStrike) -> bool| -> Vec<f64> {
         if grid_points.is_empty() && grid.yr.is_finite() && placed {
             classified
@@ -301,22 +337,32 @@ pub fn compare(grid: &GridTrace, exact: &StartTrace, band: &TieBand) -> StartCom
             }
             _ => None,
         },
-        miss: strikes.iter().map(|&e| nearest(e, &grid_points)).collect(),
-        miss_decided: decided.iter().map(|&e| nearest(e, &grid_points)).collect(),
+        miss: pts
+            .strikes
+            .iter()
+            .map(|&e| nearest(e, grid_points))
+            .collect(),
+        miss_decided: pts
+            .decided
+            .iter()
+            .map(|&e| nearest(e, grid_points))
+            .collect(),
         false_alarm: grid_points
             .iter()
             .map(|&g| nearest(g, &strikes_or_push))
             .collect(),
-        false_alarm_decided: grid_points.iter().map(|&g| nearest(g, &possible)).collect(),
+        false_alarm_decided: grid_points
+            .iter()
+            .map(|&g| nearest(g, &possible_or_push))
+            .collect(),
         unmatched_deflection: deflection(&|c| c.strike),
         unmatched_deflection_decided: deflection(&|c| c.decision == Decision::Strike),
-        exact_strikes: strikes.len(),
-        decided_points: decided.clone(),
-        grid_points: grid_points.clone(),
+        exact_strikes: pts.strikes.len(),
         undecided: classified
             .iter()
             .filter(|c| c.decision == Decision::Undecided)
             .count(),
+        points: pts,
     }
 }
 

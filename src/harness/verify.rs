@@ -9,8 +9,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::metrics::{
-    DECIDED_METRICS, Decision, METRICS, StartComparison, Stats, TieBand, classify, compare,
-    metric_index,
+    DECIDED_METRICS, METRICS, StartComparison, StartPoints, Stats, TieBand, compare, metric_index,
 };
 use super::nearest::PointSet;
 use super::trace::{Fault, grid_trace};
@@ -241,28 +240,13 @@ pub struct Comparison {
 }
 
 /// One start-angle pair: its row, its comparison, the grid's colliding
-/// nodes, the exact strikes snapped to nodes, and the xz points of the
-/// area distance.
+/// nodes and the exact strikes snapped to nodes.
 type PairResult = (
     VerifyRow,
     StartComparison,
     Vec<(usize, usize)>,
     Vec<(usize, usize)>,
-    AreaPoints,
 );
-
-/// One start's contribution to the area distance: xz points of the grid's
-/// strikes, the exact strikes, the decided exact strikes, and the exact
-/// contacts not gentler than the band; the last three with the push
-/// contact where the false-alarm side needs it.
-#[derive(Debug, Clone, Default)]
-struct AreaPoints {
-    grid: Vec<[f64; 2]>,
-    strikes: Vec<[f64; 2]>,
-    decided: Vec<[f64; 2]>,
-    possible: Vec<[f64; 2]>,
-    push: Vec<[f64; 2]>,
-}
 
 /// Compares `grid` with `traces` (angle-major over `starts`, positions in
 /// mm that must be nodes of `grid`).
@@ -314,31 +298,13 @@ pub fn compare_grid(
                 (StartStatus::NotPlaced, false) => "not_placed",
             };
             let worst = |v: &[f64]| v.iter().copied().reduce(f64::max).filter(|v| v.is_finite());
-            let classified = classify(trace, &band);
-            let xz = |p: [f64; 3]| [p[0], p[2]];
-            let exact_xz = |keep: &dyn Fn(Decision, bool) -> bool| -> Vec<[f64; 2]> {
-                classified
-                    .iter()
-                    .filter(|c| keep(c.decision, c.strike))
-                    .map(|c| xz(c.contact.witness))
-                    .collect()
-            };
-            let snapped: Vec<(usize, usize)> = exact_xz(&|_, strike| strike)
+            let snapped: Vec<(usize, usize)> = cmp
+                .points
+                .strikes
                 .iter()
                 .filter_map(|p| node_of(p[0], p[1]))
                 .collect();
-            let area = AreaPoints {
-                grid: g.colliding.iter().map(|c| xz(c.point)).collect(),
-                strikes: exact_xz(&|_, strike| strike),
-                decided: exact_xz(&|d, _| d == Decision::Strike),
-                possible: exact_xz(&|d, _| d != Decision::NoStrike),
-                push: trace
-                    .push_witness
-                    .filter(|_| trace.status == StartStatus::Placed)
-                    .map(xz)
-                    .into_iter()
-                    .collect(),
-            };
+            let worst_at = cmp.worst_decided_point().map(|(p, _)| p);
             let row = VerifyRow {
                 i,
                 j,
@@ -356,11 +322,11 @@ pub fn compare_grid(
                 exact_strikes: cmp.exact_strikes,
                 exact_undecided: cmp.undecided,
                 grid_colliding: cmp.false_alarm.len(),
-                worst_x: cmp.worst_decided_point().map(|(p, _)| p[0]),
-                worst_z: cmp.worst_decided_point().map(|(p, _)| p[1]),
+                worst_x: worst_at.map(|p| p[0]),
+                worst_z: worst_at.map(|p| p[1]),
             };
             let grid_nodes = g.colliding.iter().map(|c| c.node).collect();
-            (row, cmp, grid_nodes, snapped, area)
+            (row, cmp, grid_nodes, snapped)
         })
         .collect();
     let grid_s = t.elapsed().as_secs_f64();
@@ -371,8 +337,8 @@ pub fn compare_grid(
     };
     let mut values: Vec<Vec<f64>> = vec![Vec::new(); METRICS.len()];
     let (mut grid_set, mut exact_set) = (HashSet::new(), HashSet::new());
-    let mut area_points: Vec<AreaPoints> = vec![AreaPoints::default(); footprints.len()];
-    for ((row, cmp, grid_nodes, snapped, area), &(a, _)) in results.iter().zip(&pairs) {
+    let mut area_points: Vec<StartPoints> = vec![StartPoints::default(); footprints.len()];
+    for ((row, cmp, grid_nodes, snapped), &(a, _)) in results.iter().zip(&pairs) {
         match row.status.as_str() {
             "compared" => counts.compared += 1,
             "grid_not_placed" => counts.grid_not_placed += 1,
@@ -417,12 +383,7 @@ pub fn compare_grid(
         if row.status == "compared" || row.status == "grid_not_placed" {
             grid_set.extend(grid_nodes.iter().map(|&n| (a, n)));
             exact_set.extend(snapped.iter().map(|&n| (a, n)));
-            let to = &mut area_points[a];
-            to.grid.extend(&area.grid);
-            to.strikes.extend(&area.strikes);
-            to.decided.extend(&area.decided);
-            to.possible.extend(&area.possible);
-            to.push.extend(&area.push);
+            area_points[a].extend(&cmp.points);
         }
     }
     let union = grid_set.union(&exact_set).count();
@@ -458,19 +419,17 @@ pub fn compare_grid(
 
 /// The area distance of one angle's unions of points (see
 /// [`AreaDistance`]).
-fn area_distance(angle_deg: f64, pts: AreaPoints) -> AreaDistance {
-    let grid = PointSet::new(pts.grid.clone());
-    let with_push =
-        |v: &[[f64; 2]]| -> Vec<[f64; 2]> { v.iter().chain(&pts.push).copied().collect() };
+fn area_distance(angle_deg: f64, pts: StartPoints) -> AreaDistance {
     // A set with no point is infinitely far from any point, and no point
     // is any distance from anything: PointSet's Hausdorff says both.
+    let grid = PointSet::new(pts.grid.clone());
     let from_grid = |to: Vec<[f64; 2]>| PointSet::new(to).hausdorff_from(&pts.grid);
     AreaDistance {
         angle_deg,
         miss: grid.hausdorff_from(&pts.strikes),
-        false_alarm: from_grid(with_push(&pts.strikes)),
+        false_alarm: from_grid(pts.with_push(&pts.strikes)),
         miss_decided: grid.hausdorff_from(&pts.decided),
-        false_alarm_decided: from_grid(with_push(&pts.possible)),
+        false_alarm_decided: from_grid(pts.with_push(&pts.possible)),
     }
 }
 
@@ -480,19 +439,7 @@ impl Comparison {
     /// strikes (in the tie band) never fail a comparison; they are counted
     /// and their metrics shown beside the decided ones.
     pub fn passes(&self, tolerance: f64) -> bool {
-        let c = &self.counts;
-        let area_finite = self
-            .area
-            .iter()
-            .all(|a| a.miss_decided.is_finite() && a.false_alarm_decided.is_finite());
-        self.stats
-            .iter()
-            .filter(|(m, _)| DECIDED_METRICS.contains(&m.as_str()))
-            .all(|(_, s)| s.max <= tolerance)
-            && area_finite
-            && c.oracle_not_placed == 0
-            && c.oracle_failed == 0
-            && c.unmatched_grid_decided == 0
+        self.failures(tolerance).is_empty()
     }
 
     /// Why a comparison fails `tolerance`, one phrase per reason (empty
