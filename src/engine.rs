@@ -77,12 +77,19 @@ const LANES: usize = 16;
 
 /// Runs push and slide for every footprint (one per angle) on `grid`.
 /// `on_angle` is called once per finished angle (for a progress bar).
+///
+/// # Panics
+///
+/// When a footprint was laid on a grid of another pitch
+/// ([`GridFootprint::new`] takes the grid's spec): its rows would be
+/// offsets on the wrong lattice.
 pub fn colliding_masks(
     grid: &HeightGrid,
     footprints: &[GridFootprint],
     options: &EngineOptions,
     on_angle: &(dyn Fn() + Sync),
 ) -> Vec<AngleMask> {
+    assert_same_pitch(grid, footprints);
     let padded = PaddedGrid::new(grid, footprints);
     let table = match options.algorithm {
         Algorithm::Fast => {
@@ -143,6 +150,18 @@ pub fn colliding_masks(
             }
         })
         .collect()
+}
+
+/// Refuses footprints laid on a grid of another pitch than `grid`'s.
+pub(crate) fn assert_same_pitch(grid: &HeightGrid, footprints: &[GridFootprint]) {
+    for fp in footprints {
+        assert!(
+            fp.pitch == grid.spec.pitch,
+            "a footprint laid at pitch {} mm used on a {} mm grid",
+            fp.pitch,
+            grid.spec.pitch
+        );
+    }
 }
 
 dispatch! {
@@ -257,6 +276,7 @@ fn paper_band(
 /// `+inf` where the start is not placed. For comparisons with the exact
 /// oracle; [`colliding_masks`] computes these on the way.
 pub fn push_levels(grid: &HeightGrid, fp: &GridFootprint) -> Vec<f64> {
+    assert_same_pitch(grid, std::slice::from_ref(fp));
     let padded = PaddedGrid::new(grid, std::slice::from_ref(fp));
     let max_width = fp
         .rows
@@ -295,7 +315,7 @@ pub fn composite(masks: &[AngleMask]) -> Vec<u16> {
 mod tests {
     use super::*;
     use crate::grid::GridSpec;
-    use crate::kneeform::{Footprint, KneeForm};
+    use crate::kneeform::KneeForm;
 
     /// The block width is a tuning knob per instruction set: every width
     /// gives the same reach and placed count (the tests elsewhere run only
@@ -328,7 +348,7 @@ mod tests {
         };
         let rows: Vec<usize> = (0..spec.nz).collect();
         for angle in [-30.0, 0.0, 17.0] {
-            let fp = GridFootprint::new(&Footprint::new(&knee, angle), angle, spec.pitch);
+            let fp = GridFootprint::new(&knee, angle, &spec);
             let padded = PaddedGrid::new(&grid, std::slice::from_ref(&fp));
             let table = WindowMin::new(&padded, 512);
             let run =

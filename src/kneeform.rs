@@ -6,6 +6,8 @@
 //! (front is -x, z up). The reference point is the triangle vertex `v0`, the
 //! centre of the rounded front corner, at the origin of the footprint.
 
+use crate::grid::GridSpec;
+
 /// Distance (mm) within which a node counts as inside the closed footprint
 /// (SPEC, "push"), and within which two slide distances form one tie group
 /// (SPEC, "slide"). It only has to absorb floating-point rounding of
@@ -143,10 +145,15 @@ pub struct FootprintRow {
 
 /// A footprint laid on a grid of pitch `p`: its rows, plus the order in
 /// which the slide meets their first nodes in front (by `d0`, ties grouped).
+/// Built from the grid it is laid on ([`GridFootprint::new`] takes the
+/// grid's [`GridSpec`]), so its pitch is the grid's.
 #[derive(Debug, Clone)]
 pub struct GridFootprint {
     /// Angle (degrees) of this footprint.
     pub angle_deg: f64,
+    /// The pitch (mm) of the grid it was laid on; the engine and the
+    /// harness refuse a footprint of another grid.
+    pub pitch: f64,
     /// Rows sorted by `dj`.
     pub rows: Vec<FootprintRow>,
     /// Indices into `rows`, sorted by `d0` (ties by `dj`).
@@ -157,8 +164,10 @@ pub struct GridFootprint {
 }
 
 impl GridFootprint {
-    /// Lays `footprint` on a grid of pitch `pitch` (mm).
-    pub fn new(footprint: &Footprint, angle_deg: f64, pitch: f64) -> GridFootprint {
+    /// Lays the footprint of `knee` at `angle_deg` on the grid `spec`.
+    pub fn new(knee: &KneeForm, angle_deg: f64, spec: &GridSpec) -> GridFootprint {
+        let footprint = Footprint::new(knee, angle_deg);
+        let pitch = spec.pitch;
         let (zlo, zhi) = footprint.z_range();
         let dj_lo = ((zlo - NODE_TOL) / pitch).ceil() as i32;
         let dj_hi = ((zhi + NODE_TOL) / pitch).floor() as i32;
@@ -185,6 +194,7 @@ impl GridFootprint {
         let groups = tie_groups(slide_order.iter().map(|&r| rows[r as usize].d0));
         GridFootprint {
             angle_deg,
+            pitch,
             rows,
             slide_order,
             groups,
@@ -290,7 +300,8 @@ mod tests {
     fn rows_on_exact_pitch_include_boundary_nodes() {
         // a(0) = -60 is a multiple of 1, 2 and 4 mm: that node is inside.
         for p in [1.0, 2.0, 4.0] {
-            let fp = GridFootprint::new(&Footprint::new(&KneeForm::default(), 0.0), 0.0, p);
+            let spec = GridSpec::explicit(0.0, 0.0, 1, 1, p);
+            let fp = GridFootprint::new(&KneeForm::default(), 0.0, &spec);
             let row = fp.rows.iter().find(|r| r.dj == 0).unwrap();
             assert_eq!(f64::from(row.klo) * p, -60.0);
             assert_eq!(row.d0, p);

@@ -15,6 +15,7 @@
 //!
 //! All lengths are mm and all angles degrees.
 
+pub mod analysis;
 pub mod console;
 pub mod engine;
 pub mod grid;
@@ -33,8 +34,9 @@ pub mod slide;
 pub mod strike;
 pub mod summary;
 
+pub use analysis::{Analysis, AnalysisError, GridPlacement, Progress, Setup, SetupError, Status};
 pub use engine::{Algorithm, AngleMask, EngineOptions, colliding_masks, composite, push_levels};
 pub use grid::{GridSpec, HeightGrid};
 pub use kneeform::{Footprint, GridFootprint, KneeForm};
-pub use mesh::{Part, Side};
+pub use mesh::{Part, PartFile, Side, read_part};
 pub use strike::StrikeRule;

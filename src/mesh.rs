@@ -5,7 +5,9 @@
 //! later step works in SPEC's canonical frame (knee pushed in +y, sliding in
 //! -x). Results are mirrored back with [`Side::to_part`].
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+use sha2::Digest;
 
 /// One triangle, three vertices (x, y, z) in mm.
 pub type Triangle = [[f64; 3]; 3];
@@ -67,6 +69,9 @@ pub enum MeshError {
         /// The triangle's index in the file.
         index: usize,
     },
+    /// A scenario file could not be read or tessellated.
+    #[error(transparent)]
+    Scenario(#[from] crate::scenario::ScenarioError),
     /// Every triangle is degenerate.
     #[error("{path}: all {count} triangles are degenerate (zero area)")]
     AllDegenerate {
@@ -88,6 +93,73 @@ pub struct Part {
     pub degenerate: usize,
 }
 
+/// A part read from its file, with the file's identity: what a run, its
+/// verification and its report are matched by.
+#[derive(Debug, Clone)]
+pub struct PartFile {
+    /// The file as given.
+    pub path: PathBuf,
+    /// SHA-256 of the file's bytes (lowercase hex).
+    pub sha256: String,
+    /// Factor from the file's units to mm.
+    pub scale: f64,
+    /// The side the part was read for (mirrored into the analysis frame
+    /// for [`Side::Right`]).
+    pub side: Side,
+    /// The part, in mm and the analysis frame.
+    pub part: Part,
+}
+
+impl PartFile {
+    /// A part built in memory (a test, a CAD plug-in's own mesh) rather
+    /// than read: no file, so its `sha256` is empty and a report cannot
+    /// be matched to it. Scale 1, left side: `part` is already in mm and
+    /// the analysis frame.
+    pub fn in_memory(name: &str, part: Part) -> PartFile {
+        PartFile {
+            path: PathBuf::from(name),
+            sha256: String::new(),
+            scale: 1.0,
+            side: Side::Left,
+            part,
+        }
+    }
+}
+
+/// Reads a part from an STL file (binary or ASCII) or a scenario file
+/// (`.toml`, tessellated at its own step), scales it by `scale` (to mm)
+/// and maps `side` into the analysis frame; the file's SHA-256 is taken
+/// from the same bytes.
+pub fn read_part(path: &Path, scale: f64, side: Side) -> Result<PartFile, MeshError> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
+        path: name.clone(),
+        source,
+    })?;
+    let sha256 = sha2::Sha256::digest(&bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    let part = if crate::scenario::is_scenario_file(path) {
+        let text =
+            std::str::from_utf8(&bytes).map_err(|e| crate::scenario::ScenarioError::Read {
+                path: path.to_path_buf(),
+                cause: std::io::Error::new(std::io::ErrorKind::InvalidData, e),
+            })?;
+        let triangles = crate::scenario::parse(text, path)?.triangulate(None);
+        Part::from_triangles(&name, triangles, scale, side)?
+    } else {
+        Part::from_stl_bytes(&name, &bytes, scale, side)?
+    };
+    Ok(PartFile {
+        path: path.to_path_buf(),
+        sha256,
+        scale,
+        side,
+        part,
+    })
+}
+
 /// An axis-aligned box (mm).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Bbox {
@@ -98,17 +170,6 @@ pub struct Bbox {
 }
 
 impl Part {
-    /// Reads an STL file, scales it by `scale` (to mm) and maps `side` into
-    /// the analysis frame.
-    pub fn read(path: &Path, scale: f64, side: Side) -> Result<Part, MeshError> {
-        let name = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
-            path: name.clone(),
-            source,
-        })?;
-        Part::from_stl_bytes(&name, &bytes, scale, side)
-    }
-
     /// Parses the bytes of an STL file named `name` (for messages).
     pub fn from_stl_bytes(
         name: &str,

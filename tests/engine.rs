@@ -3,7 +3,7 @@
 
 use kneeform::strike::RateEstimate;
 use kneeform::{
-    Algorithm, EngineOptions, Footprint, GridFootprint, HeightGrid, KneeForm, StrikeRule,
+    Algorithm, EngineOptions, GridFootprint, GridSpec, HeightGrid, KneeForm, StrikeRule,
     colliding_masks,
 };
 
@@ -27,7 +27,7 @@ fn run(
 ) -> Vec<kneeform::AngleMask> {
     let footprints: Vec<GridFootprint> = angles
         .iter()
-        .map(|&a| GridFootprint::new(&Footprint::new(knee, a), a, grid.spec.pitch))
+        .map(|&a| GridFootprint::new(knee, a, &grid.spec))
         .collect();
     let options = EngineOptions {
         rule,
@@ -156,7 +156,7 @@ fn assert_thresholds_exercised(rules: &[StrikeRule], not_struck: &[Vec<usize>]) 
 /// pitch and holds no node (SPEC's exception for `sigma = 0`).
 fn has_a_row_without_nodes(knee: &KneeForm, pitch: f64) -> bool {
     ANGLES.iter().any(|&a| {
-        GridFootprint::new(&Footprint::new(knee, a), a, pitch)
+        GridFootprint::new(knee, a, &GridSpec::explicit(0.0, 0.0, 1, 1, pitch))
             .rows
             .iter()
             .any(|r| r.klo > r.khi)

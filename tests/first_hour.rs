@@ -373,13 +373,13 @@ fn an_os_error_is_said_once() {
 #[test]
 fn a_part_in_metres_is_warned_of_and_its_empty_result_too() {
     let dir = scratch_dir("metres");
-    let mm = kneeform::Part::read(
+    let mm = kneeform::read_part(
         &repo().join("scenarios/console_side.stl"),
         0.001,
         kneeform::Side::Left,
     )
     .unwrap();
-    kneeform::scenario::write_stl(&dir.join("console_m.stl"), &mm.triangles).unwrap();
+    kneeform::scenario::write_stl(&dir.join("console_m.stl"), &mm.part.triangles).unwrap();
     let out = ok(
         kneeform(&dir, &["analyze", "console_m.stl", "--out", "run"]),
         "a part in metres",
@@ -423,8 +423,13 @@ fn a_surface_facing_plus_y_is_warned_of_unless_side_right() {
     step_part(&dir, "step.stl");
     // The same part on the vehicle's right, as CAD would export it: mirrored
     // in y, its triangles wound to face +y.
-    let part = kneeform::Part::read(&dir.join("step.stl"), 1.0, kneeform::Side::Right).unwrap();
-    let rewound: Vec<_> = part.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect();
+    let part = kneeform::read_part(&dir.join("step.stl"), 1.0, kneeform::Side::Right).unwrap();
+    let rewound: Vec<_> = part
+        .part
+        .triangles
+        .iter()
+        .map(|&[a, b, c]| [a, c, b])
+        .collect();
     kneeform::scenario::write_stl(&dir.join("right.stl"), &rewound).unwrap();
     let out = ok(kneeform(&dir, &quick("right.stl", "as-left", &[])), "left");
     let w = warnings(&out);

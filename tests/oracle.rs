@@ -93,10 +93,7 @@ fn grid_push_level_is_never_below_the_exact_one() {
             .collect();
         let traces = evaluate(&exact, &starts, &angles, &options).unwrap();
         for (a, &angle) in angles.iter().enumerate() {
-            let yr = push_levels(
-                &grid,
-                &GridFootprint::new(&Footprint::new(&knee, angle), angle, pitch),
-            );
+            let yr = push_levels(&grid, &GridFootprint::new(&knee, angle, &grid.spec));
             for (s, &(i, j)) in nodes.iter().enumerate() {
                 let trace = &traces[a * starts.len() + s];
                 let grid_yr = yr[j * grid.spec.nx + i];

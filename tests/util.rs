@@ -299,30 +299,26 @@ pub fn mask_diff(grid: &HeightGrid, got: &[u8], want: &[u8]) -> String {
     )
 }
 
-/// Samples `triangles` on SPEC's default grid and runs the fast engine.
+/// `kneeform analyze` of `triangles` (mm, analysis frame) at `pitch` and
+/// `angles`, through the library: the grid and the masks.
 pub fn analyse(
     triangles: &[kneeform::mesh::Triangle],
     pitch: f64,
     knee: &KneeForm,
     angles: &[f64],
 ) -> (HeightGrid, Vec<kneeform::AngleMask>) {
-    use kneeform::{EngineOptions, Footprint, GridFootprint, Part, Side, colliding_masks};
+    use kneeform::{Analysis, Part, PartFile, Setup, Side};
     let part =
         Part::from_triangles("test", triangles.to_vec(), 1.0, Side::Left).expect("a valid part");
-    let extent: Vec<Footprint> = angles
-        .iter()
-        .flat_map(|&a| [Footprint::new(knee, a), Footprint::new(knee, -a)])
-        .collect();
-    let grid = HeightGrid::sample(
-        &part.triangles,
-        GridSpec::around(&part.bbox(), &extent, pitch),
-    );
-    let footprints: Vec<GridFootprint> = angles
-        .iter()
-        .map(|&a| GridFootprint::new(&Footprint::new(knee, a), a, pitch))
-        .collect();
-    let masks = colliding_masks(&grid, &footprints, &EngineOptions::default(), &|| {});
-    (grid, masks)
+    let setup = Setup {
+        pitch,
+        knee: *knee,
+        angles: angles.to_vec(),
+        ..Setup::default()
+    };
+    let analysis =
+        Analysis::run(PartFile::in_memory("test", part), &setup, &()).expect("an analysis");
+    (analysis.grid, analysis.masks)
 }
 
 /// A unique, empty scratch directory under the system's temporary one.

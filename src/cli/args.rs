@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, bail, ensure};
+use anyhow::{Context, ensure};
 use clap::{Args, Parser, Subcommand};
 use kneeform::strike::RateEstimate;
-use kneeform::{Algorithm, KneeForm, Side, StrikeRule};
+use kneeform::{Algorithm, GridPlacement, KneeForm, Setup, SetupError, Side, StrikeRule};
 
 /// UN Regulation No. 21 knee-form inspection: which areas of an interior
 /// part a sliding knee-form strikes (push-and-slide on a height grid, after
@@ -197,11 +197,6 @@ impl StartArgs {
     /// Validates the flags.
     pub fn validate(&self) -> anyhow::Result<kneeform::harness::StartSelection> {
         use kneeform::harness::StartSelection;
-        ensure!(
-            self.tie_band.is_finite() && self.tie_band >= 0.0,
-            "--tie-band must be a finite number >= 0, got {}",
-            self.tie_band
-        );
         if self.starts == "all" {
             return Ok(StartSelection::All);
         }
@@ -214,18 +209,12 @@ impl StartArgs {
                 .with_context(|| {
                     format!("--starts {:?}: expected strip:Z0:Z1 in mm", self.starts)
                 })?;
-            ensure!(
-                lo.is_finite() && hi.is_finite() && lo <= hi,
-                "--starts {:?}: expected Z0 <= Z1, both finite",
-                self.starts
-            );
             return Ok(StartSelection::Strip { z: [lo, hi] });
         }
         let count: usize = self
             .starts
             .parse()
             .with_context(|| format!("--starts {:?}: expected `all` or a number", self.starts))?;
-        ensure!(count > 0, "--starts must be at least 1");
         Ok(StartSelection::Sample {
             count,
             seed: self.seed,
@@ -325,73 +314,23 @@ pub struct BenchArgs {
     pub markdown: Option<PathBuf>,
 }
 
-/// The grid's placement.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum GridPlacement {
-    /// SPEC's default extent around the part.
-    AroundPart,
-    /// An explicit origin (mm) and size (nodes).
-    Explicit {
-        /// Origin x, z (mm).
-        origin: [f64; 2],
-        /// Nodes along x, z.
-        size: [usize; 2],
-    },
-}
-
-/// A validated analysis setup.
-#[derive(Debug, Clone)]
-pub struct Setup {
-    pub pitch: f64,
-    pub knee: KneeForm,
-    pub angles: Vec<f64>,
-    pub rule: StrikeRule,
-    pub grid: GridPlacement,
-    pub algorithm: Algorithm,
-    pub threads: Option<usize>,
-    pub max_memory_bytes: f64,
-}
-
 impl SetupArgs {
-    /// Validates the flags.
-    pub fn validate(&self) -> anyhow::Result<Setup> {
-        positive("--pitch", self.pitch)?;
-        positive("--triangle-side", self.triangle_side)?;
-        positive("--radius", self.radius)?;
-        positive("--thickness", self.thickness)?;
-        positive("--max-memory", self.max_memory)?;
-        ensure!(
-            self.deflection.is_finite() && (0.0..45.0).contains(&self.deflection),
-            "--deflection must be a number of degrees in [0, 45), got {}",
-            self.deflection
-        );
-        ensure!(
-            self.e0.is_finite() && (0.0..=0.01).contains(&self.e0),
-            "--e0 must be a number of mm in [0, 0.01] (it only absorbs rounding), got {}",
-            self.e0
-        );
+    /// Parses the flags into the library's [`Setup`] and checks it, naming
+    /// the flag at fault; also returns `--threads`.
+    pub fn validate(&self) -> anyhow::Result<(Setup, Option<usize>)> {
         if let Some(n) = self.threads {
             ensure!(n >= 1, "--threads must be at least 1");
         }
         let grid = match (&self.grid_origin, &self.grid_size) {
-            (Some(origin), Some(size)) => {
-                let [x, z] = pair::<f64>(origin)
-                    .with_context(|| format!("--grid-origin {origin:?}: expected X,Z in mm"))?;
-                ensure!(
-                    x.is_finite() && z.is_finite(),
-                    "--grid-origin must be finite"
-                );
-                let [nx, nz] = pair::<usize>(size)
-                    .with_context(|| format!("--grid-size {size:?}: expected NX,NZ node counts"))?;
-                ensure!(nx > 0 && nz > 0, "--grid-size must be at least 1,1");
-                GridPlacement::Explicit {
-                    origin: [x, z],
-                    size: [nx, nz],
-                }
-            }
+            (Some(origin), Some(size)) => GridPlacement::Explicit {
+                origin: pair::<f64>(origin)
+                    .with_context(|| format!("--grid-origin {origin:?}: expected X,Z in mm"))?,
+                size: pair::<usize>(size)
+                    .with_context(|| format!("--grid-size {size:?}: expected NX,NZ node counts"))?,
+            },
             _ => GridPlacement::AroundPart,
         };
-        Ok(Setup {
+        let setup = Setup {
             pitch: self.pitch,
             knee: KneeForm {
                 triangle_side: self.triangle_side,
@@ -402,25 +341,29 @@ impl SetupArgs {
             rule: StrikeRule::new(self.deflection, self.e0).with_rate(self.rate),
             grid,
             algorithm: self.algorithm,
-            threads: self.threads,
             max_memory_bytes: self.max_memory * f64::from(1u32 << 30),
-        })
+        };
+        setup.validate().map_err(with_flag)?;
+        Ok((setup, self.threads))
     }
+}
+
+/// A setup error with the flag it concerns in front: `--pitch: ...`.
+pub fn with_flag(err: SetupError) -> anyhow::Error {
+    let flag = format!("--{}", err.field().replace('_', "-"));
+    anyhow::Error::new(err).context(flag)
 }
 
 impl PartArgs {
     /// Validates the flags.
     pub fn validate(&self) -> anyhow::Result<()> {
-        positive("--scale", self.scale)
+        ensure!(
+            self.scale.is_finite() && self.scale > 0.0,
+            "--scale must be a finite number > 0, got {}",
+            self.scale
+        );
+        Ok(())
     }
-}
-
-fn positive(flag: &str, v: f64) -> anyhow::Result<()> {
-    ensure!(
-        v.is_finite() && v > 0.0,
-        "{flag} must be a finite number > 0, got {v}"
-    );
-    Ok(())
 }
 
 fn pair<T: std::str::FromStr>(s: &str) -> anyhow::Result<[T; 2]>
@@ -435,20 +378,18 @@ where
 /// Parses `FROM:TO:STEP` (inclusive) or a comma-separated list of angles.
 pub fn parse_angles(s: &str) -> anyhow::Result<Vec<f64>> {
     let number = |t: &str| -> anyhow::Result<f64> {
-        let v: f64 = t
-            .trim()
+        t.trim()
             .parse()
-            .with_context(|| format!("--angles: {t:?} is not a number"))?;
-        ensure!(
-            v.is_finite() && v.abs() <= 90.0,
-            "--angles: {v} is outside -90..90 degrees"
-        );
-        Ok(v)
+            .with_context(|| format!("--angles: {t:?} is not a number"))
     };
     let angles = if s.contains(':') {
         let parts: Vec<&str> = s.split(':').collect();
         ensure!(parts.len() == 3, "--angles {s:?}: expected FROM:TO:STEP");
         let (from, to, step) = (number(parts[0])?, number(parts[1])?, number(parts[2])?);
+        ensure!(
+            from.is_finite() && to.is_finite() && step.is_finite(),
+            "--angles {s:?}: FROM, TO and STEP must be finite"
+        );
         ensure!(step > 0.0, "--angles {s:?}: STEP must be > 0");
         ensure!(to >= from, "--angles {s:?}: TO must be >= FROM");
         let n = ((to - from) / step + 1e-9).floor() as usize + 1;
@@ -461,12 +402,6 @@ pub fn parse_angles(s: &str) -> anyhow::Result<Vec<f64>> {
             .map(number)
             .collect::<anyhow::Result<Vec<f64>>>()?
     };
-    let mut sorted = angles.clone();
-    sorted.sort_by(f64::total_cmp);
-    if sorted.windows(2).any(|w| w[0] == w[1]) {
-        bail!("--angles {s:?}: an angle is repeated");
-    }
-    ensure!(!angles.is_empty(), "--angles is empty");
     Ok(angles)
 }
 
@@ -482,7 +417,6 @@ mod tests {
             vec![-30.0, -13.0, 0.0, 7.0, 30.0]
         );
         assert_eq!(parse_angles("0:1:0.1").unwrap()[3], 0.3);
-        assert!(parse_angles("1,1").is_err());
         assert!(parse_angles("0:1").is_err());
         assert!(parse_angles("a").is_err());
         assert!(parse_angles("0:10:0").is_err());
@@ -495,6 +429,13 @@ mod tests {
         let Command::Analyze(a) = cli.command else {
             panic!("not analyze")
         };
-        assert_eq!(a.setup.validate().unwrap().angles, vec![-30.0, -13.0]);
+        assert_eq!(a.setup.validate().unwrap().0.angles, vec![-30.0, -13.0]);
+        let repeated =
+            Cli::try_parse_from(["kneeform", "analyze", "p.stl", "--angles", "1,1"]).unwrap();
+        let Command::Analyze(a) = repeated.command else {
+            panic!("not analyze")
+        };
+        let err = format!("{:#}", a.setup.validate().unwrap_err());
+        assert!(err.starts_with("--angles: "), "{err}");
     }
 }

@@ -12,9 +12,7 @@ use std::time::Instant;
 use anyhow::ensure;
 use kneeform::console::{CONSOLE_SIZE, console_triangles};
 use kneeform::grid::GridSpec;
-use kneeform::{
-    Algorithm, EngineOptions, Footprint, GridFootprint, HeightGrid, KneeForm, colliding_masks,
-};
+use kneeform::{Algorithm, EngineOptions, GridFootprint, HeightGrid, KneeForm, colliding_masks};
 
 use super::args::BenchArgs;
 
@@ -59,7 +57,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     let spec = GridSpec::explicit(origin[0], origin[1], nx, nz, PAPER_PITCH);
     let footprints: Vec<GridFootprint> = angles
         .iter()
-        .map(|&a| GridFootprint::new(&Footprint::new(&knee, a), a, PAPER_PITCH))
+        .map(|&a| GridFootprint::new(&knee, a, &spec))
         .collect();
     let fast = EngineOptions::default();
 
@@ -130,7 +128,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
                 ]
             })
             .collect();
-        let options = super::verify::oracle_options(&knee, PAPER_PITCH, spec.x(0));
+        let options = kneeform::harness::oracle_options(&knee, PAPER_PITCH, spec.x(0));
         let t = Instant::now();
         kneeform_oracle::evaluate(&part, &starts, &[0.0], &options)?;
         Some(t.elapsed().as_secs_f64() / starts.len() as f64)

@@ -4,6 +4,7 @@ pub mod analyze;
 pub mod args;
 pub mod bench;
 pub mod converge;
+pub mod progress;
 pub mod report;
 pub mod scenario;
 pub mod verify;
@@ -11,26 +12,44 @@ pub mod verify;
 use std::path::Path;
 
 use anyhow::Context;
-use kneeform::{Part, Side};
-use sha2::Digest;
+use kneeform::harness::HarnessError;
+use kneeform::report::ReportOptions;
 
-/// Reads a part, from an STL file or a scenario file (`.toml`, generated
-/// on the fly), into the analysis frame; returns it with the SHA-256 of
-/// the file's bytes.
-pub fn load_part(path: &Path, scale: f64, side: Side) -> anyhow::Result<(Part, String)> {
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let sha256 = sha2::Sha256::digest(&bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    let name = path.display().to_string();
-    let part = if kneeform::scenario::is_scenario_file(path) {
-        let triangles = kneeform::scenario::triangles_from_file(path, None)?;
-        Part::from_triangles(&name, triangles, scale, side)?
-    } else {
-        Part::from_stl_bytes(&name, &bytes, scale, side)?
+/// Writes the report of `options` to `out` and says so on stderr, naming
+/// the file `shown_as` (where it will be once staged files are moved):
+/// `report`'s work, and `analyze --report`'s.
+pub fn write_report(options: &ReportOptions, out: &Path, shown_as: &Path) -> anyhow::Result<()> {
+    let report = kneeform::report::write_report(options, out).with_context(|| {
+        format!(
+            "cannot write the report of {} to {}",
+            options.run_dir.display(),
+            shown_as.display()
+        )
+    })?;
+    eprintln!(
+        "kneeform: report of {} ({} triangles, views rendered in {:.2} s) written to {}",
+        report.run.part_path.display(),
+        report.run.part.triangles.len(),
+        report.views.render_s,
+        shown_as.display()
+    );
+    Ok(())
+}
+
+/// A harness error with the flag it concerns in front, where one does.
+pub fn harness_error(err: HarnessError) -> anyhow::Error {
+    let flag = match &err {
+        HarnessError::Setup(e) => Some(format!("--{}", e.field().replace('_', "-"))),
+        HarnessError::Tolerance(_) => Some("--tolerance".into()),
+        HarnessError::TieBand(_) => Some("--tie-band".into()),
+        HarnessError::Pitches(_) => Some("--pitches".into()),
+        HarnessError::EmptySample | HarnessError::Strip(_) => Some("--starts".into()),
+        _ => None,
     };
-    Ok((part, sha256))
+    match flag {
+        Some(flag) => anyhow::Error::new(err).context(flag),
+        None => err.into(),
+    }
 }
 
 /// The error and its causes as one line, `outer: inner: ...`, each cause

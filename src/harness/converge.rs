@@ -3,13 +3,21 @@
 //! power law `error ~ C p^alpha` fitted in log-log per metric, and the
 //! coarsest pitch that meets a tolerance.
 
-use std::path::Path;
+use std::time::Instant;
 
-use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::metrics::{DECIDED_METRICS, METRICS};
-use super::verify::Comparison;
+use super::HarnessError;
+use super::compare::{CompareOptions, Comparison, StartSelection, compare_grid};
+use super::metrics::METRICS;
+use super::verify::{
+    check_selection, check_tie_band, check_tolerance, oracle_options, run_oracle, start_positions,
+    tie_band_rule,
+};
+use crate::analysis::{Progress, Setup};
+use crate::engine::{EngineOptions, colliding_masks};
+use crate::grid::{GridSpec, HeightGrid};
+use crate::mesh::PartFile;
 
 /// One pitch of a convergence study.
 #[derive(Debug, Clone)]
@@ -101,10 +109,10 @@ pub struct ConvergeSummary {
     #[serde(default)]
     pub input_sha256: String,
     /// Factor from the file's units to mm.
-    #[serde(default = "super::unit_scale")]
+    #[serde(default = "super::verify::unit_scale")]
     pub scale: f64,
     /// `left` or `right`.
-    #[serde(default = "super::left_side")]
+    #[serde(default = "super::verify::left_side")]
     pub side: crate::Side,
     /// Knee-form L, R, W (mm).
     #[serde(default)]
@@ -139,147 +147,195 @@ pub struct ConvergeSummary {
     pub seconds: Vec<f64>,
 }
 
-/// Draws the log-log error plot (one series per decided metric, fitted
-/// order in the legend: the guarantee a user reads) and the time plot into
-/// `dir`.
-pub fn write_plots(
-    dir: &Path,
-    results: &[PitchResult],
-    fits: &[(String, Option<Fit>)],
-) -> anyhow::Result<()> {
-    crate::output::register_font()?;
-    let pitches: Vec<f64> = results.iter().map(|r| r.pitch).collect();
-    let (pmin, pmax) = (
-        pitches.iter().copied().fold(f64::INFINITY, f64::min),
-        pitches.iter().copied().fold(0.0, f64::max),
-    );
-    let positive: Vec<f64> = results
-        .iter()
-        .flat_map(|r| r.comparison.stats.iter().map(|s| s.1.max))
-        .filter(|v| *v > 0.0 && v.is_finite())
-        .collect();
-    let (emin, emax) = (
-        positive
-            .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min)
-            .min(1e-3),
-        positive.iter().copied().fold(0.0, f64::max).max(1e-2),
-    );
-    let colours = [
-        RGBColor(31, 119, 180),
-        RGBColor(214, 39, 40),
-        RGBColor(44, 160, 44),
-        RGBColor(148, 103, 189),
-        RGBColor(255, 127, 14),
-        RGBColor(140, 86, 75),
-    ];
-    {
-        let path = dir.join("error_vs_pitch.png");
-        let root = BitMapBackend::new(&path, (900, 600)).into_drawing_area();
-        root.fill(&WHITE).map_err(draw_error)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
-                "Grid vs exact, decided strikes: largest error against pitch (log-log)",
-                ("sans-serif", 22),
-            )
-            .margin(16)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d(
-                (pmin / 1.5..pmax * 1.5).log_scale(),
-                (emin / 2.0..emax * 2.0).log_scale(),
-            )
-            .map_err(draw_error)?;
-        chart
-            .configure_mesh()
-            .x_desc("pitch (mm)")
-            .y_desc("max error (mm)")
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(draw_error)?;
-        let plotted = fits
-            .iter()
-            .enumerate()
-            .filter(|(_, (m, _))| DECIDED_METRICS.contains(&m.as_str()));
-        for (series, (k, (metric, fit))) in plotted.enumerate() {
-            let colour = colours[series % colours.len()];
-            let points: Vec<(f64, f64)> = results
-                .iter()
-                .map(|r| (r.pitch, r.comparison.stats[k].1.max))
-                .filter(|(_, e)| *e > 0.0 && e.is_finite())
-                .collect();
-            let label = match fit {
-                Some(f) => format!("{metric}: alpha = {:.2}", f.alpha),
-                None => format!("{metric}: no fit"),
-            };
-            chart
-                .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
-                .map_err(draw_error)?
-                .label(label)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
-            chart
-                .draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))
-                .map_err(draw_error)?;
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .position(SeriesLabelPosition::LowerRight)
-            .draw()
-            .map_err(draw_error)?;
-        root.present().map_err(draw_error)?;
-    }
-    {
-        let path = dir.join("time_vs_pitch.png");
-        let root = BitMapBackend::new(&path, (900, 600)).into_drawing_area();
-        root.fill(&WHITE).map_err(draw_error)?;
-        let times: Vec<(f64, f64)> = results
-            .iter()
-            .map(|r| (r.pitch, r.seconds.max(1e-4)))
-            .collect();
-        let (tmin, tmax) = (
-            times.iter().map(|t| t.1).fold(f64::INFINITY, f64::min),
-            times.iter().map(|t| t.1).fold(0.0, f64::max),
-        );
-        let mut chart = ChartBuilder::on(&root)
-            .caption("Engine time against pitch (log-log)", ("sans-serif", 22))
-            .margin(16)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d(
-                (pmin / 1.5..pmax * 1.5).log_scale(),
-                (tmin / 2.0..tmax * 2.0).log_scale(),
-            )
-            .map_err(draw_error)?;
-        chart
-            .configure_mesh()
-            .x_desc("pitch (mm)")
-            .y_desc("push + slide, study angles (s)")
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(draw_error)?;
-        chart
-            .draw_series(LineSeries::new(times.clone(), colours[0].stroke_width(2)))
-            .map_err(draw_error)?;
-        chart
-            .draw_series(
-                times
-                    .iter()
-                    .map(|&p| Circle::new(p, 4, colours[0].filled())),
-            )
-            .map_err(draw_error)?;
-        root.present().map_err(draw_error)?;
-    }
-    Ok(())
+/// How to run a convergence study, beside the analysis [`Setup`] (whose
+/// pitch it ignores).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConvergeOptions {
+    /// The pitches (mm), coarsest first, each dividing the coarsest so that
+    /// every grid holds the coarsest grid's starts.
+    pub pitches: Vec<f64>,
+    /// Which starts to compare (on the coarsest grid).
+    pub selection: StartSelection,
+    /// The tie band's growth with the pitch ([`super::TieBand`], per mm).
+    pub tie_band_per_mm: f64,
+    /// The tolerance to name the coarsest pitch for (mm).
+    pub tolerance: Option<f64>,
 }
 
-fn draw_error<E: std::fmt::Display>(e: E) -> anyhow::Error {
-    anyhow::anyhow!("cannot draw the convergence plot: {e}")
+impl ConvergeOptions {
+    /// Checks the options: at least two distinct positive pitches,
+    /// coarsest first, each dividing the coarsest.
+    pub fn validate(&self) -> Result<(), HarnessError> {
+        check_selection(&self.selection)?;
+        check_tie_band(self.tie_band_per_mm)?;
+        if let Some(t) = self.tolerance {
+            check_tolerance(t)?;
+        }
+        let bad = |why: String| Err(HarnessError::Pitches(why));
+        if self.pitches.len() < 2 {
+            return bad("a convergence study needs at least two pitches".into());
+        }
+        if let Some(p) = self.pitches.iter().find(|p| !(p.is_finite() && **p > 0.0)) {
+            return bad(format!(
+                "every pitch must be a finite number of mm > 0, got {p}"
+            ));
+        }
+        if self.pitches.windows(2).any(|w| w[0] <= w[1]) {
+            return bad("the pitches must be distinct, coarsest first".into());
+        }
+        let coarsest = self.pitches[0];
+        for &p in &self.pitches {
+            let ratio = coarsest / p;
+            if (ratio - ratio.round()).abs() >= 1e-9 * ratio {
+                return bad(format!(
+                    "{p} mm does not divide {coarsest} mm, so the grids would not share the coarsest grid's starts"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A convergence study's results.
+#[derive(Debug, Clone)]
+pub struct Convergence {
+    /// Every pitch's comparison, coarsest first.
+    pub results: Vec<PitchResult>,
+    /// Per metric ([`METRICS`] order), the fit of its max error.
+    pub fits: Vec<(String, Option<Fit>)>,
+    /// `converge.json`.
+    pub summary: ConvergeSummary,
+    /// Seconds the oracle took.
+    pub oracle_s: f64,
+}
+
+impl Convergence {
+    /// The coarsest pitch meeting the study's tolerance, if one was asked
+    /// for and one meets it.
+    pub fn recommended(&self) -> Option<&PitchResult> {
+        recommended_pitch(&self.results, self.summary.tolerance_mm?)
+    }
+}
+
+/// Compares grid and oracle on the same starts (the coarsest grid's) at
+/// every pitch of `options`: the oracle runs once, at the finest pitch's
+/// resolution; each grid is sampled, timed over the full engine at the
+/// study's angles, and compared.
+pub fn converge(
+    input: &PartFile,
+    setup: &Setup,
+    options: &ConvergeOptions,
+    progress: &dyn Progress,
+) -> Result<Convergence, HarnessError> {
+    options.validate()?;
+    let pitches = &options.pitches;
+    let coarse_setup = Setup {
+        pitch: pitches[0],
+        ..setup.clone()
+    };
+    coarse_setup.validate()?;
+    let triangles = &input.part.triangles;
+    let coarse = coarse_setup.grid_spec(&input.part.bbox())?;
+    // Finer grids cover exactly the coarse grid's extent from its origin.
+    let specs: Vec<GridSpec> = pitches
+        .iter()
+        .map(|&p| {
+            let r = (pitches[0] / p).round() as usize;
+            GridSpec::explicit(
+                coarse.x(0),
+                coarse.z(0),
+                (coarse.nx - 1) * r + 1,
+                (coarse.nz - 1) * r + 1,
+                p,
+            )
+        })
+        .collect();
+    for spec in &specs {
+        spec.check_fits(setup.max_memory_bytes)?;
+    }
+    let coarse_grid = HeightGrid::sample(triangles, coarse);
+    let starts = start_positions(
+        &coarse_grid,
+        &coarse_setup.footprints(&coarse),
+        &options.selection,
+    )?;
+    drop(coarse_grid);
+    let finest = pitches[pitches.len() - 1];
+    let oracle = oracle_options(&setup.knee, finest, coarse.x(0));
+    let (traces, oracle_s) = run_oracle(triangles, &starts, &setup.angles, &oracle, progress)?;
+    let compare = CompareOptions {
+        knee: setup.knee,
+        rule: setup.rule,
+        tie_band_per_mm: options.tie_band_per_mm,
+    };
+    let mut results = Vec::new();
+    for (&pitch, spec) in pitches.iter().zip(&specs) {
+        progress.begin(
+            &format!("pitch {pitch} mm: {} x {} grid", spec.nx, spec.nz),
+            None,
+        );
+        let grid = HeightGrid::sample(triangles, *spec);
+        let footprints = setup.footprints(spec);
+        let t = Instant::now();
+        let masks = colliding_masks(
+            &grid,
+            &footprints,
+            &EngineOptions {
+                rule: setup.rule,
+                ..EngineOptions::default()
+            },
+            &|| {},
+        );
+        let seconds = t.elapsed().as_secs_f64();
+        drop(masks);
+        let comparison = compare_grid(&grid, &footprints, &starts, &traces, &compare);
+        progress.end();
+        results.push(PitchResult {
+            pitch,
+            comparison: comparison?,
+            seconds,
+            nodes: spec.len(),
+        });
+    }
+    let fits = fits(&results);
+    let recommended = options
+        .tolerance
+        .and_then(|t| recommended_pitch(&results, t));
+    let full_angles = 61.0 / setup.angles.len() as f64;
+    let summary = ConvergeSummary {
+        kneeform_version: env!("CARGO_PKG_VERSION").into(),
+        input_file: input.path.display().to_string(),
+        input_sha256: input.sha256.clone(),
+        scale: input.scale,
+        side: input.side,
+        knee_form_mm: [
+            setup.knee.triangle_side,
+            setup.knee.radius,
+            setup.knee.thickness,
+        ],
+        sigma: setup.rule.sigma,
+        rate: setup.rule.rate.name().into(),
+        pitches_mm: pitches.clone(),
+        fits: fits
+            .iter()
+            .filter_map(|(m, f)| f.map(|f| (m.clone(), f)))
+            .collect(),
+        tolerance_mm: options.tolerance,
+        recommended_pitch_mm: recommended.map(|r| r.pitch),
+        predicted_full_time_s: recommended.map(|r| r.seconds * full_angles),
+        angles_deg: setup.angles.clone(),
+        deflection_deg: setup.rule.deflection_deg(),
+        e0_mm: setup.rule.e0,
+        tie_band_rule: tie_band_rule(options.tie_band_per_mm),
+        starts: starts.len(),
+        seconds: results.iter().map(|r| r.seconds).collect(),
+    };
+    Ok(Convergence {
+        results,
+        fits,
+        summary,
+        oracle_s,
+    })
 }
 
 #[cfg(test)]

@@ -2,134 +2,99 @@
 //! the same starts (SPEC, "What the harness measures"), and convergence
 //! over the pitch.
 //!
-//! * [`trace`]: the grid's push and slide of one start, with the travel of
-//!   each colliding node (and test-only [`Fault`]s);
-//! * [`metrics`]: push, first-contact, miss and false-alarm errors, area
-//!   IoU;
-//! * [`verify`]: start selection, the oracle's traces, one grid's
+//! * [`verify()`]: one pitch, a part's starts compared with the oracle
+//!   ([`Verification`]: the per-start rows, the metrics, `verify.json`'s
+//!   summary);
+//! * [`converge()`]: the same starts at several pitches, the fitted order
+//!   of convergence and the pitch to choose ([`Convergence`]);
+//! * [`compare`]: start selection, the oracle's traces, one grid's
 //!   comparison;
-//! * [`converge`]: the same starts at several pitches, the fitted order of
-//!   convergence and the pitch to choose.
+//! * [`trace`]: the grid's push and slide of one start, with the travel of
+//!   each colliding node;
+//! * [`metrics`]: push, first-contact, miss and false-alarm errors, the
+//!   tie band, the area distance;
+//! * [`nearest`]: a 2-d tree for the area distance's nearest points.
 //!
-//! **Invariant:** the harness reads the oracle's answers and the engine's,
-//! and computes neither's geometry itself.
+//! **Invariant:** the harness reads the engine's grid and the oracle's
+//! traces and computes neither side's geometry, with one exception stated
+//! here: [`trace`] re-runs SPEC's push and slide of one start on the
+//! engine's grid, because the engine's fast path keeps no per-start
+//! travel (it keeps each node's reach). It is a direct transcription of
+//! SPEC, tested equal to the engine's masks on every start.
 
+pub mod compare;
 pub mod converge;
 pub mod metrics;
 pub mod nearest;
 pub mod trace;
 pub mod verify;
 
-pub use metrics::{DECIDED_METRICS, METRICS, Stats, TieBand};
-pub use trace::{Fault, GridTrace, grid_trace};
-pub use verify::{
+#[cfg(test)]
+mod fault_tests;
+
+pub use compare::{
     AreaDistance, CompareOptions, Comparison, Counts, StartSelection, VerifyRow, compare_grid,
     exact_traces, select_starts,
 };
+pub use converge::{ConvergeOptions, ConvergeSummary, Convergence, PitchResult, converge};
+pub use metrics::{DECIDED_METRICS, METRICS, Stats, TieBand};
+pub use trace::{GridContact, GridTrace};
+pub use verify::{
+    Verification, VerifyOptions, VerifySummary, VerifyTimings, WorstStart, oracle_options,
+    tie_band_rule, verify,
+};
 
-use serde::{Deserialize, Serialize};
+use crate::analysis::SetupError;
+use crate::grid::GridError;
 
-/// `verify.json`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct VerifySummary {
-    /// Version of kneeform.
-    pub kneeform_version: String,
-    /// The part (STL or scenario file) as given.
-    pub input_file: String,
-    /// SHA-256 of the part file's bytes (hex), as `summary.json`'s
-    /// `sha256`: what `kneeform report` matches a verification to its run by.
-    #[serde(default)]
-    pub input_sha256: String,
-    /// Factor from the file's units to mm.
-    #[serde(default = "unit_scale")]
-    pub scale: f64,
-    /// `left` or `right`.
-    #[serde(default = "left_side")]
-    pub side: crate::Side,
-    /// Grid pitch (mm).
-    pub pitch_mm: f64,
-    /// The tolerance every metric's max is held to (mm).
-    pub tolerance_mm: f64,
-    /// Whether every decided metric is within tolerance, with nothing
-    /// contradictory or failed (undecided strikes never fail).
-    pub pass: bool,
-    /// Angles (degrees).
-    pub angles_deg: Vec<f64>,
-    /// Knee-form L, R, W (mm).
-    pub knee_form_mm: [f64; 3],
-    /// Deflection threshold delta (degrees).
-    pub deflection_deg: f64,
-    /// The same threshold as a rate, `sigma = tan(delta)`.
-    pub sigma: f64,
-    /// Rounding tolerance e0 (mm).
-    pub e0_mm: f64,
-    /// How the grid's deflection rate is estimated (`capped` or `x-slope`).
-    pub rate: String,
-    /// The tie band at this pitch: `sigma`, `m`, and its bounds as rates.
-    pub tie_band: TieBand,
-    /// The tie band's rule, in words.
-    pub tie_band_rule: String,
-    /// The headline: the area distance, decided (mm; `null` if infinite).
-    pub area_distance_decided_mm: Option<f64>,
-    /// The area distance over all strikes (mm; `null` if infinite).
-    pub area_distance_mm: Option<f64>,
-    /// The area distance per angle.
-    pub area_distance: Vec<AreaDistance>,
-    /// `all`, or the sample size.
-    pub starts: String,
-    /// The sample's seed.
-    pub seed: u64,
-    /// Per metric: max, p95, mean over the values (mm).
-    pub metrics: std::collections::BTreeMap<String, Stats>,
-    /// Grid mask against exact contacts snapped to nodes.
-    pub area_iou: f64,
-    /// Counts.
-    pub counts: Counts,
-    /// The worst start-angle pairs.
-    pub worst_starts: Vec<WorstStart>,
-    /// Seconds on each side.
-    pub timings: VerifyTimings,
-}
-
-/// `scale` of files written before it was recorded.
-pub(crate) fn unit_scale() -> f64 {
-    1.0
-}
-
-/// `side` of files written before it was recorded.
-pub(crate) fn left_side() -> crate::Side {
-    crate::Side::Left
-}
-
-/// One of the worst start-angle pairs.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct WorstStart {
-    /// Grid column.
-    pub i: usize,
-    /// Grid row.
-    pub j: usize,
-    /// Start position x (mm, analysis frame).
-    pub x: f64,
-    /// Start position z (mm).
-    pub z: f64,
-    /// Angle (degrees).
-    pub angle_deg: f64,
-    /// The metric that is worst there.
-    pub metric: String,
-    /// Its value (mm).
-    pub value: f64,
-    /// Where the disagreement lies, `[x, z]` (mm, analysis frame): the
-    /// missed exact strike or the false-alarm grid strike.
-    pub at: Option<[f64; 2]>,
-}
-
-/// Seconds spent by each side.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-pub struct VerifyTimings {
-    /// Sampling the grid.
-    pub sample_s: f64,
-    /// Grid push and slide of the compared starts.
-    pub grid_s: f64,
-    /// The oracle's traces.
-    pub oracle_s: f64,
+/// Why a verification or convergence study could not run. (A failed
+/// oracle query on one start is no error: it is counted and fails the
+/// comparison.)
+#[derive(Debug, thiserror::Error)]
+pub enum HarnessError {
+    /// The setup is invalid.
+    #[error(transparent)]
+    Setup(#[from] SetupError),
+    /// The grid cannot be laid.
+    #[error(transparent)]
+    Grid(#[from] GridError),
+    /// The oracle refused the part or its options.
+    #[error(transparent)]
+    Oracle(#[from] kneeform_oracle::OracleError),
+    /// No start is placed on the part.
+    #[error("no start is placed on this part: nothing to compare")]
+    NoStarts,
+    /// A start given is not a node of the grid compared.
+    #[error("start ({x}, {z}) mm is not a node of the {pitch} mm grid: the pitches must nest")]
+    StartNotANode {
+        /// The start's x (mm).
+        x: f64,
+        /// The start's z (mm).
+        z: f64,
+        /// The grid's pitch (mm).
+        pitch: f64,
+    },
+    /// The traces are not one per start and angle.
+    #[error("{traces} exact traces for {expected} start-angle pairs")]
+    TraceCount {
+        /// Traces given.
+        traces: usize,
+        /// Starts times angles.
+        expected: usize,
+    },
+    /// The tolerance is not a finite positive length.
+    #[error("the tolerance must be a finite number of mm > 0, got {0}")]
+    Tolerance(f64),
+    /// The tie band's growth is not a finite number >= 0.
+    #[error("the tie band's growth must be a finite number >= 0 (per mm), got {0}")]
+    TieBand(f64),
+    /// The pitch ladder of a convergence study is unusable.
+    #[error("{0}")]
+    Pitches(String),
+    /// A start sample of no start.
+    #[error("a start sample must hold at least one start")]
+    EmptySample,
+    /// A strip of start rows whose bounds are not finite and ordered.
+    #[error("a strip of starts needs finite z bounds Z0 <= Z1 (mm), got {0:?}")]
+    Strip([f64; 2]),
 }

@@ -11,9 +11,11 @@ use crate::kneeform::{GridFootprint, NODE_TOL};
 use crate::strike::StrikeRule;
 
 /// A deliberate mistake in the grid side of a comparison, for the tests
-/// that show the harness catches a broken engine.
+/// that show the harness catches a broken engine. Crate-private: no
+/// public entry point takes one.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Fault {
+#[cfg_attr(not(test), allow(dead_code))]
+pub(crate) enum Fault {
     /// Every height offset by half a pitch away from the knee (+y).
     HeightsOffsetHalfPitch,
     /// The footprint loses its leading row (the row reaching furthest to
@@ -44,7 +46,7 @@ pub struct GridTrace {
 }
 
 /// Pushes and slides the start at node `(i0, j0)`, with an optional fault.
-pub fn grid_trace(
+pub(crate) fn grid_trace(
     grid: &HeightGrid,
     fp: &GridFootprint,
     i0: usize,
@@ -52,6 +54,7 @@ pub fn grid_trace(
     rule: &StrikeRule,
     fault: Option<Fault>,
 ) -> GridTrace {
+    crate::engine::assert_same_pitch(grid, std::slice::from_ref(fp));
     let spec = grid.spec;
     let p = spec.pitch;
     let offset = if fault == Some(Fault::HeightsOffsetHalfPitch) {
@@ -136,7 +139,7 @@ mod tests {
     use super::*;
     use crate::engine::{EngineOptions, colliding_masks};
     use crate::grid::GridSpec;
-    use crate::kneeform::{Footprint, KneeForm};
+    use crate::kneeform::KneeForm;
 
     /// The union of the per-start traces is the engine's mask.
     #[test]
@@ -161,7 +164,7 @@ mod tests {
             thickness: 100.0,
         };
         for angle in [-30.0, 0.0, 12.0] {
-            let fp = GridFootprint::new(&Footprint::new(&knee, angle), angle, spec.pitch);
+            let fp = GridFootprint::new(&knee, angle, &spec);
             let mut union = vec![0u8; spec.len()];
             for j0 in 0..spec.nz {
                 for i0 in 0..spec.nx {

@@ -22,11 +22,15 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 mod csv;
+mod plot;
 mod ply;
 mod png;
+mod results;
 mod stl;
+mod surface;
 
 pub use self::csv::{write_colliding_points, write_composite};
+pub use self::plot::write_plots;
 pub use self::ply::write_colliding_area_ply;
 pub(crate) use self::png::count_colour;
 pub(crate) use self::png::register_font;
@@ -34,8 +38,75 @@ pub use self::png::{
     CROP_MARGIN, NO_PART, PngError, RING_BELOW, RING_COLOUR, Window, composite_key, crop_window,
     depth_bar_ends, view_line, write_composite_png, write_depth_png,
 };
+pub use self::results::{write_analysis, write_convergence, write_verification};
 pub(crate) use self::stl::to_stl_triangle;
 pub use self::stl::write_colliding_area;
+
+/// Why a result could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum WriteError {
+    /// A file could not be created or written.
+    #[error("cannot write {}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: io::Error,
+    },
+    /// A result directory could not be staged or moved into place.
+    #[error("cannot move results into {}", path.display())]
+    Commit {
+        /// The final directory.
+        path: PathBuf,
+        /// The cause.
+        source: io::Error,
+    },
+    /// An image could not be drawn.
+    #[error(transparent)]
+    Png(#[from] PngError),
+    /// A plot could not be drawn.
+    #[error("cannot draw the convergence plot: {0}")]
+    Plot(String),
+}
+
+impl WriteError {
+    /// A closure wrapping an I/O-ish error with the file it concerns.
+    pub(crate) fn at<E: Into<io::Error>>(path: &Path) -> impl FnOnce(E) -> WriteError + '_ {
+        move |e| WriteError::Io {
+            path: path.to_path_buf(),
+            source: e.into(),
+        }
+    }
+}
+
+/// Writes the file `path` whole or not at all: `write` fills a temporary
+/// file in the same directory, which is synced and then renamed into
+/// place; on any failure the temporary file is removed and `path` is left
+/// as it was.
+pub fn write_file_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut io::BufWriter<std::fs::File>) -> io::Result<()>,
+) -> io::Result<()> {
+    let mut tmp_name = path.file_name().unwrap_or_default().to_os_string();
+    static NEXT: AtomicUsize = AtomicUsize::new(0);
+    tmp_name.push(format!(
+        ".tmp-{}-{}",
+        std::process::id(),
+        NEXT.fetch_add(1, Ordering::Relaxed)
+    ));
+    let tmp = path.with_file_name(tmp_name);
+    let written = (|| {
+        let mut file = io::BufWriter::new(std::fs::File::create(&tmp)?);
+        write(&mut file)?;
+        let file = file.into_inner().map_err(io::IntoInnerError::into_error)?;
+        file.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written
+}
 
 /// A result directory written atomically: files go into a hidden sibling
 /// staging directory (`<parent>/.<name>.partial-<pid>-<n>`) and are renamed

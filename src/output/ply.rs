@@ -17,10 +17,7 @@ use crate::grid::HeightGrid;
 use crate::mesh::Side;
 
 use super::count_colour;
-
-/// Side of the square drawn on an unconnected colliding node, as a fraction
-/// of the pitch: the STL's patch size, so both files show the same area.
-const PATCH_FRACTION: f64 = 0.25;
+use super::surface::{AreaSurface, to_part, wound};
 
 /// Writes the composite area (nodes with `composite > 0`) as an ASCII PLY
 /// mesh in the part's coordinates (mm; vertex `(x, side.to_part(h), z)`),
@@ -36,17 +33,7 @@ pub fn write_colliding_area_ply<W: Write>(
     n_angles: usize,
     side: Side,
 ) -> io::Result<usize> {
-    if composite.len() != grid.spec.len() {
-        return Err(io::Error::new(
-            io::ErrorKind::InvalidInput,
-            format!(
-                "composite has {} entries but the grid has {} nodes",
-                composite.len(),
-                grid.spec.len()
-            ),
-        ));
-    }
-    let mesh = ColouredMesh::build(grid, composite, side);
+    let mesh = AreaSurface::new(grid, composite)?;
     let max_count = composite.iter().copied().max().unwrap_or(0);
     let n = n_angles.max(usize::from(max_count)).max(1);
     writeln!(w, "ply")?;
@@ -67,7 +54,8 @@ pub fn write_colliding_area_ply<W: Write>(
     writeln!(w, "element face {}", mesh.faces.len())?;
     writeln!(w, "property list uchar int vertex_indices")?;
     writeln!(w, "end_header")?;
-    for &([x, y, z], count) in &mesh.vertices {
+    for &(v, count) in &mesh.vertices {
+        let [x, y, z] = to_part(v, side);
         let c = count_colour(usize::from(count), n);
         // -0 is written as 0, as in the CSV files: mirroring a zero height
         // must not change the file.
@@ -83,80 +71,12 @@ pub fn write_colliding_area_ply<W: Write>(
             c.2
         )?;
     }
-    for [a, b, c] in &mesh.faces {
+    for &f in &mesh.faces {
+        let [a, b, c] = wound(f, side);
         writeln!(w, "3 {a} {b} {c}")?;
     }
     w.flush()?;
     Ok(mesh.faces.len())
-}
-
-/// Vertices (part frame, mm) with their count, and triangles indexing them.
-struct ColouredMesh {
-    vertices: Vec<([f64; 3], u16)>,
-    faces: Vec<[u32; 3]>,
-}
-
-impl ColouredMesh {
-    fn build(grid: &HeightGrid, composite: &[u16], side: Side) -> ColouredMesh {
-        let (nx, nz) = (grid.spec.nx, grid.spec.nz);
-        let hit = |i: usize, j: usize| composite[j * nx + i] > 0;
-        let mut index = vec![u32::MAX; composite.len()];
-        let mut mesh = ColouredMesh {
-            vertices: Vec::new(),
-            faces: Vec::new(),
-        };
-        let mut vertex = |mesh: &mut ColouredMesh, i: usize, j: usize| -> u32 {
-            let k = j * nx + i;
-            if index[k] == u32::MAX {
-                index[k] = mesh.vertices.len() as u32;
-                let p = [grid.spec.x(i), side.to_part(grid.h[k]), grid.spec.z(j)];
-                mesh.vertices.push((p, composite[k]));
-            }
-            index[k]
-        };
-        for j in 0..nz.saturating_sub(1) {
-            for i in 0..nx.saturating_sub(1) {
-                // Corners counter-clockwise in (x, z), x right and z up: the
-                // normal faces -y in the analysis frame.
-                let corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
-                let on: Vec<(usize, usize)> =
-                    corners.into_iter().filter(|&(a, b)| hit(a, b)).collect();
-                let tris: &[[usize; 3]] = match on.len() {
-                    4 => &[[0, 1, 2], [0, 2, 3]],
-                    3 => &[[0, 1, 2]],
-                    _ => &[],
-                };
-                for t in tris {
-                    let f = t.map(|c| vertex(&mut mesh, on[c].0, on[c].1));
-                    mesh.faces.push(wound(f, side));
-                }
-            }
-        }
-        let half = 0.5 * PATCH_FRACTION * grid.spec.pitch;
-        for k in 0..composite.len() {
-            if composite[k] == 0 || index[k] != u32::MAX {
-                continue;
-            }
-            let (x, z) = (grid.spec.x(k % nx), grid.spec.z(k / nx));
-            let y = side.to_part(grid.h[k]);
-            let first = mesh.vertices.len() as u32;
-            for (dx, dz) in [(-half, -half), (half, -half), (half, half), (-half, half)] {
-                mesh.vertices.push(([x + dx, y, z + dz], composite[k]));
-            }
-            mesh.faces.push(wound([first, first + 1, first + 2], side));
-            mesh.faces.push(wound([first, first + 2, first + 3], side));
-        }
-        mesh
-    }
-}
-
-/// A mirror (the right side) reverses the sense of rotation: swap two
-/// vertices so the face still faces the knee.
-fn wound([a, b, c]: [u32; 3], side: Side) -> [u32; 3] {
-    match side {
-        Side::Left => [a, b, c],
-        Side::Right => [a, c, b],
-    }
 }
 
 #[cfg(test)]

@@ -1,12 +1,8 @@
 //! The colliding area as a binary STL surface, for viewing over the part in
 //! a CAD tool.
 //!
-//! The surface is polyhedral over the grid: adjacent colliding nodes are
-//! joined (a cell with four colliding corners gives two triangles, one with
-//! exactly three gives the triangle of those three), and a colliding node
-//! that ends up in no triangle, isolated or only on a line of nodes, gets a
-//! small flat square so that it is still visible. Vertices sit at the nodes'
-//! heights, so the surface lies on the part.
+//! The surface is [`AreaSurface`], the one the PLY writer writes too:
+//! vertices at the colliding nodes' heights, so it lies on the part.
 //!
 //! Triangles face the knee: -y in the analysis frame. For the right side y
 //! is mirrored back to the part, and a mirror reverses the sense of
@@ -15,13 +11,9 @@
 
 use std::io::{self, Write};
 
+use super::surface::{AreaSurface, to_part, wound};
 use crate::grid::HeightGrid;
 use crate::mesh::{Side, Triangle};
-
-/// Side of the square patch drawn on an otherwise unconnected colliding
-/// node, as a fraction of the pitch: small enough not to be mistaken for a
-/// cell, large enough to see.
-const PATCH_FRACTION: f64 = 0.25;
 
 /// Writes the composite area (nodes with `composite > 0`) as a binary STL
 /// in the part's coordinates (mm; vertex `(x, side.to_part(h), z)`), facing
@@ -35,80 +27,16 @@ pub fn write_colliding_area<W: Write>(
     composite: &[u16],
     side: Side,
 ) -> io::Result<usize> {
-    if composite.len() != grid.spec.len() {
-        return Err(io::Error::new(
-            io::ErrorKind::InvalidInput,
-            format!(
-                "composite has {} entries but the grid has {} nodes",
-                composite.len(),
-                grid.spec.len()
-            ),
-        ));
-    }
-    let triangles: Vec<stl_io::Triangle> = colliding_area(grid, composite)
+    let surface = AreaSurface::new(grid, composite)?;
+    let triangles: Vec<stl_io::Triangle> = surface
+        .faces
         .iter()
-        .map(|t| to_stl_triangle(&to_part(t, side)))
+        .map(|&f| {
+            to_stl_triangle(&wound(f, side).map(|v| to_part(surface.vertices[v as usize].0, side)))
+        })
         .collect();
     stl_io::write_stl(&mut w, triangles.iter())?;
     Ok(triangles.len())
-}
-
-/// The area's triangles in the analysis frame, wound counter-clockwise in
-/// (x, z) so that their normals face -y.
-fn colliding_area(grid: &HeightGrid, composite: &[u16]) -> Vec<Triangle> {
-    let (nx, nz) = (grid.spec.nx, grid.spec.nz);
-    let hit = |i: usize, j: usize| composite[j * nx + i] > 0;
-    let vertex = |i: usize, j: usize| [grid.spec.x(i), grid.h[j * nx + i], grid.spec.z(j)];
-    let mut used = vec![false; composite.len()];
-    let mut out = Vec::new();
-    for j in 0..nz.saturating_sub(1) {
-        for i in 0..nx.saturating_sub(1) {
-            // Corners counter-clockwise in (x, z): x to the right, z up.
-            let corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
-            let on: Vec<(usize, usize)> = corners.into_iter().filter(|&(a, b)| hit(a, b)).collect();
-            let tris: &[[usize; 3]] = match on.len() {
-                4 => &[[0, 1, 2], [0, 2, 3]],
-                // Dropping one corner keeps the others' cyclic order.
-                3 => &[[0, 1, 2]],
-                _ => &[],
-            };
-            for t in tris {
-                out.push(t.map(|k| vertex(on[k].0, on[k].1)));
-            }
-            if !tris.is_empty() {
-                for &(a, b) in &on {
-                    used[b * nx + a] = true;
-                }
-            }
-        }
-    }
-    let half = 0.5 * PATCH_FRACTION * grid.spec.pitch;
-    for (k, _) in composite
-        .iter()
-        .enumerate()
-        .filter(|&(k, &c)| c > 0 && !used[k])
-    {
-        let [x, y, z] = vertex(k % nx, k / nx);
-        let c = [
-            [x - half, y, z - half],
-            [x + half, y, z - half],
-            [x + half, y, z + half],
-            [x - half, y, z + half],
-        ];
-        out.push([c[0], c[1], c[2]]);
-        out.push([c[0], c[2], c[3]]);
-    }
-    out
-}
-
-/// Maps an analysis-frame triangle to the part: y mirrored for the right
-/// side, with two vertices swapped so the winding still gives the normal.
-fn to_part(t: &Triangle, side: Side) -> Triangle {
-    let [a, b, c] = t.map(|[x, y, z]| [x, side.to_part(y), z]);
-    match side {
-        Side::Left => [a, b, c],
-        Side::Right => [a, c, b],
-    }
 }
 
 /// An STL triangle with its unit normal from the winding (right-hand rule);

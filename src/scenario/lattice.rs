@@ -18,7 +18,7 @@ const SAME_LINE: f64 = 1e-3;
 /// The lattice coordinates along one axis: every multiple of `step` inside
 /// `range`, the range's ends, and the `extra` creases strictly inside it
 /// (each unless within [`SAME_LINE`] of a line already there), sorted.
-pub(super) fn axis(range: (f64, f64), step: f64, extra: &[f64]) -> Vec<f64> {
+pub fn axis(range: (f64, f64), step: f64, extra: &[f64]) -> Vec<f64> {
     let (lo, hi) = range;
     let first = (lo / step).ceil() as i64;
     let last = (hi / step).floor() as i64;
@@ -96,11 +96,7 @@ pub(super) fn refined_step(
 /// Samples `height` at every lattice vertex `(xs[i], zs[k])` and splits
 /// each cell into two triangles, counter-clockwise in (x, z) so their
 /// normals face -y, towards the knee. Vertex y is exactly `height(x, z)`.
-pub(super) fn tessellate(
-    xs: &[f64],
-    zs: &[f64],
-    height: impl Fn(f64, f64) -> f64,
-) -> Vec<Triangle> {
+pub fn tessellate(xs: &[f64], zs: &[f64], height: impl Fn(f64, f64) -> f64) -> Vec<Triangle> {
     let row = |z: f64| -> Vec<[f64; 3]> { xs.iter().map(|&x| [x, height(x, z), z]).collect() };
     let cells = xs.len().saturating_sub(1) * zs.len().saturating_sub(1);
     let mut out = Vec::with_capacity(2 * cells);

@@ -299,7 +299,7 @@ fn parts_that_strike_nothing_strike_nothing() {
         let footprints: Vec<GridFootprint> = angles
             .iter()
             .zip(&shapes)
-            .map(|(&a, s)| GridFootprint::new(s, a, pitch))
+            .map(|(&a, _)| GridFootprint::new(&knee, a, &spec))
             .collect();
         let masks = colliding_masks(&grid, &footprints, &EngineOptions::default(), &|| {});
         for m in &masks {

@@ -38,6 +38,7 @@ pub use file::{
     Extent, MAX_TRIANGLES, ScenarioError, ScenarioFile, is_scenario_file, load, parse,
     triangles_from_file,
 };
+pub use lattice::{axis, tessellate};
 pub use primitive::{Boss, Bump, Console, Feature, Groove, Plane, Rib, Ridge, Step, Wave};
 
 /// Writes `triangles` (mm) as a binary STL at `path`, through a temporary

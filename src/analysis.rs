@@ -1,0 +1,448 @@
+//! The analysis as one call: a part and a validated [`Setup`] in; the
+//! grid, the colliding mask per angle, the composite, the warnings and the
+//! summary out ([`Analysis`]).
+//!
+//! This is the pipeline every front end shares (the CLI's `analyze`, the
+//! harness's `verify` and `converge`, the tests, an embedding program):
+//! SPEC's default grid extent, the memory check before anything is
+//! allocated, the grid laid and sampled, the footprints laid on that grid,
+//! push and slide, the composite. Progress and warnings go through a
+//! [`Progress`] callback; nothing here prints or writes files (the writers
+//! are in [`crate::output`]).
+
+use std::time::Instant;
+
+use crate::engine::{Algorithm, AngleMask, EngineOptions, colliding_masks, composite};
+use crate::grid::{GridError, GridSpec, HeightGrid};
+use crate::kneeform::{Footprint, GridFootprint, KneeForm};
+use crate::mesh::{Bbox, MeshError, PartFile, read_part};
+use crate::sanity::{self, Warning};
+use crate::strike::StrikeRule;
+use crate::summary::{AngleSummary, Summary, Timings};
+
+/// Where the grid lies.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GridPlacement {
+    /// SPEC's default extent: every node whose footprint, at any angle or
+    /// its mirror, can reach the part's xz bounding box.
+    AroundPart,
+    /// An explicit origin (mm, snapped to multiples of the pitch) and
+    /// size (nodes).
+    Explicit {
+        /// Origin x, z (mm).
+        origin: [f64; 2],
+        /// Nodes along x, z.
+        size: [usize; 2],
+    },
+}
+
+/// What an analysis computes: the knee-form, the grid, the angles and the
+/// strike rule. Lengths in mm, angles in degrees. [`Setup::validate`]
+/// checks it; [`Analysis::run`] does so before any work.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Setup {
+    /// Grid pitch (mm).
+    pub pitch: f64,
+    /// The knee-form.
+    pub knee: KneeForm,
+    /// Knee-form angles (degrees, positive raises its back), distinct.
+    pub angles: Vec<f64>,
+    /// SPEC's strike rule.
+    pub rule: StrikeRule,
+    /// Where the grid lies.
+    pub grid: GridPlacement,
+    /// Which implementation of push and slide runs (both give the same
+    /// masks).
+    pub algorithm: Algorithm,
+    /// The largest estimated working memory allowed (bytes).
+    pub max_memory_bytes: f64,
+}
+
+impl Default for Setup {
+    /// The paper's setup: 1.24 mm pitch, the default knee-form, every
+    /// whole degree from -30 to 30, SPEC's default strike rule, the default
+    /// extent, the fast engine, 16 GiB.
+    fn default() -> Self {
+        Setup {
+            pitch: 1.24,
+            knee: KneeForm::default(),
+            angles: (-30..=30).map(f64::from).collect(),
+            rule: StrikeRule::default(),
+            grid: GridPlacement::AroundPart,
+            algorithm: Algorithm::Fast,
+            max_memory_bytes: 16.0 * f64::from(1u32 << 30),
+        }
+    }
+}
+
+/// A setup that cannot be run. Each names the field at fault
+/// ([`SetupError::field`]), so that a front end can name its own flag.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SetupError {
+    /// A length or limit that must be a finite positive number is not.
+    #[error("the {field} must be a finite number > 0, got {value}")]
+    NotPositive {
+        /// The field (`pitch`, `triangle_side`, `radius`, `thickness`,
+        /// `max_memory`).
+        field: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// The angle list is empty.
+    #[error("no angle given")]
+    NoAngles,
+    /// An angle is not finite or beyond +-90 degrees.
+    #[error("angle {0} is outside -90..90 degrees")]
+    AngleOutOfRange(f64),
+    /// An angle is given twice.
+    #[error("angle {0} is given twice")]
+    RepeatedAngle(f64),
+    /// The deflection threshold is outside [0, 45) degrees.
+    #[error("the deflection threshold must be a number of degrees in [0, 45), got {0}")]
+    Deflection(f64),
+    /// The rounding tolerance is outside [0, 0.01] mm.
+    #[error("e0 must be a number of mm in [0, 0.01] (it only absorbs rounding), got {0}")]
+    E0(f64),
+    /// The explicit grid's origin is not finite.
+    #[error("the grid origin must be finite, got {0:?}")]
+    GridOrigin([f64; 2]),
+    /// The explicit grid has no node.
+    #[error("the grid size must be at least 1,1, got {0:?}")]
+    GridSize([usize; 2]),
+}
+
+impl SetupError {
+    /// The [`Setup`] field at fault, snake_case (`pitch`, `angles`,
+    /// `deflection`, `e0`, `grid_origin`, ...).
+    pub fn field(&self) -> &'static str {
+        match self {
+            SetupError::NotPositive { field, .. } => field,
+            SetupError::NoAngles
+            | SetupError::AngleOutOfRange(_)
+            | SetupError::RepeatedAngle(_) => "angles",
+            SetupError::Deflection(_) => "deflection",
+            SetupError::E0(_) => "e0",
+            SetupError::GridOrigin(_) => "grid_origin",
+            SetupError::GridSize(_) => "grid_size",
+        }
+    }
+}
+
+impl Setup {
+    /// Checks every field, before any work.
+    pub fn validate(&self) -> Result<(), SetupError> {
+        let positive = |field: &'static str, value: f64| {
+            if value.is_finite() && value > 0.0 {
+                Ok(())
+            } else {
+                Err(SetupError::NotPositive { field, value })
+            }
+        };
+        positive("pitch", self.pitch)?;
+        positive("triangle_side", self.knee.triangle_side)?;
+        positive("radius", self.knee.radius)?;
+        positive("thickness", self.knee.thickness)?;
+        positive("max_memory", self.max_memory_bytes)?;
+        if self.angles.is_empty() {
+            return Err(SetupError::NoAngles);
+        }
+        if let Some(&a) = self
+            .angles
+            .iter()
+            .find(|a| !(a.is_finite() && a.abs() <= 90.0))
+        {
+            return Err(SetupError::AngleOutOfRange(a));
+        }
+        let mut sorted = self.angles.clone();
+        sorted.sort_by(f64::total_cmp);
+        if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
+            return Err(SetupError::RepeatedAngle(w[0]));
+        }
+        let deflection = self.rule.deflection_deg();
+        if !(deflection.is_finite() && (0.0..45.0).contains(&deflection)) {
+            return Err(SetupError::Deflection(deflection));
+        }
+        if !(self.rule.e0.is_finite() && (0.0..=0.01).contains(&self.rule.e0)) {
+            return Err(SetupError::E0(self.rule.e0));
+        }
+        if let GridPlacement::Explicit { origin, size } = self.grid {
+            if !origin.iter().all(|c| c.is_finite()) {
+                return Err(SetupError::GridOrigin(origin));
+            }
+            if size.contains(&0) {
+                return Err(SetupError::GridSize(size));
+            }
+        }
+        Ok(())
+    }
+
+    /// The grid for a part with bounding box `bbox` (analysis frame), at
+    /// this setup's pitch: SPEC's default extent covers every requested
+    /// angle and its mirror, so that a part mirrored in z gets the mirrored
+    /// grid. Checked to be non-empty and within the memory limit.
+    pub fn grid_spec(&self, bbox: &Bbox) -> Result<GridSpec, GridError> {
+        let spec = match self.grid {
+            GridPlacement::AroundPart => {
+                let extents: Vec<Footprint> = self
+                    .angles
+                    .iter()
+                    .flat_map(|&a| {
+                        [
+                            Footprint::new(&self.knee, a),
+                            Footprint::new(&self.knee, -a),
+                        ]
+                    })
+                    .collect();
+                GridSpec::around(bbox, &extents, self.pitch)
+            }
+            GridPlacement::Explicit { origin, size } => {
+                GridSpec::explicit(origin[0], origin[1], size[0], size[1], self.pitch)
+            }
+        };
+        spec.check_fits(self.max_memory_bytes)?;
+        Ok(spec)
+    }
+
+    /// The knee-form's footprint at every angle, laid on `spec`.
+    pub fn footprints(&self, spec: &GridSpec) -> Vec<GridFootprint> {
+        self.angles
+            .iter()
+            .map(|&a| GridFootprint::new(&self.knee, a, spec))
+            .collect()
+    }
+}
+
+/// Why an analysis could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum AnalysisError {
+    /// The setup is invalid.
+    #[error(transparent)]
+    Setup(#[from] SetupError),
+    /// The part could not be read.
+    #[error(transparent)]
+    Part(#[from] MeshError),
+    /// The grid cannot be laid (empty, or too large for the memory limit).
+    #[error(transparent)]
+    Grid(#[from] GridError),
+}
+
+/// What a long computation reports while it runs. Every method has an
+/// empty default, and `()` reports nothing.
+pub trait Progress: Sync {
+    /// A finding, said as soon as it is known (before the work it
+    /// concerns).
+    fn warn(&self, warning: &Warning) {
+        let _ = warning;
+    }
+    /// A stage begins: `what` in words, `total` steps when known.
+    fn begin(&self, what: &str, total: Option<u64>) {
+        let _ = (what, total);
+    }
+    /// One step of the current stage is done.
+    fn step(&self) {}
+    /// The current stage is done.
+    fn end(&self) {}
+}
+
+impl Progress for () {}
+
+/// The outcome of an analysis, in one word.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// Some node is struck at some angle.
+    Struck,
+    /// Nothing is struck at any angle: a part in the wrong units or facing
+    /// the wrong way, more often than a part with no knee contact (see the
+    /// warnings).
+    NothingStruck,
+}
+
+/// One analysed part: the grid it was sampled on, the colliding mask per
+/// angle, their composite and what was found on the way.
+#[derive(Debug, Clone)]
+pub struct Analysis {
+    /// The part and its file's identity.
+    pub input: PartFile,
+    /// The setup it ran with.
+    pub setup: Setup,
+    /// The height grid.
+    pub grid: HeightGrid,
+    /// The footprints, laid on `grid`, in the order of `setup.angles`.
+    pub footprints: Vec<GridFootprint>,
+    /// The colliding mask per angle, in the order of `setup.angles`.
+    pub masks: Vec<AngleMask>,
+    /// Per node, the number of angles at which it collides.
+    pub composite: Vec<u16>,
+    /// The sanity checks' findings, in the order they were made.
+    pub warnings: Vec<Warning>,
+    /// Seconds per stage (`write_s` and `total_s` are the writer's).
+    pub timings: Timings,
+}
+
+impl Analysis {
+    /// Reads the part at `path` ([`read_part`]) and analyses it.
+    pub fn of_file(
+        path: &std::path::Path,
+        scale: f64,
+        side: crate::mesh::Side,
+        setup: &Setup,
+        progress: &dyn Progress,
+    ) -> Result<Analysis, AnalysisError> {
+        setup.validate()?;
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(SetupError::NotPositive {
+                field: "scale",
+                value: scale,
+            }
+            .into());
+        }
+        let angle_warnings = sanity::angle_warnings(&setup.angles);
+        for w in &angle_warnings {
+            progress.warn(w);
+        }
+        let t = Instant::now();
+        let input = read_part(path, scale, side)?;
+        let read_s = t.elapsed().as_secs_f64();
+        let mut analysis = Analysis::run_checked(input, setup, progress, angle_warnings)?;
+        analysis.timings.read_s = read_s;
+        Ok(analysis)
+    }
+
+    /// Analyses a part already read: the checks of the part, the grid, push
+    /// and slide at every angle, the composite.
+    pub fn run(
+        input: PartFile,
+        setup: &Setup,
+        progress: &dyn Progress,
+    ) -> Result<Analysis, AnalysisError> {
+        setup.validate()?;
+        let angle_warnings = sanity::angle_warnings(&setup.angles);
+        for w in &angle_warnings {
+            progress.warn(w);
+        }
+        Analysis::run_checked(input, setup, progress, angle_warnings)
+    }
+
+    fn run_checked(
+        input: PartFile,
+        setup: &Setup,
+        progress: &dyn Progress,
+        mut warnings: Vec<Warning>,
+    ) -> Result<Analysis, AnalysisError> {
+        let part_warnings = sanity::part_warnings(&input.part, input.side, &setup.knee);
+        for w in &part_warnings {
+            progress.warn(w);
+        }
+        warnings.extend(part_warnings);
+
+        let t = Instant::now();
+        let spec = setup.grid_spec(&input.part.bbox())?;
+        let grid = HeightGrid::sample(&input.part.triangles, spec);
+        let footprints = setup.footprints(&spec);
+        let sample_s = t.elapsed().as_secs_f64();
+
+        let t = Instant::now();
+        progress.begin("push and slide", Some(footprints.len() as u64));
+        let options = EngineOptions {
+            rule: setup.rule,
+            algorithm: setup.algorithm,
+            start_rows: None,
+        };
+        let masks = colliding_masks(&grid, &footprints, &options, &|| progress.step());
+        progress.end();
+        let push_slide_s = t.elapsed().as_secs_f64();
+
+        let composite = composite(&masks);
+        let struck = composite.iter().filter(|&&c| c > 0).count();
+        let result_warnings = sanity::result_warnings(struck);
+        for w in &result_warnings {
+            progress.warn(w);
+        }
+        warnings.extend(result_warnings);
+        Ok(Analysis {
+            input,
+            setup: setup.clone(),
+            grid,
+            footprints,
+            masks,
+            composite,
+            warnings,
+            timings: Timings {
+                sample_s,
+                push_slide_s,
+                ..Timings::default()
+            },
+        })
+    }
+
+    /// Nodes colliding at some angle.
+    pub fn composite_nodes(&self) -> usize {
+        self.composite.iter().filter(|&&c| c > 0).count()
+    }
+
+    /// Whether anything is struck.
+    pub fn status(&self) -> Status {
+        if self.composite_nodes() > 0 {
+            Status::Struck
+        } else {
+            Status::NothingStruck
+        }
+    }
+
+    /// `summary.json`'s content: every parameter, the input's identity,
+    /// the counts; the timings as measured so far.
+    pub fn summary(&self) -> Summary {
+        let spec = self.grid.spec;
+        let area = spec.pitch * spec.pitch;
+        let part = &self.input.part;
+        let bbox = part.bbox();
+        // Back to the part's frame: a mirrored side swaps the y bounds.
+        let side = self.input.side;
+        let (y0, y1) = (side.to_part(bbox.min[1]), side.to_part(bbox.max[1]));
+        let composite_nodes = self.composite_nodes();
+        let setup = &self.setup;
+        Summary {
+            kneeform_version: env!("CARGO_PKG_VERSION").into(),
+            run_unix_time: std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_secs()),
+            input_file: self.input.path.display().to_string(),
+            sha256: self.input.sha256.clone(),
+            triangles: part.file_triangles,
+            degenerate_triangles: part.degenerate,
+            bbox_min: [bbox.min[0], y0.min(y1), bbox.min[2]],
+            bbox_max: [bbox.max[0], y0.max(y1), bbox.max[2]],
+            scale: self.input.scale,
+            side,
+            triangle_side_mm: setup.knee.triangle_side,
+            triangle_side_assumed: setup.knee.triangle_side == KneeForm::default().triangle_side,
+            radius_mm: setup.knee.radius,
+            thickness_mm: setup.knee.thickness,
+            pitch_mm: spec.pitch,
+            grid_origin: [spec.x(0), spec.z(0)],
+            grid_size: [spec.nx, spec.nz],
+            sampled_nodes: self.grid.finite_count(),
+            angles_deg: setup.angles.clone(),
+            deflection_deg: setup.rule.deflection_deg(),
+            sigma: setup.rule.sigma,
+            e0_mm: setup.rule.e0,
+            rate: setup.rule.rate.name().into(),
+            algorithm: setup.algorithm,
+            threads: rayon::current_num_threads(),
+            per_angle: self
+                .masks
+                .iter()
+                .map(|m| AngleSummary {
+                    angle_deg: m.angle_deg,
+                    placed_starts: m.placed,
+                    colliding_nodes: m.colliding,
+                    colliding_area_mm2: m.colliding as f64 * area,
+                })
+                .collect(),
+            composite_nodes,
+            composite_area_mm2: composite_nodes as f64 * area,
+            timings: self.timings.clone(),
+            warnings: self.warnings.iter().map(ToString::to_string).collect(),
+        }
+    }
+}

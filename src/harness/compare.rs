@@ -1,0 +1,555 @@
+//! One grid against the exact oracle's traces on the same starts: start
+//! selection, the oracle's traces, the per-start rows and the metrics of
+//! their difference ([`compare_grid`]).
+
+use std::collections::HashSet;
+use std::time::Instant;
+
+use kneeform_oracle::{OracleOptions, StartStatus, StartTrace};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::HarnessError;
+use super::metrics::{
+    DECIDED_METRICS, METRICS, StartComparison, StartPoints, Stats, TieBand, compare, metric_index,
+};
+use super::nearest::PointSet;
+use super::trace::{Fault, grid_trace};
+use crate::grid::HeightGrid;
+use crate::kneeform::{GridFootprint, KneeForm};
+use crate::mesh::Triangle;
+use crate::strike::StrikeRule;
+
+/// Which starts to compare.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StartSelection {
+    /// Every grid node whose start is placed at some angle.
+    All,
+    /// A seeded random sample of those, without replacement.
+    Sample {
+        /// How many.
+        count: usize,
+        /// The seed.
+        seed: u64,
+    },
+    /// Every one of those whose z lies in `[z[0], z[1]]` (mm): a strip of
+    /// whole start rows.
+    Strip {
+        /// The strip's z range (mm).
+        z: [f64; 2],
+    },
+    /// These starts (x, z in mm), placed or not; each must be a node of
+    /// the grid compared (of the coarsest one in a convergence study).
+    At(Vec<[f64; 2]>),
+}
+
+/// How to compare.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompareOptions {
+    /// The knee-form.
+    pub knee: KneeForm,
+    /// SPEC's strike rule, on both sides.
+    pub rule: StrikeRule,
+    /// The tie band's growth with the pitch ([`TieBand`], per mm).
+    pub tie_band_per_mm: f64,
+}
+
+/// SplitMix64, for seeded start samples (same sample on every machine).
+struct SplitMix(u64);
+
+impl SplitMix {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+}
+
+/// The starts to compare, as grid nodes `(i, j)` in row-major order: nodes
+/// placed at one of `footprints` at least, all, a strip or a seeded sample;
+/// for [`StartSelection::At`], the given starts that are nodes, in the
+/// order given.
+pub fn select_starts(
+    grid: &HeightGrid,
+    footprints: &[GridFootprint],
+    selection: &StartSelection,
+) -> Vec<(usize, usize)> {
+    let spec = grid.spec;
+    if let StartSelection::At(starts) = selection {
+        return starts
+            .iter()
+            .filter_map(|&[x, z]| node_at(&spec, x, z))
+            .collect();
+    }
+    let nx = grid.spec.nx;
+    let mut placed = vec![false; grid.spec.len()];
+    for fp in footprints {
+        for (p, y) in placed.iter_mut().zip(crate::engine::push_levels(grid, fp)) {
+            *p |= y.is_finite();
+        }
+    }
+    let mut nodes: Vec<(usize, usize)> = (0..spec.len())
+        .filter(|&n| placed[n])
+        .map(|n| (n % nx, n / nx))
+        .filter(|&(_, j)| match selection {
+            StartSelection::Strip { z } => (z[0]..=z[1]).contains(&spec.z(j)),
+            _ => true,
+        })
+        .collect();
+    if let &StartSelection::Sample { count, seed } = selection {
+        // A partial Fisher-Yates shuffle, then back to row-major order.
+        let mut rng = SplitMix(seed);
+        let count = count.min(nodes.len());
+        for k in 0..count {
+            let pick = k + (rng.next() % (nodes.len() - k) as u64) as usize;
+            nodes.swap(k, pick);
+        }
+        nodes.truncate(count);
+        nodes.sort_by_key(|&(i, j)| (j, i));
+    }
+    nodes
+}
+
+/// The node nearest `(x, z)` (mm), if it lies within half a pitch of one.
+fn nearest_node(spec: &crate::grid::GridSpec, x: f64, z: f64) -> Option<(usize, usize)> {
+    let i = ((x - spec.x(0)) / spec.pitch).round();
+    let j = ((z - spec.z(0)) / spec.pitch).round();
+    let inside = i >= 0.0 && j >= 0.0 && (i as usize) < spec.nx && (j as usize) < spec.nz;
+    inside.then_some((i as usize, j as usize))
+}
+
+/// The node at `(x, z)` (mm), within rounding (1e-6 mm).
+fn node_at(spec: &crate::grid::GridSpec, x: f64, z: f64) -> Option<(usize, usize)> {
+    let (i, j) = nearest_node(spec, x, z)?;
+    ((spec.x(i) - x).abs() < 1e-6 && (spec.z(j) - z).abs() < 1e-6).then_some((i, j))
+}
+
+/// The exact traces of `starts` (mm, analysis frame) at `angles`, in
+/// angle-major order.
+pub fn exact_traces(
+    triangles: &[Triangle],
+    starts: &[[f64; 2]],
+    angles: &[f64],
+    options: &OracleOptions,
+) -> Result<Vec<StartTrace>, HarnessError> {
+    let part = kneeform_oracle::Part::from_triangles(triangles)?;
+    Ok(kneeform_oracle::evaluate(&part, starts, angles, options)?)
+}
+
+/// One row of `verify.csv`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct VerifyRow {
+    /// Grid column of the start.
+    pub i: usize,
+    /// Grid row of the start.
+    pub j: usize,
+    /// Knee-form angle (degrees).
+    pub angle_deg: f64,
+    /// `compared`, `grid_not_placed`, `not_placed` (neither), `oracle_not_placed`
+    /// or `oracle_failed`.
+    pub status: String,
+    /// `yr - yr*` (mm).
+    pub push_error: Option<f64>,
+    /// Grid minus exact travel to the first contact (mm).
+    pub first_contact_error: Option<f64>,
+    /// Largest distance from an exact contact to the grid's colliding
+    /// points of this start (mm; empty when the grid has none: see
+    /// `unmatched_deflection`).
+    pub miss_distance: Option<f64>,
+    /// Largest distance from a grid colliding point to the exact contacts
+    /// and push contact (mm).
+    pub false_alarm_distance: Option<f64>,
+    /// When the grid strikes nothing but the oracle strikes: the largest
+    /// deflection of the exact knee-form below the grid's level.
+    pub unmatched_deflection: Option<f64>,
+    /// `first_contact_error` where the exact first strike is decided.
+    pub first_contact_error_decided: Option<f64>,
+    /// `miss_distance` over decided exact strikes.
+    pub miss_distance_decided: Option<f64>,
+    /// Largest xz distance from a grid strike to the exact contacts that
+    /// are not decided non-strikes (and the push contact).
+    pub false_alarm_distance_decided: Option<f64>,
+    /// `unmatched_deflection` over decided exact strikes.
+    pub unmatched_deflection_decided: Option<f64>,
+    /// Exact strikes (contacts with a rate above sigma).
+    pub exact_strikes: usize,
+    /// Exact contacts in the tie band.
+    pub exact_undecided: usize,
+    /// Grid strikes.
+    pub grid_colliding: usize,
+    /// x of the worst decided disagreement of this start (mm, analysis
+    /// frame): the decided exact strike the grid missed furthest, or the
+    /// grid strike furthest from any possible exact one.
+    pub worst_x: Option<f64>,
+    /// Its z (mm).
+    pub worst_z: Option<f64>,
+}
+
+/// Counts of a comparison.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Counts {
+    /// Start-angle pairs looked at.
+    pub pairs: usize,
+    /// Pairs placed by both.
+    pub compared: usize,
+    /// Placed by the oracle only (mesh in the footprint between nodes).
+    pub grid_not_placed: usize,
+    /// Placed by the grid only: a contradiction (a grid sample is a mesh
+    /// point), counted as a failure.
+    pub oracle_not_placed: usize,
+    /// Placed by neither.
+    pub not_placed: usize,
+    /// Oracle queries that failed.
+    pub oracle_failed: usize,
+    /// Exact strikes in starts where the grid strikes nothing (their
+    /// size is the `unmatched_deflection` metric).
+    pub unmatched_exact: usize,
+    /// The same, decided exact strikes only.
+    pub unmatched_exact_decided: usize,
+    /// Grid strikes in starts where the oracle has neither a strike nor a
+    /// push contact.
+    pub unmatched_grid: usize,
+    /// Grid strikes in starts where the oracle has neither a possible
+    /// strike (a contact not gentler than the tie band) nor a push contact:
+    /// a decided disagreement, counted as a failure.
+    pub unmatched_grid_decided: usize,
+    /// Exact strikes (rate above sigma).
+    pub exact_strikes: usize,
+    /// Exact contacts in the tie band: either answer is right at this
+    /// pitch.
+    pub exact_undecided: usize,
+}
+
+/// The area distance at one angle: the two directed Hausdorff distances in
+/// xz between the union of the exact strikes and the union of the grid
+/// strikes over every compared start (mm; `+inf` where one side is empty
+/// and the other is not).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct AreaDistance {
+    /// The angle (degrees).
+    pub angle_deg: f64,
+    /// Largest distance from an exact strike to the grid's strikes: how
+    /// far the grid's area falls short.
+    pub miss: f64,
+    /// Largest distance from a grid strike to the exact strikes (or push
+    /// contacts): how far the grid's area overreaches.
+    pub false_alarm: f64,
+    /// `miss` from decided exact strikes only.
+    pub miss_decided: f64,
+    /// `false_alarm` against every exact contact not gentler than the tie
+    /// band.
+    pub false_alarm_decided: f64,
+}
+
+/// The metrics of one grid against the exact traces.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Comparison {
+    /// One row per start and angle.
+    pub rows: Vec<VerifyRow>,
+    /// Statistics per metric, in [`METRICS`] order (finite values only;
+    /// infinite ones are the `unmatched` counts).
+    pub stats: Vec<(String, Stats)>,
+    /// Grid colliding (angle, node) pairs against exact strikes snapped
+    /// to grid nodes, over the compared starts: intersection over union.
+    pub area_iou: f64,
+    /// The area distance at each angle.
+    pub area: Vec<AreaDistance>,
+    /// The tie band at this pitch.
+    pub band: TieBand,
+    /// Counts.
+    pub counts: Counts,
+    /// Seconds spent on the grid side.
+    pub grid_s: f64,
+}
+
+/// One start-angle pair: its row, its comparison, the grid's colliding
+/// nodes and the exact strikes snapped to nodes.
+type PairResult = (
+    VerifyRow,
+    StartComparison,
+    Vec<(usize, usize)>,
+    Vec<(usize, usize)>,
+);
+
+/// Compares `grid` with `traces` (angle-major over `starts`, positions in
+/// mm that must be nodes of `grid`).
+pub fn compare_grid(
+    grid: &HeightGrid,
+    footprints: &[GridFootprint],
+    starts: &[[f64; 2]],
+    traces: &[StartTrace],
+    options: &CompareOptions,
+) -> Result<Comparison, HarnessError> {
+    compare_grid_with(grid, footprints, starts, traces, options, None)
+}
+
+/// [`compare_grid`] with an optional deliberate mistake on the grid side:
+/// the harness's own tests show it catches a broken engine.
+pub(crate) fn compare_grid_with(
+    grid: &HeightGrid,
+    footprints: &[GridFootprint],
+    starts: &[[f64; 2]],
+    traces: &[StartTrace],
+    options: &CompareOptions,
+    fault: Option<Fault>,
+) -> Result<Comparison, HarnessError> {
+    crate::engine::assert_same_pitch(grid, footprints);
+    let spec = grid.spec;
+    let band = TieBand::new(options.rule.sigma, spec.pitch, options.tie_band_per_mm);
+    let node_of = |x: f64, z: f64| nearest_node(&spec, x, z);
+    let mut nodes = Vec::with_capacity(starts.len());
+    for &[x, z] in starts {
+        nodes.push(node_at(&spec, x, z).ok_or(HarnessError::StartNotANode {
+            x,
+            z,
+            pitch: spec.pitch,
+        })?);
+    }
+    if traces.len() != footprints.len() * nodes.len() {
+        return Err(HarnessError::TraceCount {
+            traces: traces.len(),
+            expected: footprints.len() * nodes.len(),
+        });
+    }
+    let t = Instant::now();
+    let pairs: Vec<(usize, usize)> = (0..footprints.len())
+        .flat_map(|a| (0..nodes.len()).map(move |s| (a, s)))
+        .collect();
+    let results: Vec<PairResult> = pairs
+        .par_iter()
+        .map(|&(a, s)| {
+            let (i, j) = nodes[s];
+            let fp = &footprints[a];
+            let trace = &traces[a * nodes.len() + s];
+            let g = grid_trace(grid, fp, i, j, &options.rule, fault);
+            let cmp = compare(&g, trace, &band);
+            let grid_placed = g.yr.is_finite();
+            let status = match (trace.status, grid_placed) {
+                (StartStatus::Failed { .. }, _) => "oracle_failed",
+                (StartStatus::Placed, true) => "compared",
+                (StartStatus::Placed, false) => "grid_not_placed",
+                (StartStatus::NotPlaced, true) => "oracle_not_placed",
+                (StartStatus::NotPlaced, false) => "not_placed",
+            };
+            let worst = |v: &[f64]| v.iter().copied().reduce(f64::max).filter(|v| v.is_finite());
+            let snapped: Vec<(usize, usize)> = cmp
+                .points
+                .strikes
+                .iter()
+                .filter_map(|p| node_of(p[0], p[1]))
+                .collect();
+            let worst_at = cmp.worst_decided_point().map(|(p, _)| p);
+            let row = VerifyRow {
+                i,
+                j,
+                angle_deg: fp.angle_deg,
+                status: status.into(),
+                push_error: cmp.push_error,
+                first_contact_error: cmp.first_contact_error,
+                miss_distance: worst(&cmp.miss),
+                false_alarm_distance: worst(&cmp.false_alarm),
+                unmatched_deflection: worst(&cmp.unmatched_deflection),
+                first_contact_error_decided: cmp.first_contact_error_decided,
+                miss_distance_decided: worst(&cmp.miss_decided),
+                false_alarm_distance_decided: worst(&cmp.false_alarm_decided),
+                unmatched_deflection_decided: worst(&cmp.unmatched_deflection_decided),
+                exact_strikes: cmp.exact_strikes,
+                exact_undecided: cmp.undecided,
+                grid_colliding: cmp.false_alarm.len(),
+                worst_x: worst_at.map(|p| p[0]),
+                worst_z: worst_at.map(|p| p[1]),
+            };
+            let grid_nodes = g.colliding.iter().map(|c| c.node).collect();
+            (row, cmp, grid_nodes, snapped)
+        })
+        .collect();
+    let grid_s = t.elapsed().as_secs_f64();
+
+    let mut counts = Counts {
+        pairs: results.len(),
+        ..Counts::default()
+    };
+    let mut values: Vec<Vec<f64>> = vec![Vec::new(); METRICS.len()];
+    let (mut grid_set, mut exact_set) = (HashSet::new(), HashSet::new());
+    let mut area_points: Vec<StartPoints> = vec![StartPoints::default(); footprints.len()];
+    for ((row, cmp, grid_nodes, snapped), &(a, _)) in results.iter().zip(&pairs) {
+        match row.status.as_str() {
+            "compared" => counts.compared += 1,
+            "grid_not_placed" => counts.grid_not_placed += 1,
+            "oracle_not_placed" => counts.oracle_not_placed += 1,
+            "not_placed" => counts.not_placed += 1,
+            _ => counts.oracle_failed += 1,
+        }
+        counts.exact_strikes += cmp.exact_strikes;
+        counts.exact_undecided += cmp.undecided;
+        let mut push = |name: &str, v: &[f64]| -> usize {
+            let (finite, infinite): (Vec<f64>, Vec<f64>) = v.iter().partition(|x| x.is_finite());
+            values[metric_index(name)].extend(finite);
+            infinite.len()
+        };
+        push("push_error", &Vec::from_iter(cmp.push_error));
+        push(
+            "first_contact_error",
+            &Vec::from_iter(cmp.first_contact_error),
+        );
+        push(
+            "first_contact_error_decided",
+            &Vec::from_iter(cmp.first_contact_error_decided),
+        );
+        // A start the oracle failed on has no exact answer: it is counted
+        // as a failure, not as grid strikes without an exact one.
+        let judged = row.status != "oracle_failed";
+        let unmatched_exact = push("miss_distance", &cmp.miss);
+        let unmatched_exact_decided = push("miss_distance_decided", &cmp.miss_decided);
+        let unmatched_grid = push("false_alarm_distance", &cmp.false_alarm);
+        let unmatched_grid_decided = push("false_alarm_distance_decided", &cmp.false_alarm_decided);
+        if judged {
+            counts.unmatched_exact += unmatched_exact;
+            counts.unmatched_exact_decided += unmatched_exact_decided;
+            counts.unmatched_grid += unmatched_grid;
+            counts.unmatched_grid_decided += unmatched_grid_decided;
+        }
+        push("unmatched_deflection", &cmp.unmatched_deflection);
+        push(
+            "unmatched_deflection_decided",
+            &cmp.unmatched_deflection_decided,
+        );
+        if row.status == "compared" || row.status == "grid_not_placed" {
+            grid_set.extend(grid_nodes.iter().map(|&n| (a, n)));
+            exact_set.extend(snapped.iter().map(|&n| (a, n)));
+            area_points[a].extend(&cmp.points);
+        }
+    }
+    let union = grid_set.union(&exact_set).count();
+    let area_iou = if union == 0 {
+        1.0
+    } else {
+        grid_set.intersection(&exact_set).count() as f64 / union as f64
+    };
+    let area: Vec<AreaDistance> = area_points
+        .into_par_iter()
+        .zip(footprints)
+        .map(|(pts, fp)| area_distance(fp.angle_deg, pts))
+        .collect();
+    for a in &area {
+        values[metric_index("area_distance")].push(a.miss.max(a.false_alarm));
+        values[metric_index("area_distance_decided")]
+            .push(a.miss_decided.max(a.false_alarm_decided));
+    }
+    Ok(Comparison {
+        rows: results.into_iter().map(|r| r.0).collect(),
+        stats: METRICS
+            .iter()
+            .zip(&values)
+            .map(|(m, v)| (m.to_string(), Stats::of(v)))
+            .collect(),
+        area_iou,
+        area,
+        band,
+        counts,
+        grid_s,
+    })
+}
+
+/// The area distance of one angle's unions of points (see
+/// [`AreaDistance`]).
+fn area_distance(angle_deg: f64, pts: StartPoints) -> AreaDistance {
+    // A set with no point is infinitely far from any point, and no point
+    // is any distance from anything: PointSet's Hausdorff says both.
+    let grid = PointSet::new(pts.grid.clone());
+    let from_grid = |to: Vec<[f64; 2]>| PointSet::new(to).hausdorff_from(&pts.grid);
+    AreaDistance {
+        angle_deg,
+        miss: grid.hausdorff_from(&pts.strikes),
+        false_alarm: from_grid(pts.with_push(&pts.strikes)),
+        miss_decided: grid.hausdorff_from(&pts.decided),
+        false_alarm_decided: from_grid(pts.with_push(&pts.possible)),
+    }
+}
+
+impl Comparison {
+    /// Whether every decided metric ([`DECIDED_METRICS`]) is within
+    /// `tolerance` (mm) and nothing is contradictory or failed. Undecided
+    /// strikes (in the tie band) never fail a comparison; they are counted
+    /// and their metrics shown beside the decided ones.
+    pub fn passes(&self, tolerance: f64) -> bool {
+        self.failures(tolerance).is_empty()
+    }
+
+    /// Why a comparison fails `tolerance`, one phrase per reason (empty
+    /// when it passes).
+    pub fn failures(&self, tolerance: f64) -> Vec<String> {
+        let c = &self.counts;
+        let mut why: Vec<String> = self
+            .stats
+            .iter()
+            .filter(|(m, s)| DECIDED_METRICS.contains(&m.as_str()) && s.max > tolerance)
+            .map(|(m, s)| format!("{m} {:.3} mm", s.max))
+            .collect();
+        if self
+            .area
+            .iter()
+            .any(|a| !(a.miss_decided.is_finite() && a.false_alarm_decided.is_finite()))
+        {
+            why.push("area distance infinite (one side strikes nothing)".into());
+        }
+        for (n, what) in [
+            (
+                c.oracle_failed,
+                "oracle failures (no exact answer for those starts)",
+            ),
+            (
+                c.oracle_not_placed,
+                "starts placed by the grid but not by the oracle",
+            ),
+            (
+                c.unmatched_grid_decided,
+                "grid strikes with no possible exact one in their start",
+            ),
+        ] {
+            if n > 0 {
+                why.push(format!("{n} {what}"));
+            }
+        }
+        why
+    }
+
+    /// The statistics of metric `name`.
+    pub fn stat(&self, name: &str) -> Stats {
+        self.stats[metric_index(name)].1
+    }
+
+    /// The worst start-angle pairs by their largest decided metric, at most
+    /// `n`.
+    pub fn worst(&self, n: usize) -> Vec<(VerifyRow, String, f64)> {
+        let mut scored: Vec<(VerifyRow, String, f64)> = self
+            .rows
+            .iter()
+            .filter_map(|r| {
+                let candidates = [
+                    ("push_error", r.push_error),
+                    ("first_contact_error_decided", r.first_contact_error_decided),
+                    ("miss_distance_decided", r.miss_distance_decided),
+                    (
+                        "false_alarm_distance_decided",
+                        r.false_alarm_distance_decided,
+                    ),
+                    (
+                        "unmatched_deflection_decided",
+                        r.unmatched_deflection_decided,
+                    ),
+                ];
+                let (name, v) = candidates
+                    .into_iter()
+                    .filter_map(|(m, v)| v.map(|v| (m, v.abs())))
+                    .max_by(|a, b| a.1.total_cmp(&b.1))?;
+                Some((r.clone(), name.to_string(), v))
+            })
+            .collect();
+        scored.sort_by(|a, b| b.2.total_cmp(&a.2));
+        scored.truncate(n);
+        scored
+    }
+}

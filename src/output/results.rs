@@ -1,0 +1,154 @@
+//! Each command's result files, from the library's results: an analysis
+//! ([`write_analysis`]), a verification ([`write_verification`]), a
+//! convergence study ([`write_convergence`]).
+
+use std::io::{BufWriter, Write};
+use std::path::Path;
+use std::time::Instant;
+
+use super::{OutputDir, WriteError};
+use crate::analysis::Analysis;
+use crate::harness::{Convergence, Verification};
+use crate::summary::Summary;
+
+/// Writes the files of an analysis into the staged directory `out`: the
+/// colliding points and the composite as CSV, the colliding area as STL
+/// and PLY, the depth and composite images, and `summary.json` last, with
+/// the writing time. Returns the summary written.
+pub fn write_analysis(out: &OutputDir, analysis: &Analysis) -> Result<Summary, WriteError> {
+    let t = Instant::now();
+    let side = analysis.input.side;
+    let grid = &analysis.grid;
+    let (masks, counts) = (&analysis.masks, &analysis.composite);
+    let file =
+        |name: &str, write: &dyn Fn(&mut BufWriter<std::fs::File>) -> std::io::Result<()>| {
+            let path = out.path(name);
+            std::fs::File::create(&path)
+                .and_then(|f| {
+                    let mut w = BufWriter::new(f);
+                    write(&mut w)?;
+                    w.flush()
+                })
+                .map_err(WriteError::at(&path))
+        };
+    file("colliding_points.csv", &|w| {
+        Ok(super::write_colliding_points(w, grid, masks, side)?)
+    })?;
+    file("composite.csv", &|w| {
+        Ok(super::write_composite(w, grid, counts, side)?)
+    })?;
+    file("colliding_area.stl", &|w| {
+        super::write_colliding_area(w, grid, counts, side).map(drop)
+    })?;
+    file("colliding_area.ply", &|w| {
+        super::write_colliding_area_ply(w, grid, counts, masks.len(), side).map(drop)
+    })?;
+    super::write_depth_png(&out.path("depth.png"), grid, side)?;
+    let title = format!(
+        "Composite colliding area, {} angles (L = {} mm)",
+        masks.len(),
+        analysis.setup.knee.triangle_side
+    );
+    super::write_composite_png(
+        &out.path("composite.png"),
+        grid,
+        counts,
+        masks.len(),
+        &title,
+        side,
+    )?;
+    let mut summary = analysis.summary();
+    let t_ = &mut summary.timings;
+    t_.write_s = t.elapsed().as_secs_f64();
+    t_.total_s = t_.read_s + t_.sample_s + t_.push_slide_s + t_.write_s;
+    write_json(&out.path("summary.json"), &summary)?;
+    Ok(summary)
+}
+
+/// Writes `verify.csv` (one row per start and angle) and `verify.json`
+/// into `dir`, which appears with both or is left as it was.
+pub fn write_verification(dir: &Path, verification: &Verification) -> Result<(), WriteError> {
+    let out = OutputDir::stage(dir).map_err(|source| WriteError::Commit {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    write_rows(&out.path("verify.csv"), &verification.comparison.rows)?;
+    write_json(&out.path("verify.json"), &verification.summary)?;
+    commit(out, dir)
+}
+
+/// Writes a convergence study into `dir`: `converge.csv` (every metric at
+/// every pitch), `verify_<pitch>mm.csv` (each pitch's per-start rows),
+/// `converge.json` and the plots; `dir` appears with all of them or is
+/// left as it was.
+pub fn write_convergence(dir: &Path, convergence: &Convergence) -> Result<(), WriteError> {
+    let out = OutputDir::stage(dir).map_err(|source| WriteError::Commit {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let results = &convergence.results;
+    let tolerance = convergence.summary.tolerance_mm;
+    let path = out.path("converge.csv");
+    (|| -> csv::Result<()> {
+        let mut csv = csv::Writer::from_path(&path)?;
+        csv.write_record([
+            "pitch_mm", "metric", "max", "p95", "mean", "n", "seconds", "area_iou", "pass",
+        ])?;
+        for r in results {
+            let pass = tolerance.map_or(String::new(), |t| r.comparison.passes(t).to_string());
+            for (metric, s) in &r.comparison.stats {
+                csv.write_record([
+                    r.pitch.to_string(),
+                    metric.clone(),
+                    s.max.to_string(),
+                    s.p95.to_string(),
+                    s.mean.to_string(),
+                    s.n.to_string(),
+                    r.seconds.to_string(),
+                    r.comparison.area_iou.to_string(),
+                    pass.clone(),
+                ])?;
+            }
+        }
+        csv.flush()?;
+        Ok(())
+    })()
+    .map_err(WriteError::at(&path))?;
+    // Every pitch's per-start rows, as `verify.csv` has them: where each
+    // figure of converge.csv comes from.
+    for r in results {
+        write_rows(
+            &out.path(format!("verify_{}mm.csv", r.pitch)),
+            &r.comparison.rows,
+        )?;
+    }
+    write_json(&out.path("converge.json"), &convergence.summary)?;
+    super::write_plots(out.path(".").as_path(), results, &convergence.fits)?;
+    commit(out, dir)
+}
+
+/// Writes `value` as pretty JSON with a final newline.
+fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<(), WriteError> {
+    let text = serde_json::to_string_pretty(value).map_err(WriteError::at(path))? + "\n";
+    std::fs::write(path, text).map_err(WriteError::at(path))
+}
+
+/// Writes serialisable rows as CSV with a header.
+fn write_rows(path: &Path, rows: &[impl serde::Serialize]) -> Result<(), WriteError> {
+    (|| -> csv::Result<()> {
+        let mut csv = csv::Writer::from_path(path)?;
+        for row in rows {
+            csv.serialize(row)?;
+        }
+        csv.flush()?;
+        Ok(())
+    })()
+    .map_err(WriteError::at(path))
+}
+
+fn commit(out: OutputDir, dir: &Path) -> Result<(), WriteError> {
+    out.commit().map_err(|source| WriteError::Commit {
+        path: dir.to_path_buf(),
+        source,
+    })
+}
