@@ -20,9 +20,8 @@ use crate::slide::{LayerRows, slide_block, slide_carried};
 use crate::strike::StrikeRule;
 
 /// Which implementation of push and slide to run. Both give identical masks.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum Algorithm {
     /// The paper's sections 3 and 4, literally: the reference and baseline.

@@ -10,10 +10,33 @@
 //! * [`push`] and [`slide`]: step 2, the fast path; [`paper`]: the
 //!   paper-literal reference;
 //! * [`engine`]: every angle and start, the colliding masks and composite;
+//! * [`analysis`]: the pipeline above as one call, with its typed setup;
 //! * [`sanity`]: the checks that warn of a part in the wrong units or
 //!   facing the wrong way, and of a result with nothing struck.
 //!
 //! All lengths are mm and all angles degrees.
+//!
+//! The whole analysis is one call, [`Analysis::run`] (or
+//! [`Analysis::of_file`]); [`harness::verify()`] and [`harness::converge()`]
+//! check it against the exact oracle; [`output`] writes the results. The
+//! `kneeform` binary (feature `cli`, on by default) only parses flags, shows
+//! progress and calls these.
+//!
+//! # Example
+//!
+//! A bundled scenario analysed at a 4 mm pitch and three angles:
+//!
+//! ```
+//! use kneeform::{Analysis, Setup, Side, Status};
+//!
+//! let setup = Setup { pitch: 4.0, angles: vec![-30.0, 0.0, 30.0], ..Setup::default() };
+//! let wave = std::path::Path::new("scenarios/wave.toml");
+//! let analysis = Analysis::of_file(wave, 1.0, Side::Left, &setup, &())?;
+//! assert_eq!(analysis.status(), Status::Struck);
+//! let summary = analysis.summary();
+//! println!("composite: {} nodes, {:.0} mm^2", summary.composite_nodes, summary.composite_area_mm2);
+//! # Ok::<(), kneeform::AnalysisError>(())
+//! ```
 
 pub mod analysis;
 pub mod console;

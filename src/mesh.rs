@@ -13,9 +13,8 @@ use sha2::Digest;
 pub type Triangle = [[f64; 3]; 3];
 
 /// Which side of the vehicle the analysed surface is on.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum Side {
     /// The analysed surface faces -y (SPEC's canonical frame).

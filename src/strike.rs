@@ -25,7 +25,8 @@
 use serde::{Deserialize, Serialize};
 
 /// How a grid contact's deflection rate is estimated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum RateEstimate {
     /// SPEC's baseline (the default, comparable node for node with any

@@ -10,7 +10,8 @@ use crate::mesh::Triangle;
 
 /// A synthetic part. The names on the command line are kebab-case
 /// (`flat-wall`, `growing-wave`, ...).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Scenario {
     /// `y = 0`: a flat wall; nothing collides.
     FlatWall,

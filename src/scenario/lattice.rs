@@ -17,7 +17,7 @@ const SAME_LINE: f64 = 1e-3;
 
 /// The lattice coordinates along one axis: every multiple of `step` inside
 /// `range`, the range's ends, and the `extra` creases strictly inside it
-/// (each unless within [`SAME_LINE`] of a line already there), sorted.
+/// (each unless within 1 um (`SAME_LINE`) of a line already there), sorted.
 pub fn axis(range: (f64, f64), step: f64, extra: &[f64]) -> Vec<f64> {
     let (lo, hi) = range;
     let first = (lo / step).ceil() as i64;
