@@ -243,50 +243,6 @@ pub fn tie_groups(sorted: impl Iterator<Item = f64>) -> Vec<std::ops::Range<usiz
 mod tests {
     use super::*;
 
-    /// Distance from (x, z) to the rotated triangle (0 inside), by brute
-    /// force over its edges: an independent check of the row intervals.
-    fn distance_to_triangle(fp: &Footprint, x: f64, z: f64) -> f64 {
-        let v = fp.vertices;
-        let side =
-            |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]) * (z - a[1]) - (b[1] - a[1]) * (x - a[0]);
-        let inside = (0..3).all(|k| side(v[k], v[(k + 1) % 3]) >= 0.0);
-        if inside {
-            return 0.0;
-        }
-        (0..3)
-            .map(|k| {
-                let (a, b) = (v[k], v[(k + 1) % 3]);
-                let (ex, ez) = (b[0] - a[0], b[1] - a[1]);
-                let t = (((x - a[0]) * ex + (z - a[1]) * ez) / (ex * ex + ez * ez)).clamp(0.0, 1.0);
-                (x - a[0] - t * ex).hypot(z - a[1] - t * ez)
-            })
-            .fold(f64::INFINITY, f64::min)
-    }
-
-    #[test]
-    fn row_interval_endpoints_lie_on_the_boundary() {
-        let knee = KneeForm::default();
-        for angle in [-30.0, -17.0, 0.0, 5.5, 30.0] {
-            let fp = Footprint::new(&knee, angle);
-            let (zlo, zhi) = fp.z_range();
-            let mut dz = zlo + 0.01;
-            while dz < zhi {
-                let (a, b) = fp.row_interval(dz).unwrap();
-                assert!(a <= b);
-                for x in [a, b] {
-                    let d = distance_to_triangle(&fp, x, dz);
-                    assert!((d - knee.radius).abs() < 1e-9, "angle {angle} dz {dz}: {d}");
-                }
-                // Just outside the interval is outside the footprint.
-                assert!(distance_to_triangle(&fp, a - 1e-6, dz) > knee.radius);
-                assert!(distance_to_triangle(&fp, b + 1e-6, dz) > knee.radius);
-                dz += 0.77;
-            }
-            assert!(fp.row_interval(zhi + 1e-6).is_none());
-            assert!(fp.row_interval(zlo - 1e-6).is_none());
-        }
-    }
-
     #[test]
     fn front_corner_at_zero_angle() {
         let fp = Footprint::new(&KneeForm::default(), 0.0);

@@ -3,11 +3,13 @@
 
 use kneeform::strike::RateEstimate;
 use kneeform::{
-    Algorithm, EngineOptions, GridFootprint, GridSpec, HeightGrid, KneeForm, StrikeRule,
+    Algorithm, EngineOptions, Footprint, GridFootprint, GridSpec, HeightGrid, KneeForm, StrikeRule,
     colliding_masks,
 };
 
-use crate::util::{SEEDS, brute_force_rules, mask_diff, random_grid_quantised};
+use crate::util::{
+    SEEDS, brute_force_rules, distance_to_triangle, mask_diff, random_grid_quantised,
+};
 
 /// A knee-form smaller than the test grids.
 const SMALL: KneeForm = KneeForm {
@@ -234,4 +236,30 @@ fn fast_and_paper_equal_brute_force_for_a_small_knee_form() {
         check_against_brute_force(50, 40, 3.3, &SMALL),
     ];
     assert_thresholds_exercised(&default_rules(), &counts);
+}
+
+#[test]
+fn row_interval_endpoints_lie_on_the_boundary() {
+    // The footprint's closed form against the brute-force distance to its
+    // triangle: every row end lies at distance R, just outside is further.
+    let knee = KneeForm::default();
+    for angle in [-30.0, -17.0, 0.0, 5.5, 30.0] {
+        let fp = Footprint::new(&knee, angle);
+        let (zlo, zhi) = fp.z_range();
+        let mut dz = zlo + 0.01;
+        while dz < zhi {
+            let (a, b) = fp.row_interval(dz).unwrap();
+            assert!(a <= b);
+            for x in [a, b] {
+                let d = distance_to_triangle(&fp.vertices, x, dz);
+                assert!((d - knee.radius).abs() < 1e-9, "angle {angle} dz {dz}: {d}");
+            }
+            // Just outside the interval is outside the footprint.
+            assert!(distance_to_triangle(&fp.vertices, a - 1e-6, dz) > knee.radius);
+            assert!(distance_to_triangle(&fp.vertices, b + 1e-6, dz) > knee.radius);
+            dz += 0.77;
+        }
+        assert!(fp.row_interval(zhi + 1e-6).is_none());
+        assert!(fp.row_interval(zlo - 1e-6).is_none());
+    }
 }

@@ -91,7 +91,7 @@ fn triangle(knee: &KneeForm, angle_deg: f64) -> [[f64; 2]; 3] {
 }
 
 /// Distance from (x, z) to the filled triangle.
-fn distance_to_triangle(v: &[[f64; 2]; 3], x: f64, z: f64) -> f64 {
+pub fn distance_to_triangle(v: &[[f64; 2]; 3], x: f64, z: f64) -> f64 {
     let cross = |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]) * (z - a[1]) - (b[1] - a[1]) * (x - a[0]);
     let s = [cross(v[0], v[1]), cross(v[1], v[2]), cross(v[2], v[0])];
     if s.iter().all(|&c| c >= 0.0) || s.iter().all(|&c| c <= 0.0) {

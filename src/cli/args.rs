@@ -58,6 +58,20 @@ pub struct PartArgs {
     pub side: Side,
 }
 
+/// The knee-form angles.
+#[derive(Debug, Args)]
+pub struct AnglesArg {
+    /// Knee-form angles (degrees, positive raises its back): FROM:TO:STEP,
+    /// or a comma-separated list (e.g. --angles=-30,-13,0,7,30).
+    #[arg(
+        long,
+        default_value = "-30:30:1",
+        allow_hyphen_values = true,
+        value_name = "ANGLES"
+    )]
+    pub angles: String,
+}
+
 /// The knee-form and the grid.
 #[derive(Debug, Args)]
 pub struct SetupArgs {
@@ -75,15 +89,8 @@ pub struct SetupArgs {
     /// Thickness W of the knee-form along y (mm).
     #[arg(long, default_value_t = 120.0, value_name = "MM")]
     pub thickness: f64,
-    /// Knee-form angles (degrees, positive raises its back): FROM:TO:STEP,
-    /// or a comma-separated list (e.g. --angles=-30,-13,0,7,30).
-    #[arg(
-        long,
-        default_value = "-30:30:1",
-        allow_hyphen_values = true,
-        value_name = "ANGLES"
-    )]
-    pub angles: String,
+    #[command(flatten)]
+    pub angles: AnglesArg,
     /// Deflection threshold delta (degrees, 0 <= delta < 45): a point the
     /// knee-form meets is a strike (a colliding point) only when the surface
     /// there turns the knee-form aside by more than this angle (its rise
@@ -284,15 +291,10 @@ pub struct ScenarioArgs {
 /// `kneeform bench`.
 #[derive(Debug, Args)]
 pub struct BenchArgs {
-    /// Knee-form angles (degrees) for the fast engine's timing, as for
-    /// `analyze`; the paper's workload is all 61.
-    #[arg(
-        long,
-        default_value = "-30:30:1",
-        allow_hyphen_values = true,
-        value_name = "ANGLES"
-    )]
-    pub angles: String,
+    /// The angles of the fast engine's timing (the paper's workload is all
+    /// 61).
+    #[command(flatten)]
+    pub angles: AnglesArg,
     /// Timed runs of the fast engine; the median is reported.
     #[arg(long, default_value_t = 5, value_name = "N")]
     pub runs: usize,
@@ -337,7 +339,7 @@ impl SetupArgs {
                 radius: self.radius,
                 thickness: self.thickness,
             },
-            angles: parse_angles(&self.angles)?,
+            angles: parse_angles(&self.angles.angles)?,
             rule: StrikeRule::new(self.deflection, self.e0).with_rate(self.rate),
             grid,
             algorithm: self.algorithm,

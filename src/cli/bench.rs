@@ -43,7 +43,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         "--paper-rows and --paper-angles must be at least 1"
     );
     let knee = KneeForm::default();
-    let angles = super::args::parse_angles(&args.angles)?;
+    let angles = super::args::parse_angles(&args.angles.angles)?;
     let t = Instant::now();
     let triangles = console_triangles(PAPER_TRIANGLES);
     let build_s = t.elapsed().as_secs_f64();
@@ -153,7 +153,12 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         "| grid | {nx} x {nz} at {PAPER_PITCH} mm, {} nodes sampled |",
         grid.finite_count()
     )?;
-    writeln!(md, "| angles | {} ({}) |", footprints.len(), args.angles)?;
+    writeln!(
+        md,
+        "| angles | {} ({}) |",
+        footprints.len(),
+        args.angles.angles
+    )?;
     writeln!(md, "| threads | {threads} |")?;
     writeln!(md, "| sampling (median of {}) | {sample:.3} s |", args.runs)?;
     writeln!(

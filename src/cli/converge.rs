@@ -28,17 +28,13 @@ pub fn parse_pitches(s: &str) -> anyhow::Result<Vec<f64>> {
 }
 
 pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
-    args.part.validate()?;
-    let (setup, threads) = args.setup.validate()?;
     let options = ConvergeOptions {
         pitches: parse_pitches(&args.pitches)?,
         selection: args.starts.validate()?,
         tie_band_per_mm: args.starts.tie_band,
         tolerance: args.tolerance,
     };
-    options.validate().map_err(super::harness_error)?;
-    super::set_threads(threads)?;
-    let input = kneeform::read_part(&args.part.part, args.part.scale, args.part.side)?;
+    let (input, setup) = super::study_inputs(&args.part, &args.setup, options.validate())?;
     let study = harness::converge(&input, &setup, &options, &Bars::default())
         .map_err(super::harness_error)?;
     eprintln!(

@@ -14,6 +14,9 @@ use std::path::Path;
 use anyhow::Context;
 use kneeform::harness::HarnessError;
 use kneeform::report::ReportOptions;
+use kneeform::{PartFile, Setup};
+
+use args::{PartArgs, SetupArgs};
 
 /// Writes the report of `options` to `out` and says so on stderr, naming
 /// the file `shown_as` (where it will be once staged files are moved):
@@ -34,6 +37,21 @@ pub fn write_report(options: &ReportOptions, out: &Path, shown_as: &Path) -> any
         shown_as.display()
     );
     Ok(())
+}
+
+/// The start `verify` and `converge` share: every flag checked (the
+/// command's own options by `check`), the thread pool sized, the part read.
+pub fn study_inputs(
+    part: &PartArgs,
+    setup: &SetupArgs,
+    check: Result<(), HarnessError>,
+) -> anyhow::Result<(PartFile, Setup)> {
+    part.validate()?;
+    let (setup, threads) = setup.validate()?;
+    check.map_err(harness_error)?;
+    set_threads(threads)?;
+    let input = kneeform::read_part(&part.part, part.scale, part.side)?;
+    Ok((input, setup))
 }
 
 /// A harness error with the flag it concerns in front, where one does.

@@ -42,16 +42,12 @@ fn resolving_pitch(pitch: f64, tolerance: f64, metric: &str, value: f64) -> Stri
 }
 
 pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
-    args.part.validate()?;
-    let (setup, threads) = args.setup.validate()?;
     let options = VerifyOptions {
         selection: args.starts.validate()?,
         tie_band_per_mm: args.starts.tie_band,
         tolerance: args.tolerance,
     };
-    options.validate().map_err(super::harness_error)?;
-    super::set_threads(threads)?;
-    let input = kneeform::read_part(&args.part.part, args.part.scale, args.part.side)?;
+    let (input, setup) = super::study_inputs(&args.part, &args.setup, options.validate())?;
     let result = harness::verify(&input, &setup, &options, &Bars::default())
         .map_err(super::harness_error)?;
     output::write_verification(&args.out, &result)?;

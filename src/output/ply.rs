@@ -82,21 +82,9 @@ pub fn write_colliding_area_ply<W: Write>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::GridSpec;
 
-    /// A 3 x 3 grid at pitch 2 with heights `h = i + 10 j`.
     fn grid() -> HeightGrid {
-        let spec = GridSpec {
-            pitch: 2.0,
-            i_origin: 0,
-            j_origin: 0,
-            nx: 3,
-            nz: 3,
-        };
-        let h = (0..9)
-            .map(|k| (k % 3) as f64 + 10.0 * (k / 3) as f64)
-            .collect();
-        HeightGrid { spec, h }
+        crate::output::surface::test_grid(3)
     }
 
     fn body(text: &str) -> Vec<&str> {

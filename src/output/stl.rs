@@ -65,21 +65,9 @@ pub(crate) fn to_stl_triangle(t: &Triangle) -> stl_io::Triangle {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::GridSpec;
 
-    /// A 4 x 4 grid at pitch 2 with heights `h = i + 10 j` (finite).
     fn grid() -> HeightGrid {
-        let spec = GridSpec {
-            pitch: 2.0,
-            i_origin: 0,
-            j_origin: 0,
-            nx: 4,
-            nz: 4,
-        };
-        let h = (0..16)
-            .map(|k| (k % 4) as f64 + 10.0 * (k / 4) as f64)
-            .collect();
-        HeightGrid { spec, h }
+        crate::output::surface::test_grid(4)
     }
 
     fn composite_of(nodes: &[(usize, usize)]) -> Vec<u16> {

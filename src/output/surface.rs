@@ -108,3 +108,20 @@ pub(crate) fn wound([a, b, c]: [u32; 3], side: Side) -> [u32; 3] {
         Side::Right => [a, c, b],
     }
 }
+
+/// An `n` x `n` grid at pitch 2 from the origin with heights `h = i + 10 j`
+/// (all finite), for the writers' tests.
+#[cfg(test)]
+pub(crate) fn test_grid(n: usize) -> HeightGrid {
+    let spec = crate::grid::GridSpec {
+        pitch: 2.0,
+        i_origin: 0,
+        j_origin: 0,
+        nx: n,
+        nz: n,
+    };
+    let h = (0..n * n)
+        .map(|k| (k % n) as f64 + 10.0 * (k / n) as f64)
+        .collect();
+    HeightGrid { spec, h }
+}
