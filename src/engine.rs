@@ -41,6 +41,20 @@ pub struct EngineOptions {
     /// Start rows to run (`None`: all). The benchmark runs the paper
     /// algorithm on a sample of rows.
     pub start_rows: Option<Vec<usize>>,
+    /// Cells to probe (fast path only): whether the knee-form's face meets
+    /// each at a level its `y` sticks out past ([`AngleMask::probes_met`]).
+    pub probes: Vec<Probe>,
+}
+
+/// A grid cell and a height in it: a point of the part between the
+/// cell's four corner nodes (a blind spot's lowest point).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Probe {
+    /// The cell's first corner node `(i, j)`; it spans `i..=i + 1` and
+    /// `j..=j + 1`.
+    pub cell: (usize, usize),
+    /// The height (mm).
+    pub y: f64,
 }
 
 impl Default for EngineOptions {
@@ -49,6 +63,7 @@ impl Default for EngineOptions {
             rule: StrikeRule::default(),
             algorithm: Algorithm::Fast,
             start_rows: None,
+            probes: Vec::new(),
         }
     }
 }
@@ -64,6 +79,11 @@ pub struct AngleMask {
     pub placed: usize,
     /// Number of colliding nodes.
     pub colliding: usize,
+    /// Per probe of [`EngineOptions::probes`]: whether a face level that met
+    /// one of the cell's corner nodes lies past the probe's height by more
+    /// than `e0` (its point would be a contact). All false on the paper
+    /// path, which keeps no levels.
+    pub probes_met: Vec<bool>,
 }
 
 /// Starts per block of the fast path: four AVX-512 registers of levels
@@ -117,26 +137,28 @@ pub fn colliding_masks(
     footprints
         .par_iter()
         .map(|fp| {
-            let (padded_mask, placed) = rows
+            let no_levels = || vec![f64::NEG_INFINITY; options.probes.len()];
+            let (padded_mask, placed, probe_levels) = rows
                 .par_chunks(band_len)
                 .map(|band| match &table {
                     Some(table) => {
                         let mut reach = vec![f64::NEG_INFINITY; padded.h.len()];
                         let placed = fast_band(&padded, table, fp, band, &mut reach);
                         let mask = strike_mask(&padded, &reach, &options.rule);
-                        (mask, placed)
+                        (mask, placed, probe_levels(&padded, &reach, &options.probes))
                     }
                     None => {
                         let mut mask = vec![0u8; padded.h.len()];
                         let placed = paper_band(&padded, fp, band, &options.rule, &mut mask);
-                        (mask, placed)
+                        (mask, placed, no_levels())
                     }
                 })
                 .reduce(
-                    || (vec![0u8; padded.h.len()], 0),
-                    |(mut a, pa), (b, pb)| {
+                    || (vec![0u8; padded.h.len()], 0, no_levels()),
+                    |(mut a, pa, mut la), (b, pb, lb)| {
                         a.iter_mut().zip(&b).for_each(|(x, y)| *x |= y);
-                        (a, pa + pb)
+                        la.iter_mut().zip(&lb).for_each(|(x, y)| *x = x.max(*y));
+                        (a, pa + pb, la)
                     },
                 );
             let mask = padded.unpad(&padded_mask);
@@ -146,7 +168,30 @@ pub fn colliding_masks(
                 colliding: mask.iter().filter(|&&m| m != 0).count(),
                 mask,
                 placed,
+                probes_met: options
+                    .probes
+                    .iter()
+                    .zip(&probe_levels)
+                    .map(|(probe, &level)| probe.y < level - options.rule.e0)
+                    .collect(),
             }
+        })
+        .collect()
+}
+
+/// Per probe, the highest face level that met one of its cell's corners
+/// in this band (`-inf` where none did).
+fn probe_levels(padded: &PaddedGrid, reach: &[f64], probes: &[Probe]) -> Vec<f64> {
+    let nz = padded.spec.nz as i64;
+    probes
+        .iter()
+        .map(|probe| {
+            let (i, j) = (probe.cell.0 as i64, probe.cell.1 as i64);
+            [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]
+                .into_iter()
+                .filter(|&(_, jj)| jj < nz)
+                .map(|(ii, jj)| reach[padded.index(jj, ii as i32)])
+                .fold(f64::NEG_INFINITY, f64::max)
         })
         .collect()
 }

@@ -39,6 +39,7 @@
 //! ```
 
 pub mod analysis;
+pub mod blind;
 pub mod console;
 pub mod engine;
 pub mod grid;

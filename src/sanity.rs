@@ -88,6 +88,25 @@ pub enum Warning {
         /// The angles, listed.
         angles: String,
     },
+    /// Features between the nodes, unseen by the grid, that the
+    /// knee-form meets.
+    #[error(
+        "{count} blind spots the knee-form meets (angles {angles}): the part sticks out up to {depth_mm:.2} mm past the grid's nodes where the grid cannot see it, first at x = {x:.1}, z = {z:.1} mm; their strikes are missing from the result; --pitch {pitch} resolves them (blind_spots.csv)"
+    )]
+    BlindSpotsMet {
+        /// Cells the knee-form meets.
+        count: usize,
+        /// The largest depth missed among them (mm).
+        depth_mm: f64,
+        /// The angles at which they are met, listed.
+        angles: String,
+        /// The first one's x (mm, part frame).
+        x: f64,
+        /// Its z (mm).
+        z: f64,
+        /// The pitch resolving every one of them (mm).
+        pitch: f64,
+    },
     /// Nothing is struck.
     #[error(
         "no grid node is struck at any angle: if the part should be struck, check its units (--scale) and which face the knee meets (--side)"
@@ -181,6 +200,53 @@ pub fn angle_warnings(angles_deg: &[f64]) -> Vec<Warning> {
     vec![Warning::AnglesOutsideRegulation {
         angles: outside.join(", "),
     }]
+}
+
+/// The blind spots the knee-form meets (contacts the grid cannot see), as
+/// one warning.
+pub fn blind_spot_warnings(spots: &[crate::blind::BlindSpot]) -> Vec<Warning> {
+    let near: Vec<&crate::blind::BlindSpot> = spots
+        .iter()
+        .filter(|s| !s.met_angles_deg.is_empty())
+        .collect();
+    let Some(first) = near.first() else {
+        return Vec::new();
+    };
+    let mut angles: Vec<f64> = near.iter().flat_map(|s| s.met_angles_deg.clone()).collect();
+    angles.sort_by(f64::total_cmp);
+    angles.dedup();
+    vec![Warning::BlindSpotsMet {
+        count: near.len(),
+        depth_mm: near.iter().map(|s| s.depth_missed_mm).fold(0.0, f64::max),
+        angles: angle_list(&angles),
+        x: first.x,
+        z: first.z,
+        pitch: near
+            .iter()
+            .map(|s| s.resolving_pitch_mm)
+            .fold(f64::INFINITY, f64::min),
+    }]
+}
+
+/// Angles as ranges of whole degrees where they run on: `-30..-12, 0, 7`.
+fn angle_list(sorted: &[f64]) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    let mut k = 0;
+    while k < sorted.len() {
+        let mut end = k;
+        while end + 1 < sorted.len() && (sorted[end + 1] - sorted[end] - 1.0).abs() < 1e-9 {
+            end += 1;
+        }
+        parts.push(if end > k + 1 {
+            format!("{}..{}", sorted[k], sorted[end])
+        } else if end == k + 1 {
+            format!("{}, {}", sorted[k], sorted[end])
+        } else {
+            sorted[k].to_string()
+        });
+        k = end + 1;
+    }
+    parts.join(", ")
 }
 
 /// The checks of a result: `composite_nodes` is the number of nodes

@@ -25,6 +25,9 @@ pub struct Timings {
     pub sample_s: f64,
     /// Push and slide over every angle.
     pub push_slide_s: f64,
+    /// Finding the blind spots.
+    #[serde(default)]
+    pub blind_s: f64,
     /// Writing the output files.
     pub write_s: f64,
     /// Everything.
@@ -96,6 +99,18 @@ pub struct Summary {
     pub composite_nodes: usize,
     /// Their area (mm^2).
     pub composite_area_mm2: f64,
+    /// The depth threshold of a blind spot (mm). Absent in runs of
+    /// earlier versions.
+    #[serde(default)]
+    pub blind_depth_mm: f64,
+    /// Grid cells where the part sticks out between the nodes by more
+    /// than `blind_depth_mm`: `blind_spots.csv`.
+    #[serde(default)]
+    pub blind_spots: usize,
+    /// Those the knee-form's face meets at some angle at a level they
+    /// stick out past: contacts the grid cannot see (said in `warnings`).
+    #[serde(default)]
+    pub blind_spots_met: usize,
     /// Time per stage.
     pub timings: Timings,
     /// The sanity checks' warnings (one line each), as printed on stderr:

@@ -35,6 +35,7 @@ fn run(
         rule,
         algorithm,
         start_rows: None,
+        probes: Vec::new(),
     };
     colliding_masks(grid, &footprints, &options, &|| {})
 }

@@ -8,4 +8,5 @@ mod first_hour;
 mod harness;
 mod oracle;
 mod report;
+mod resolution;
 mod util;

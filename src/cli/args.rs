@@ -135,6 +135,13 @@ pub struct SetupArgs {
     /// Worker threads (default: one per CPU). Results do not depend on it.
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
+    /// Blind-spot depth (mm, > 0): a grid cell where the part sticks out
+    /// towards the knee between the cell's four nodes by more than this is
+    /// a blind spot, a feature the grid cannot see at this pitch (a thin
+    /// rib, a sharp edge, a boss). Listed in blind_spots.csv with the pitch
+    /// that resolves it; warned of when near the colliding area.
+    #[arg(long, default_value_t = Setup::DEFAULT_BLIND_DEPTH, value_name = "MM")]
+    pub blind_depth: f64,
     /// Refuse grids whose estimated working memory exceeds this (GiB).
     #[arg(long, default_value_t = 16.0, value_name = "GIB")]
     pub max_memory: f64,
@@ -344,6 +351,7 @@ impl SetupArgs {
             grid,
             algorithm: self.algorithm,
             max_memory_bytes: self.max_memory * f64::from(1u32 << 30),
+            blind_depth: self.blind_depth,
         };
         setup.validate().map_err(with_flag)?;
         Ok((setup, self.threads))

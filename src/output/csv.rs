@@ -176,6 +176,7 @@ mod tests {
             colliding: mask.iter().filter(|&&m| m != 0).count(),
             mask,
             placed: 1,
+            probes_met: Vec::new(),
         }
     }
 

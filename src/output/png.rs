@@ -69,6 +69,14 @@ pub const RING_COLOUR: RGBColor = RGBColor(228, 26, 28);
 /// Radius of those circles (pixels).
 const RING_RADIUS: i32 = 9;
 
+/// The colour of the blind-spot marks (a cross on each cell the grid
+/// cannot see into): magenta, apart from the counts' ramp, the greys and
+/// the rings' red.
+pub const BLIND_COLOUR: RGBColor = RGBColor(214, 0, 214);
+
+/// Half the size of a blind-spot cross (pixels).
+const BLIND_HALF: i32 = 4;
+
 /// Why an image could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum PngError {
@@ -138,6 +146,7 @@ pub fn write_depth_png(path: &Path, grid: &HeightGrid, side: Side) -> Result<(),
         side,
         key: &[(NO_PART, "no part (the node's line misses it)")],
         rings: &[],
+        marks: &[],
     };
     draw_plot(path, &plot, |area, bar_top, bar_bottom| {
         let mut bar = colour_bar(area, "y (mm, part frame)", y_lo..y_hi)?;
@@ -178,13 +187,16 @@ pub fn depth_bar_ends(side: Side) -> [&'static str; 2] {
 /// The key of the composite image, beside its colour bar of counts: the
 /// grey of the part not struck, the pale of no part, and the circles when
 /// there are any.
-pub fn composite_key(ringed: bool) -> Vec<(RGBColor, &'static str)> {
+pub fn composite_key(ringed: bool, blind: bool) -> Vec<(RGBColor, &'static str)> {
     let mut key = vec![
         (grey(0.5), "part, not struck (lighter = closer to the knee)"),
         (NO_PART, "no part"),
     ];
     if ringed {
         key.push((RING_COLOUR, "circled: struck (few nodes)"));
+    }
+    if blind {
+        key.push((BLIND_COLOUR, "crossed: blind spot (unseen between nodes)"));
     }
     key
 }
@@ -194,7 +206,8 @@ pub fn composite_key(ringed: bool) -> Vec<(RGBColor, &'static str)> {
 /// a discrete legend) over the height grid in grey (pale neutral where the
 /// part is missed), both in the key, mm axes, `title` with the side and
 /// viewing direction under it, cropped to the part and what was struck;
-/// few struck pixels are circled.
+/// few struck pixels are circled, and the cells `blind` (each by its first
+/// corner node `(i, j)`: [`crate::blind`]) crossed.
 pub fn write_composite_png(
     path: &Path,
     grid: &HeightGrid,
@@ -202,6 +215,7 @@ pub fn write_composite_png(
     n_angles: usize,
     title: &str,
     side: Side,
+    blind: &[(usize, usize)],
 ) -> Result<(), PngError> {
     if composite.len() != grid.spec.len() {
         return Err(PngError::Length {
@@ -230,6 +244,13 @@ pub fn write_composite_png(
         Vec::new()
     };
     rings.dedup();
+    let mut marks: Vec<usize> = blind
+        .iter()
+        .filter(|&&(i, j)| window.i.contains(&i) && window.j.contains(&j))
+        .map(|&(i, j)| raster.pixel_of(i - window.i.start, j - window.j.start))
+        .collect();
+    marks.sort_unstable();
+    marks.dedup();
     let pixels: Vec<RGBColor> = counts
         .into_iter()
         .zip(heights)
@@ -239,7 +260,7 @@ pub fn write_composite_png(
             (0, false) => NO_PART,
         })
         .collect();
-    let key = composite_key(!rings.is_empty());
+    let key = composite_key(!rings.is_empty(), !marks.is_empty());
     let plot = Plot {
         grid: &shown,
         raster: &raster,
@@ -248,6 +269,7 @@ pub fn write_composite_png(
         side,
         key: &key,
         rings: &rings,
+        marks: &marks,
     };
     draw_plot(path, &plot, |area, _, _| {
         let top = n as f64 + 0.5;
@@ -474,6 +496,8 @@ struct Plot<'a> {
     key: &'a [(RGBColor, &'a str)],
     /// Pixels (indices into `pixels`) to circle.
     rings: &'a [usize],
+    /// Pixels to cross (blind spots).
+    marks: &'a [usize],
 }
 
 /// The second line of every title: the side and where it is seen from.
@@ -555,6 +579,19 @@ fn draw_plot(
                 at(k),
                 RING_RADIUS,
                 RING_COLOUR.stroke_width(2),
+            ))?;
+        }
+        for &k in plot.marks {
+            let (x, y) = at(k);
+            let h = BLIND_HALF;
+            let stroke = BLIND_COLOUR.stroke_width(2);
+            root.draw(&PathElement::new(
+                vec![(x - h, y - h), (x + h, y + h)],
+                stroke,
+            ))?;
+            root.draw(&PathElement::new(
+                vec![(x - h, y + h), (x + h, y - h)],
+                stroke,
             ))?;
         }
         let x_label = |v: &f64| tick(&if reversed { -v } else { *v });
@@ -723,8 +760,12 @@ mod tests {
             61,
             "Composite, 61 angles",
             Side::Left,
+            &[(40, 20)],
         )
         .unwrap();
+        // The blind spot's cross is drawn.
+        let (_, _, pixels) = decode(&dir.join("composite.png"));
+        assert!(count_of(&pixels, BLIND_COLOUR) > 4);
         // The part meets columns 5..120: grown by a twentieth of that
         // (5 nodes), the window is the whole grid, 120 x 60 nodes, enlarged
         // 4 times to reach MIN_PLOT.
@@ -759,6 +800,7 @@ mod tests {
             1,
             "all",
             Side::Left,
+            &[],
         )
         .unwrap();
         assert!(png_size(&dir.join("c.png")).0 <= 1600);
@@ -874,17 +916,17 @@ mod tests {
         let mut composite = vec![0u16; nx * nz];
         composite[300 * nx + 1000] = 5;
         let path = dir.join("one.png");
-        write_composite_png(&path, &g, &composite, 61, "one node", Side::Left).unwrap();
+        write_composite_png(&path, &g, &composite, 61, "one node", Side::Left, &[]).unwrap();
         let (_, _, pixels) = decode(&path);
         // The ring: 2 px wide, radius 9: well over 50 pixels.
         assert!(count_of(&pixels, RING_COLOUR) > 50, "no ring");
         assert!(count_of(&pixels, count_colour(5, 61)) >= 1, "no node");
         // The grey of the part is in the key: its swatch's colour is drawn.
-        let swatch = composite_key(true)[0].0;
+        let swatch = composite_key(true, false)[0].0;
         assert!(count_of(&pixels, swatch) >= 14 * 14 - 4 * 14);
         // Many struck nodes: no rings.
         let many = vec![1u16; nx * nz];
-        write_composite_png(&path, &g, &many, 61, "all", Side::Left).unwrap();
+        write_composite_png(&path, &g, &many, 61, "all", Side::Left, &[]).unwrap();
         let (_, _, pixels) = decode(&path);
         assert_eq!(count_of(&pixels, RING_COLOUR), 0);
         std::fs::remove_dir_all(dir).unwrap();
@@ -900,7 +942,7 @@ mod tests {
         let mut first_column = Vec::new();
         for side in [Side::Left, Side::Right] {
             let path = dir.join("side.png");
-            write_composite_png(&path, &g, &composite, 1, "side", side).unwrap();
+            write_composite_png(&path, &g, &composite, 1, "side", side, &[]).unwrap();
             let (w, _, pixels) = decode(&path);
             let cols: Vec<usize> = (0..pixels.len())
                 .filter(|&k| pixels[k] == [struck.0, struck.1, struck.2])

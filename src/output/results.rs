@@ -49,6 +49,7 @@ pub fn write_analysis(out: &OutputDir, analysis: &Analysis) -> Result<Summary, W
         masks.len(),
         analysis.setup.knee.triangle_side
     );
+    let blind: Vec<(usize, usize)> = analysis.blind_spots.iter().map(|b| (b.i, b.j)).collect();
     super::write_composite_png(
         &out.path("composite.png"),
         grid,
@@ -56,7 +57,9 @@ pub fn write_analysis(out: &OutputDir, analysis: &Analysis) -> Result<Summary, W
         masks.len(),
         &title,
         side,
+        &blind,
     )?;
+    write_blind_spots(&out.path("blind_spots.csv"), analysis)?;
     let mut summary = analysis.summary();
     let t_ = &mut summary.timings;
     t_.write_s = t.elapsed().as_secs_f64();
@@ -125,6 +128,42 @@ pub fn write_convergence(dir: &Path, convergence: &Convergence) -> Result<(), Wr
     write_json(&out.path("converge.json"), &convergence.summary)?;
     super::write_plots(out.path(".").as_path(), results, &convergence.fits)?;
     commit(out, dir)
+}
+
+/// Writes `blind_spots.csv`: one row per blind spot ([`crate::blind`]),
+/// where (cell `i, j`; `x, z` of its lowest point, mm, part frame), how
+/// deep and wide, the pitch resolving it, and the angles at which the
+/// knee-form meets it (`;`-separated, empty when none).
+fn write_blind_spots(path: &Path, analysis: &Analysis) -> Result<(), WriteError> {
+    (|| -> csv::Result<()> {
+        let mut csv = csv::Writer::from_path(path)?;
+        csv.write_record([
+            "i",
+            "j",
+            "x",
+            "z",
+            "depth_missed_mm",
+            "width_mm",
+            "resolving_pitch_mm",
+            "met_angles_deg",
+        ])?;
+        for b in &analysis.blind_spots {
+            let angles: Vec<String> = b.met_angles_deg.iter().map(f64::to_string).collect();
+            csv.write_record([
+                b.i.to_string(),
+                b.j.to_string(),
+                b.x.to_string(),
+                b.z.to_string(),
+                b.depth_missed_mm.to_string(),
+                b.width_mm.to_string(),
+                b.resolving_pitch_mm.to_string(),
+                angles.join(";"),
+            ])?;
+        }
+        csv.flush()?;
+        Ok(())
+    })()
+    .map_err(WriteError::at(path))
 }
 
 /// Writes `value` as pretty JSON with a final newline.

@@ -1,0 +1,101 @@
+//! Blind spots: the grid must say where it cannot see the part (issue
+//! "show where the grid is blind"), and stay quiet on smooth parts.
+
+use std::path::{Path, PathBuf};
+
+use kneeform::blind::BlindSpot;
+use kneeform::{Analysis, Setup, Side};
+
+fn scenario(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenarios/{name}.toml"))
+}
+
+/// The blind spots of a scenario at `pitch`, angles -30, 0 and 30.
+fn blind_spots(name: &str, pitch: f64) -> Vec<BlindSpot> {
+    let setup = Setup {
+        pitch,
+        angles: vec![-30.0, 0.0, 30.0],
+        ..Setup::default()
+    };
+    Analysis::of_file(&scenario(name), 1.0, Side::Left, &setup, &())
+        .unwrap()
+        .blind_spots
+}
+
+#[test]
+fn thin_ribs_are_blind_spots_where_no_node_lands_on_them() {
+    // scenarios/thin-rib.toml: two tents 0.6 mm wide at the foot and 5 mm
+    // proud, one across the slide (crest x = 10.3, z in -100..100), one
+    // along it (crest z = 40.3, x in -250..-50). Nodes sit on multiples of
+    // the pitch, so at 4, 2 and 1 mm the nearest node columns are x = 10
+    // (the foot, 0.3 mm from the crest: height 0) and the next; no node
+    // lands on the proud part of either rib.
+    for pitch in [4.0, 2.0, 1.0] {
+        let spots = blind_spots("thin-rib", pitch);
+        let across: Vec<&BlindSpot> = spots
+            .iter()
+            .filter(|s| (s.x - 10.3).abs() <= pitch && (-100.0..=100.0).contains(&s.z))
+            .collect();
+        let along: Vec<&BlindSpot> = spots
+            .iter()
+            .filter(|s| (s.z - 40.3).abs() <= pitch && (-250.0..=-50.0).contains(&s.x))
+            .collect();
+        // Every cell row (column) the rib crosses is flagged: its length
+        // over the pitch, give or take the cells at its ends.
+        assert!(
+            across.len() as f64 >= 200.0 / pitch - 2.0,
+            "{pitch} mm: {} cells on the rib across",
+            across.len()
+        );
+        assert!(
+            along.len() as f64 >= 200.0 / pitch - 2.0,
+            "{pitch} mm: {} cells on the rib along",
+            along.len()
+        );
+        assert_eq!(across.len() + along.len(), spots.len(), "{pitch} mm");
+        for s in across.iter().chain(&along) {
+            // The tent's crest is 5 mm proud of the nodes around it.
+            assert!(s.depth_missed_mm > 4.9 && s.depth_missed_mm <= 5.0, "{s:?}");
+            // No larger than the rib's 0.6 mm width, and a nested pitch.
+            assert!(s.resolving_pitch_mm <= 0.6, "{s:?}");
+            let halvings = (pitch / s.resolving_pitch_mm).log2();
+            assert!((halvings - halvings.round()).abs() < 1e-9, "{s:?}");
+            // The sliding knee-form meets a 5 mm rib on a flat wall.
+            assert!(!s.met_angles_deg.is_empty(), "{s:?}");
+        }
+    }
+}
+
+#[test]
+fn smooth_parts_have_no_blind_spot() {
+    for name in ["flat-wall", "ramp", "wave", "growing-wave", "tilted-wave"] {
+        for pitch in [4.0, 2.0, 1.0] {
+            let spots = blind_spots(name, pitch);
+            assert!(
+                spots.is_empty(),
+                "{name} at {pitch} mm: {:?}",
+                spots.first()
+            );
+        }
+    }
+}
+
+#[test]
+fn the_consoles_thin_rib_is_met_at_the_default_pitch() {
+    // scenarios/console.toml: a rib 0.6 mm wide, 5 mm proud, crest at
+    // x = 1000.3 from z = 60 to 330; the default pitch's nodes (multiples
+    // of 1.24 mm) are at x = 999.72 and 1000.96, both off its crest by
+    // more than its 0.3 mm half-width.
+    let pitch = Setup::default().pitch;
+    let spots = blind_spots("console", pitch);
+    let rib: Vec<&BlindSpot> = spots
+        .iter()
+        .filter(|s| (s.x - 1000.3).abs() <= pitch && (60.0..=330.0).contains(&s.z))
+        .collect();
+    assert!(
+        rib.len() as f64 >= 270.0 / pitch - 2.0,
+        "{} cells",
+        rib.len()
+    );
+    assert!(rib.iter().all(|s| !s.met_angles_deg.is_empty()));
+}
