@@ -289,6 +289,9 @@ pub struct Analysis {
     pub blind_spots: Vec<BlindSpot>,
     /// The sanity checks' findings, in the order they were made.
     pub warnings: Vec<Warning>,
+    /// The pitch study that chose `setup.pitch`, when one did (set by the
+    /// caller: [`crate::harness::choose_pitch`]).
+    pub pitch_choice: Option<crate::harness::PitchChoice>,
     /// Seconds per stage (`write_s` and `total_s` are the writer's).
     pub timings: Timings,
 }
@@ -399,6 +402,7 @@ impl Analysis {
             composite,
             blind_spots: blind,
             warnings,
+            pitch_choice: None,
             timings: Timings {
                 sample_s,
                 push_slide_s,
@@ -475,6 +479,7 @@ impl Analysis {
             composite_nodes,
             composite_area_mm2: composite_nodes as f64 * area,
             blind_depth_mm: setup.blind_depth,
+            pitch_study: self.pitch_choice.clone(),
             blind_spots: self.blind_spots.len(),
             blind_spots_met: self
                 .blind_spots

@@ -111,6 +111,10 @@ pub struct Summary {
     /// stick out past: contacts the grid cannot see (said in `warnings`).
     #[serde(default)]
     pub blind_spots_met: usize,
+    /// With `--pitch auto`: the pitch study, its tolerance and why it
+    /// chose `pitch_mm`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pitch_study: Option<crate::harness::PitchChoice>,
     /// Time per stage.
     pub timings: Timings,
     /// The sanity checks' warnings (one line each), as printed on stderr:

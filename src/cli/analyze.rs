@@ -7,9 +7,10 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail, ensure};
 use kneeform::Analysis;
+use kneeform::harness::{self, AutoPitch};
 use kneeform::output::{self, OutputDir};
 
-use super::args::AnalyzeArgs;
+use super::args::{AnalyzeArgs, PitchArg};
 use super::progress::Bars;
 
 /// Exit code of `analyze --report` when the analysis is written but its
@@ -18,22 +19,67 @@ pub const REPORT_FAILED: u8 = 3;
 
 pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
     args.part.validate()?;
-    let (setup, threads) = args.setup.validate()?;
+    let (mut setup, threads) = args.setup.validate()?;
+    let auto = args.setup.pitch == PitchArg::Auto;
+    let auto_pitch = match (auto, args.tolerance) {
+        (true, Some(tolerance)) => Some(AutoPitch {
+            tolerance,
+            budget_s: args.budget_s,
+            starts: AutoPitch::DEFAULT_STARTS,
+        }),
+        (true, None) => bail!("--pitch auto needs --tolerance MM: the error it must meet"),
+        (false, Some(_)) => bail!("--tolerance is for --pitch auto; with a pitch given, `kneeform verify` measures the error"),
+        (false, None) => None,
+    };
     // Before any work: where the results go, so that an unwritable or
     // occupied --out is said now, not after the computation.
     let out = stage_output(&args.out, args.force)?;
     super::set_threads(threads)?;
     let bars = Bars::default();
-    let analysis = Analysis::of_file(
+    let mut choice = None;
+    if let Some(auto) = &auto_pitch {
+        let input = kneeform::read_part(&args.part.part, args.part.scale, args.part.side)?;
+        let chosen = harness::choose_pitch(&input, &setup, auto, &bars)
+            .map_err(super::harness_error)?;
+        for row in &chosen.study {
+            let mm = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
+            eprintln!(
+                "kneeform: pitch study: {:>6} mm: exact area distance {} mm, change to the finer grid {} mm, analysis about {:.1} s, {:.2} GiB{}",
+                row.pitch_mm,
+                mm(row.exact_area_distance_mm),
+                mm(row.grid_change_mm),
+                row.predicted_s,
+                row.memory_gib,
+                if row.meets { ": meets the tolerance" } else { "" }
+            );
+        }
+        eprintln!(
+            "kneeform: --pitch auto chose {} mm: {}; the analysis should take about {:.1} s (study {:.1} s)",
+            chosen.pitch_mm, chosen.reason, chosen.predicted_s, chosen.study_s
+        );
+        setup.pitch = chosen.pitch_mm;
+        choice = Some(chosen);
+    }
+    let mut analysis = Analysis::of_file(
         &args.part.part,
         args.part.scale,
         args.part.side,
         &setup,
         &bars,
     )?;
+    analysis.pitch_choice = choice;
     let summary = output::write_analysis(&out, &analysis)?;
     out.commit()
         .with_context(|| format!("cannot move results into {}", args.out.display()))?;
+    if let Some(chosen) = &analysis.pitch_choice {
+        let t = &analysis.timings;
+        eprintln!(
+            "kneeform: at {} mm the analysis took {:.1} s (predicted {:.1} s)",
+            chosen.pitch_mm,
+            t.sample_s + t.blind_s + t.push_slide_s,
+            chosen.predicted_s
+        );
+    }
     eprintln!(
         "kneeform: {} angles, composite {} nodes ({:.0} mm^2); knee-form L = {} mm{}, R = {} mm; results in {}",
         analysis.masks.len(),

@@ -58,6 +58,28 @@ pub struct PartArgs {
     pub side: Side,
 }
 
+/// `--pitch`: a length, or `auto`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PitchArg {
+    /// This pitch (mm).
+    Mm(f64),
+    /// Chosen by a pitch study (`analyze --pitch auto --tolerance MM`).
+    Auto,
+}
+
+impl std::str::FromStr for PitchArg {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<PitchArg, String> {
+        if s == "auto" {
+            return Ok(PitchArg::Auto);
+        }
+        s.parse()
+            .map(PitchArg::Mm)
+            .map_err(|_| format!("expected a pitch in mm or `auto`, got {s:?}"))
+    }
+}
+
 /// The knee-form angles.
 #[derive(Debug, Args)]
 pub struct AnglesArg {
@@ -76,8 +98,10 @@ pub struct AnglesArg {
 #[derive(Debug, Args)]
 pub struct SetupArgs {
     /// Grid pitch (mm): node spacing in x and z. The paper used 1.24 mm.
-    #[arg(long, default_value_t = 1.24, value_name = "MM")]
-    pub pitch: f64,
+    /// `analyze` also takes `auto` (with --tolerance): a quick convergence
+    /// study on the part chooses the coarsest pitch meeting the tolerance.
+    #[arg(long, default_value = "1.24", value_name = "MM|auto")]
+    pub pitch: PitchArg,
     /// Side L of the knee-form's equilateral triangle (mm). The default 200
     /// is an ASSUMPTION (the regulation's figure was not at hand): set it
     /// from the regulation for a type-approval run.
@@ -167,6 +191,16 @@ pub struct AnalyzeArgs {
     /// only the report fails (exit code 3).
     #[arg(long)]
     pub report: bool,
+    /// With --pitch auto: the largest decided area distance (mm) allowed
+    /// between the grid's colliding area and the exact knee-form's, on a
+    /// sample of starts, and between the chosen grid and the next finer.
+    #[arg(long, value_name = "MM")]
+    pub tolerance: Option<f64>,
+    /// With --pitch auto: the longest predicted analysis (seconds) the
+    /// chosen pitch may need; a tolerance needing more is refused (exit 2)
+    /// with the pitch and time it would need.
+    #[arg(long, default_value_t = kneeform::harness::AutoPitch::DEFAULT_BUDGET_S, value_name = "S")]
+    pub budget_s: f64,
 }
 
 /// `kneeform report`.
@@ -340,7 +374,11 @@ impl SetupArgs {
             _ => GridPlacement::AroundPart,
         };
         let setup = Setup {
-            pitch: self.pitch,
+            // `auto`: a placeholder until the pitch study chooses.
+            pitch: match self.pitch {
+                PitchArg::Mm(p) => p,
+                PitchArg::Auto => Setup::default().pitch,
+            },
             knee: KneeForm {
                 triangle_side: self.triangle_side,
                 radius: self.radius,

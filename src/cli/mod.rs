@@ -47,6 +47,10 @@ pub fn study_inputs(
     check: Result<(), HarnessError>,
 ) -> anyhow::Result<(PartFile, Setup)> {
     part.validate()?;
+    anyhow::ensure!(
+        setup.pitch != args::PitchArg::Auto,
+        "--pitch auto is for analyze: give verify and converge a pitch (mm)"
+    );
     let (setup, threads) = setup.validate()?;
     check.map_err(harness_error)?;
     set_threads(threads)?;

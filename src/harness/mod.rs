@@ -22,6 +22,7 @@
 //! travel (it keeps each node's reach). It is a direct transcription of
 //! SPEC, tested equal to the engine's masks on every start.
 
+pub mod auto;
 pub mod compare;
 pub mod converge;
 pub mod metrics;
@@ -32,6 +33,7 @@ pub mod verify;
 #[cfg(test)]
 mod fault_tests;
 
+pub use auto::{AutoPitch, PitchChoice, PitchStudyRow, choose_pitch};
 pub use compare::{
     AreaDistance, CompareOptions, Comparison, Counts, StartSelection, VerifyRow, compare_grid,
     exact_traces, select_starts,
@@ -94,6 +96,37 @@ pub enum HarnessError {
     /// A start sample of no start.
     #[error("a start sample must hold at least one start")]
     EmptySample,
+    /// The time budget is not a finite positive number of seconds.
+    #[error("the time budget must be a finite number of seconds > 0, got {0}")]
+    Budget(f64),
+    /// The pitch a tolerance needs exceeds the time budget or memory.
+    #[error(
+        "a tolerance of {tolerance} mm needs a pitch of {pitch} mm or finer: about {predicted_s:.0} s and {memory_gib:.1} GiB for the analysis, beyond the budget of {budget_s} s or the {max_memory_gib:.1} GiB allowed (raise --budget-s or --max-memory, or accept a larger --tolerance)"
+    )]
+    PitchBudget {
+        /// The tolerance (mm).
+        tolerance: f64,
+        /// The pitch it would need next (mm).
+        pitch: f64,
+        /// The predicted analysis time there (s).
+        predicted_s: f64,
+        /// The memory estimate there (GiB).
+        memory_gib: f64,
+        /// The budget (s).
+        budget_s: f64,
+        /// The memory limit (GiB).
+        max_memory_gib: f64,
+    },
+    /// No pitch of the study meets the tolerance.
+    #[error(
+        "no pitch down to {finest} mm meets a tolerance of {tolerance} mm: the disagreement does not shrink with the pitch here (see the pitch study, and results/README.md on what does not converge)"
+    )]
+    PitchNotFound {
+        /// The tolerance (mm).
+        tolerance: f64,
+        /// The finest pitch studied (mm).
+        finest: f64,
+    },
     /// A strip of start rows whose bounds are not finite and ordered.
     #[error("a strip of starts needs finite z bounds Z0 <= Z1 (mm), got {0:?}")]
     Strip([f64; 2]),

@@ -1,0 +1,305 @@
+//! Choosing the pitch for the user (`analyze --pitch auto --tolerance MM`):
+//! a quick convergence study on the user's own part, then the coarsest
+//! pitch that meets the tolerance ([`choose_pitch`]).
+//!
+//! The study halves the pitch from a start derived from the tolerance. At
+//! each pitch it measures, on the study's angles (the setup's first, middle
+//! and last):
+//!
+//! * the **exact error**: the decided area distance against the exact
+//!   oracle, on a seeded sample of starts taken on the coarsest grid (so
+//!   every grid holds them), traced once;
+//! * the **grid change**: the area distance between this pitch's colliding
+//!   area and the next finer pitch's, over the whole part (the sample
+//!   cannot see a feature its starts do not cross; this does);
+//! * the engine's time, from which a full analysis's time is predicted
+//!   (scaled to the setup's angle count), and the memory estimate.
+//!
+//! A pitch **meets** the tolerance when both distances are within it. The
+//! study stops at the first pitch that meets it, and refuses when the next
+//! pitch it would need exceeds the time budget or the memory limit.
+
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use super::compare::{CompareOptions, StartSelection, compare_grid};
+use super::nearest::PointSet;
+use super::verify::{oracle_options, run_oracle, start_positions};
+use super::{HarnessError, TieBand};
+use crate::analysis::{Progress, Setup};
+use crate::engine::{AngleMask, EngineOptions, colliding_masks};
+use crate::grid::{BYTES_PER_NODE, GridSpec, HeightGrid};
+use crate::mesh::PartFile;
+
+/// How to choose the pitch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AutoPitch {
+    /// The largest decided area distance allowed (mm).
+    pub tolerance: f64,
+    /// The longest predicted analysis allowed (s).
+    pub budget_s: f64,
+    /// Starts traced by the exact oracle.
+    pub starts: usize,
+}
+
+impl AutoPitch {
+    /// The default sample of exact starts.
+    pub const DEFAULT_STARTS: usize = 40;
+    /// The default time budget (s).
+    pub const DEFAULT_BUDGET_S: f64 = 600.0;
+}
+
+/// One pitch of the study (`summary.json`'s `pitch_study`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PitchStudyRow {
+    /// The pitch (mm).
+    pub pitch_mm: f64,
+    /// Decided area distance against the exact oracle on the sample (mm;
+    /// `null` where one side strikes nothing).
+    pub exact_area_distance_mm: Option<f64>,
+    /// Area distance to the next finer pitch's colliding area (mm; `null`
+    /// for the finest pitch studied or where one side strikes nothing).
+    pub grid_change_mm: Option<f64>,
+    /// Predicted time of the full analysis at this pitch (s).
+    pub predicted_s: f64,
+    /// Estimated working memory (GiB).
+    pub memory_gib: f64,
+    /// Whether this pitch meets the tolerance.
+    pub meets: bool,
+}
+
+/// The study and its choice.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PitchChoice {
+    /// The chosen pitch (mm).
+    pub pitch_mm: f64,
+    /// The tolerance (mm).
+    pub tolerance_mm: f64,
+    /// The study, coarsest first.
+    pub study: Vec<PitchStudyRow>,
+    /// The predicted time of the analysis at the chosen pitch (s).
+    pub predicted_s: f64,
+    /// Seconds the study took.
+    pub study_s: f64,
+    /// Why this pitch, in one sentence.
+    pub reason: String,
+}
+
+/// How many halvings the study may take from its first pitch.
+const MAX_HALVINGS: usize = 6;
+
+/// The study's first pitch: four times the tolerance (smooth parts meet a
+/// tolerance at about one pitch), to the power of 2 at or above it, within
+/// 0.25..8 mm.
+fn first_pitch(tolerance: f64) -> f64 {
+    (4.0 * tolerance).log2().ceil().exp2().clamp(0.25, 8.0)
+}
+
+/// Runs the study on `input` for `setup` (its pitch ignored) and returns
+/// the coarsest pitch meeting `auto.tolerance`; an error saying which pitch
+/// and how long when the budget or the memory limit comes first.
+pub fn choose_pitch(
+    input: &PartFile,
+    setup: &Setup,
+    auto: &AutoPitch,
+    progress: &dyn Progress,
+) -> Result<PitchChoice, HarnessError> {
+    super::verify::check_tolerance(auto.tolerance)?;
+    if !(auto.budget_s.is_finite() && auto.budget_s > 0.0) {
+        return Err(HarnessError::Budget(auto.budget_s));
+    }
+    let started = Instant::now();
+    let p0 = first_pitch(auto.tolerance);
+    let pitches: Vec<f64> = (0..=MAX_HALVINGS).map(|k| p0 / f64::from(1u32 << k)).collect();
+    let angles = study_angles(&setup.angles);
+    let study_setup = |pitch: f64| Setup {
+        pitch,
+        angles: angles.clone(),
+        ..setup.clone()
+    };
+    let coarse_setup = study_setup(p0);
+    coarse_setup.validate()?;
+    let triangles = &input.part.triangles;
+    let coarse = coarse_setup.grid_spec(&input.part.bbox())?;
+    let spec_at = |p: f64| {
+        let r = (p0 / p).round() as usize;
+        GridSpec::explicit(
+            coarse.x(0),
+            coarse.z(0),
+            (coarse.nx - 1) * r + 1,
+            (coarse.nz - 1) * r + 1,
+            p,
+        )
+    };
+    let coarse_grid = HeightGrid::sample(triangles, coarse);
+    let starts = start_positions(
+        &coarse_grid,
+        &coarse_setup.footprints(&coarse),
+        &StartSelection::Sample {
+            count: auto.starts,
+            seed: 1,
+        },
+    )?;
+    drop(coarse_grid);
+    let oracle = oracle_options(&setup.knee, pitches[pitches.len() - 1], coarse.x(0));
+    let (traces, _) = run_oracle(triangles, &starts, &angles, &oracle, progress)?;
+    let compare = CompareOptions {
+        knee: setup.knee,
+        rule: setup.rule,
+        tie_band_per_mm: TieBand::DEFAULT_PER_MM,
+    };
+    let scale = setup.angles.len() as f64 / angles.len() as f64;
+    let memory = |spec: &GridSpec| spec.nx as f64 * spec.nz as f64 * BYTES_PER_NODE;
+
+    let mut rows: Vec<PitchStudyRow> = Vec::new();
+    // The struck points per angle at the previous (coarser) pitch.
+    let mut previous: Option<Vec<Vec<[f64; 2]>>> = None;
+    for &p in &pitches {
+        let spec = spec_at(p);
+        let need = memory(&spec);
+        // Cost grows as p^-3 (nodes p^-2, footprint rows p^-1).
+        let predicted_here = rows.last().map_or(0.0, |r| r.predicted_s * 8.0);
+        if need > setup.max_memory_bytes || predicted_here > auto.budget_s {
+            if let Some(row) = rows.last().filter(|r| r.meets) {
+                // The exact error is within the tolerance; the finer grid
+                // that would confirm it over the whole part is beyond the
+                // limits.
+                let row = *row;
+                return Ok(PitchChoice {
+                    pitch_mm: row.pitch_mm,
+                    tolerance_mm: auto.tolerance,
+                    study: rows,
+                    predicted_s: row.predicted_s,
+                    study_s: started.elapsed().as_secs_f64(),
+                    reason: format!(
+                        "the coarsest pitch whose decided area distance to the exact knee-form ({:.3} mm on {} sampled starts) is within {} mm; its change to the next finer grid was not measured ({p} mm would exceed the time budget or the memory limit)",
+                        row.exact_area_distance_mm.unwrap_or(f64::NAN),
+                        starts.len(),
+                        auto.tolerance
+                    ),
+                });
+            }
+            return Err(HarnessError::PitchBudget {
+                tolerance: auto.tolerance,
+                pitch: p,
+                predicted_s: predicted_here,
+                memory_gib: need / f64::from(1u32 << 30),
+                budget_s: auto.budget_s,
+                max_memory_gib: setup.max_memory_bytes / f64::from(1u32 << 30),
+            });
+        }
+        progress.begin(&format!("pitch study: {p} mm, {} x {} grid", spec.nx, spec.nz), None);
+        let t = Instant::now();
+        let grid = HeightGrid::sample(triangles, spec);
+        let footprints = study_setup(p).footprints(&spec);
+        let masks = colliding_masks(
+            &grid,
+            &footprints,
+            &EngineOptions {
+                rule: setup.rule,
+                ..EngineOptions::default()
+            },
+            &|| {},
+        );
+        let seconds = t.elapsed().as_secs_f64();
+        let comparison = compare_grid(&grid, &footprints, &starts, &traces, &compare);
+        progress.end();
+        let comparison = comparison?;
+        let decided = comparison.stat("area_distance_decided").max;
+        let finite = comparison
+            .area
+            .iter()
+            .all(|a| a.miss_decided.is_finite() && a.false_alarm_decided.is_finite());
+        let struck = struck_points(&grid, &masks);
+        if let (Some(prev), Some(last)) = (&previous, rows.last_mut()) {
+            last.grid_change_mm = area_change(prev, &struck);
+            last.meets = last.meets && last.grid_change_mm.is_some_and(|d| d <= auto.tolerance);
+            if last.meets {
+                let row = *last;
+                return Ok(PitchChoice {
+                    pitch_mm: row.pitch_mm,
+                    tolerance_mm: auto.tolerance,
+                    study: rows,
+                    predicted_s: row.predicted_s,
+                    study_s: started.elapsed().as_secs_f64(),
+                    reason: format!(
+                        "the coarsest pitch whose decided area distance to the exact knee-form ({:.3} mm on {} sampled starts) and to the next finer grid ({:.3} mm over the whole part) are within {} mm",
+                        row.exact_area_distance_mm.unwrap_or(f64::NAN),
+                        starts.len(),
+                        row.grid_change_mm.unwrap_or(f64::NAN),
+                        auto.tolerance
+                    ),
+                });
+            }
+        }
+        rows.push(PitchStudyRow {
+            pitch_mm: p,
+            exact_area_distance_mm: finite.then_some(decided),
+            grid_change_mm: None,
+            predicted_s: seconds * scale,
+            memory_gib: need / f64::from(1u32 << 30),
+            meets: finite && decided <= auto.tolerance,
+        });
+        previous = Some(struck);
+    }
+    Err(HarnessError::PitchNotFound {
+        tolerance: auto.tolerance,
+        finest: pitches[pitches.len() - 1],
+    })
+}
+
+/// The study's angles: the setup's first, middle and last (distinct).
+fn study_angles(angles: &[f64]) -> Vec<f64> {
+    let mut picked = vec![
+        angles[0],
+        angles[angles.len() / 2],
+        angles[angles.len() - 1],
+    ];
+    picked.dedup();
+    picked
+}
+
+/// Per angle, the struck nodes' positions (mm).
+fn struck_points(grid: &HeightGrid, masks: &[AngleMask]) -> Vec<Vec<[f64; 2]>> {
+    let spec = grid.spec;
+    masks
+        .iter()
+        .map(|m| {
+            m.mask
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| **c != 0)
+                .map(|(k, _)| [spec.x(k % spec.nx), spec.z(k / spec.nx)])
+                .collect()
+        })
+        .collect()
+}
+
+/// The largest Hausdorff distance, both ways, between two pitches' struck
+/// points at each angle; `None` where one side is empty and the other not.
+fn area_change(coarse: &[Vec<[f64; 2]>], fine: &[Vec<[f64; 2]>]) -> Option<f64> {
+    let mut worst: f64 = 0.0;
+    for (a, b) in coarse.iter().zip(fine) {
+        let d = PointSet::new(a.clone())
+            .hausdorff_from(b)
+            .max(PointSet::new(b.clone()).hausdorff_from(a));
+        worst = worst.max(d);
+    }
+    worst.is_finite().then_some(worst)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_study_starts_at_four_tolerances_on_powers_of_two() {
+        assert_eq!(first_pitch(1.0), 4.0);
+        assert_eq!(first_pitch(0.3), 2.0);
+        assert_eq!(first_pitch(0.01), 0.25);
+        assert_eq!(first_pitch(10.0), 8.0);
+        assert_eq!(study_angles(&[-30.0, 0.0, 30.0]), vec![-30.0, 0.0, 30.0]);
+        assert_eq!(study_angles(&[5.0]), vec![5.0]);
+    }
+}
