@@ -32,6 +32,7 @@ mod simd;
 pub mod slide;
 pub mod strike;
 pub mod summary;
+mod zbuffer;
 
 pub use engine::{Algorithm, AngleMask, EngineOptions, colliding_masks, composite, push_levels};
 pub use grid::{GridSpec, HeightGrid};
