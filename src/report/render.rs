@@ -145,6 +145,7 @@ pub struct DepthImage {
 
 impl DepthImage {
     /// Whether pixel `(c, r)` shows the part.
+    #[cfg(test)]
     pub fn covered(&self, c: usize, r: usize) -> bool {
         self.depth[r * self.view.width + c].is_finite()
     }
@@ -240,6 +241,7 @@ pub struct RgbImage {
 
 impl RgbImage {
     /// The colour of pixel `(c, r)`.
+    #[cfg(test)]
     pub fn at(&self, c: usize, r: usize) -> Rgb {
         let k = 3 * (r * self.width + c);
         [self.pixels[k], self.pixels[k + 1], self.pixels[k + 2]]
