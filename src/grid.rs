@@ -7,10 +7,9 @@
 //! nothing. Stored row-major by z: `h[j * nx + i]`, so the slide (along -x)
 //! reads contiguous memory.
 
-use rayon::prelude::*;
-
 use crate::kneeform::{Footprint, NODE_TOL};
 use crate::mesh::{Bbox, Triangle};
+use crate::zbuffer::{Lattice, Weighting, zbuffer};
 
 /// Where the grid's nodes are (mm, analysis frame).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -153,46 +152,14 @@ pub struct HeightGrid {
     pub h: Vec<f64>,
 }
 
-/// Rows per band of the parallel rasterizer: enough work per task to hide
-/// scheduling, small enough to balance two threads on a ragged part.
-const BAND_ROWS: usize = 16;
-
 impl HeightGrid {
     /// Samples `triangles` (analysis frame) on `spec` with a depth-buffer
     /// rasterizer: each triangle visits only the nodes under its xz
     /// projection. Triangles are closed (edges and vertices count, within
     /// [`NODE_TOL`]); those with a zero-area projection are skipped.
     pub fn sample(triangles: &[Triangle], spec: GridSpec) -> HeightGrid {
-        let p = spec.pitch;
-        let bands = spec.nz.div_ceil(BAND_ROWS);
-        // Bin each triangle into the bands its z-range touches.
-        let mut binned: Vec<Vec<u32>> = vec![Vec::new(); bands];
-        for (k, t) in triangles.iter().enumerate() {
-            let (zlo, zhi) = min_max([t[0][2], t[1][2], t[2][2]]);
-            let j_lo = ((zlo - NODE_TOL) / p).ceil() as i64 - spec.j_origin;
-            let j_hi = ((zhi + NODE_TOL) / p).floor() as i64 - spec.j_origin;
-            if j_hi < 0 || j_lo >= spec.nz as i64 || j_lo > j_hi {
-                continue;
-            }
-            let (b_lo, b_hi) = (
-                j_lo.max(0) as usize / BAND_ROWS,
-                j_hi.min(spec.nz as i64 - 1) as usize / BAND_ROWS,
-            );
-            for bin in &mut binned[b_lo..=b_hi] {
-                bin.push(k as u32);
-            }
-        }
-        let mut h = vec![f64::INFINITY; spec.len()];
-        h.par_chunks_mut(BAND_ROWS * spec.nx)
-            .zip(binned.par_iter())
-            .enumerate()
-            .for_each(|(band, (rows, bin))| {
-                let j_first = band * BAND_ROWS;
-                let j_end = j_first + rows.len() / spec.nx;
-                for &k in bin {
-                    rasterize(&triangles[k as usize], &spec, j_first..j_end, rows);
-                }
-            });
+        // Seen from -y: x along the columns, z along the rows, y the depth.
+        let h = zbuffer(&spec, triangles, |t| (t.map(|v| [v[0], v[2], v[1]]), ())).depth;
         HeightGrid { spec, h }
     }
 
@@ -207,47 +174,48 @@ impl HeightGrid {
     }
 }
 
-fn min_max(v: [f64; 3]) -> (f64, f64) {
-    (v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]))
+/// The grid's nodes as a z-buffer lattice: columns are x, rows are z.
+/// Triangles are closed within [`NODE_TOL`]; a zero-area one is skipped.
+impl Lattice for GridSpec {
+    const WEIGHTING: Weighting = Weighting::DivideByArea;
+
+    fn size(&self) -> (usize, usize) {
+        (self.nx, self.nz)
+    }
+
+    fn x(&self, i: usize) -> f64 {
+        GridSpec::x(self, i)
+    }
+
+    fn y(&self, j: usize) -> f64 {
+        self.z(j)
+    }
+
+    fn columns(&self, lo: f64, hi: f64) -> Option<(usize, usize)> {
+        nodes_within(self.pitch, self.i_origin, self.nx, lo, hi)
+    }
+
+    fn rows(&self, lo: f64, hi: f64) -> Option<(usize, usize)> {
+        nodes_within(self.pitch, self.j_origin, self.nz, lo, hi)
+    }
+
+    fn degenerate(&self, area2: f64) -> bool {
+        area2 == 0.0
+    }
+
+    /// A node within [`NODE_TOL`] of an edge counts as on it: its weight
+    /// is at least `-NODE_TOL * |edge| / |area2|`.
+    fn slack(&self, edges: &[[[f64; 2]; 2]; 3], area2: f64) -> [f64; 3] {
+        edges.map(|[u, v]| -NODE_TOL * (v[0] - u[0]).hypot(v[1] - u[1]) / area2.abs())
+    }
 }
 
-/// Writes the triangle's y into the nodes of rows `band` it covers, keeping
-/// the minimum. `rows` holds exactly those rows.
-fn rasterize(t: &Triangle, spec: &GridSpec, band: std::ops::Range<usize>, rows: &mut [f64]) {
-    let p = spec.pitch;
-    let [a, b, c] = t.map(|v| [v[0], v[2]]);
-    let area2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-    if area2 == 0.0 {
-        return;
-    }
-    // Edge k is opposite vertex k; its edge function, divided by area2, is
-    // vertex k's barycentric weight. A node within NODE_TOL of an edge
-    // counts as on it: weight >= -NODE_TOL * |edge| / |area2|.
-    let edges = [(b, c), (c, a), (a, b)];
-    let slack = edges.map(|(u, v)| -NODE_TOL * (v[0] - u[0]).hypot(v[1] - u[1]) / area2.abs());
-    let (xlo, xhi) = min_max([a[0], b[0], c[0]]);
-    let (zlo, zhi) = min_max([a[1], b[1], c[1]]);
-    let i_lo = (((xlo - NODE_TOL) / p).ceil() as i64 - spec.i_origin).max(0);
-    let i_hi = (((xhi + NODE_TOL) / p).floor() as i64 - spec.i_origin).min(spec.nx as i64 - 1);
-    let j_lo = (((zlo - NODE_TOL) / p).ceil() as i64 - spec.j_origin).max(band.start as i64);
-    let j_hi = (((zhi + NODE_TOL) / p).floor() as i64 - spec.j_origin).min(band.end as i64 - 1);
-    let ys = [t[0][1], t[1][1], t[2][1]];
-    for j in j_lo..=j_hi {
-        let z = spec.z(j as usize);
-        let row = &mut rows[(j as usize - band.start) * spec.nx..][..spec.nx];
-        for i in i_lo..=i_hi {
-            let x = spec.x(i as usize);
-            let w = edges
-                .map(|(u, v)| ((v[0] - u[0]) * (z - u[1]) - (v[1] - u[1]) * (x - u[0])) / area2);
-            if w[0] >= slack[0] && w[1] >= slack[1] && w[2] >= slack[2] {
-                let y = w[0] * ys[0] + w[1] * ys[1] + w[2] * ys[2];
-                let cell = &mut row[i as usize];
-                if y < *cell {
-                    *cell = y;
-                }
-            }
-        }
-    }
+/// The nodes `k` of `0..n` (at `pitch * (origin + k)`) within
+/// [`NODE_TOL`] of `[lo, hi]`.
+fn nodes_within(pitch: f64, origin: i64, n: usize, lo: f64, hi: f64) -> Option<(usize, usize)> {
+    let k_lo = (((lo - NODE_TOL) / pitch).ceil() as i64 - origin).max(0);
+    let k_hi = (((hi + NODE_TOL) / pitch).floor() as i64 - origin).min(n as i64 - 1);
+    (k_lo <= k_hi).then_some((k_lo as usize, k_hi as usize))
 }
 
 #[cfg(test)]

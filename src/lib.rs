@@ -57,6 +57,7 @@ mod simd;
 pub mod slide;
 pub mod strike;
 pub mod summary;
+mod zbuffer;
 
 pub use analysis::{Analysis, AnalysisError, GridPlacement, Progress, Setup, SetupError, Status};
 pub use engine::{Algorithm, AngleMask, EngineOptions, colliding_masks, composite, push_levels};

@@ -593,7 +593,7 @@ fn report_refuses_a_verification_of_another_part_or_setup() {
         check(name, needle);
     }
     // The strike rule, whichever keys it has.
-    let key = kneeform::report::verify::STRIKE_RULE_KEYS
+    let key = kneeform::report::STRIKE_RULE_KEYS
         .iter()
         .find(|k| v.get(**k).is_some_and(Value::is_number))
         .expect("verify.json records its strike rule");

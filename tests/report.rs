@@ -118,7 +118,7 @@ fn verification_fixtures(dir: &Path) -> [PathBuf; 2] {
                 .map(|k| summary[k].clone())
                 .to_vec(),
         );
-        for key in kneeform::report::verify::STRIKE_RULE_KEYS {
+        for key in kneeform::report::STRIKE_RULE_KEYS {
             if let Some(v) = summary.get(key) {
                 json[key] = v.clone();
             }

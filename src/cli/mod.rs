@@ -31,9 +31,9 @@ pub fn write_report(options: &ReportOptions, out: &Path, shown_as: &Path) -> any
     })?;
     eprintln!(
         "kneeform: report of {} ({} triangles, views rendered in {:.2} s) written to {}",
-        report.run.part_path.display(),
-        report.run.part.triangles.len(),
-        report.views.render_s,
+        report.part_path.display(),
+        report.triangles,
+        report.render_s,
         shown_as.display()
     );
     Ok(())

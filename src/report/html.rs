@@ -1,28 +1,28 @@
-//! Text helpers of the HTML report: escaping, number and date formatting,
-//! base64 data URIs, and the citation of a value from a run file.
+//! Text helpers of the HTML report: number and date formatting, base64
+//! data URIs, the character references the page writes by name, SVG's
+//! self-closed elements, and the citation of a value from a run file. The
+//! page itself is a [`maud`] template, which escapes every value it splices
+//! in.
 //!
 //! Every value the report takes from a JSON file is written by [`cite`]:
 //! `<span data-src="FILE#POINTER">text</span>`, where `POINTER` is the
 //! value's JSON pointer in `FILE`. A reader (or a test) can check each
 //! number against its source; none is typed by hand.
 
+use maud::{Markup, PreEscaped, Render, html};
 use serde_json::Value;
 
-/// Escapes `&`, `<`, `>`, `"` and `'` for HTML text and attribute values.
-pub fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for ch in s.chars() {
-        match ch {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            c => out.push(c),
-        }
-    }
-    out
-}
+/// `&middot;`: the page's text keeps the character references it always
+/// wrote, so that it stays ASCII where it can and byte-identical.
+pub const MIDDOT: PreEscaped<&str> = PreEscaped("&middot;");
+/// `&nbsp;`.
+pub const NBSP: PreEscaped<&str> = PreEscaped("&nbsp;");
+/// `&sup2;`.
+pub const SUP2: PreEscaped<&str> = PreEscaped("&sup2;");
+/// `&times;`.
+pub const TIMES: PreEscaped<&str> = PreEscaped("&times;");
+/// `&asymp;`.
+pub const ASYMP: PreEscaped<&str> = PreEscaped("&asymp;");
 
 /// A number for reading: whole numbers in full, others to six significant
 /// digits with trailing zeros dropped (`1234.57`, `0.0123457`), so a value
@@ -46,31 +46,44 @@ pub fn fmt_num(v: f64) -> String {
 }
 
 /// The text of a JSON value: numbers by [`fmt_num`], strings as they are,
-/// booleans as `yes`/`no`, arrays of numbers joined by `, `; escaped.
+/// booleans as `yes`/`no`, arrays of numbers joined by `, `; plain text,
+/// for the template to escape.
 pub fn value_text(v: &Value) -> String {
     match v {
         Value::Number(n) => n.as_f64().map_or_else(|| n.to_string(), fmt_num),
-        Value::String(s) => escape(s),
+        Value::String(s) => s.clone(),
         Value::Bool(b) => if *b { "yes" } else { "no" }.into(),
         Value::Array(items) => items.iter().map(value_text).collect::<Vec<_>>().join(", "),
         Value::Null => "—".into(),
-        Value::Object(_) => escape(&v.to_string()),
+        Value::Object(_) => v.to_string(),
     }
 }
 
 /// The value at `pointer` in `json` (the contents of `file`), cited:
 /// `<span data-src="file#pointer">text</span>`; a missing value shows as
 /// "not in file", uncited.
-pub fn cite(file: &str, json: &Value, pointer: &str) -> String {
+pub fn cite(file: &str, json: &Value, pointer: &str) -> Markup {
     match json.pointer(pointer) {
-        Some(v) => format!(
-            "<span data-src=\"{}#{}\">{}</span>",
-            escape(file),
-            escape(pointer),
-            value_text(v)
-        ),
-        None => "<span class=\"missing\">not in file</span>".into(),
+        Some(v) => html! { span data-src={ (file) "#" (pointer) } { (value_text(v)) } },
+        None => html! { span class="missing" { "not in file" } },
     }
+}
+
+/// An empty SVG element closed as SVG writes it, `<name key="value"/>`
+/// (a template's `name;` would leave it open, and the HTML parser would
+/// nest what follows inside it); the values escaped.
+pub fn svg_empty(name: &str, attributes: &[(&str, &dyn Render)]) -> Markup {
+    let mut out = String::from("<");
+    out.push_str(name);
+    for (key, value) in attributes {
+        out.push(' ');
+        out.push_str(key);
+        out.push_str("=\"");
+        value.render_to(&mut out);
+        out.push('"');
+    }
+    out.push_str("/>");
+    PreEscaped(out)
 }
 
 /// Standard base64 (RFC 4648, with padding).
@@ -127,10 +140,10 @@ mod tests {
     use super::*;
 
     #[test]
-    fn escaping_covers_markup_and_quotes() {
+    fn svg_elements_close_themselves_and_escape_their_values() {
         assert_eq!(
-            escape(r#"<a href="x">&'</a>"#),
-            "&lt;a href=&quot;x&quot;&gt;&amp;&#39;&lt;/a&gt;"
+            svg_empty("rect", &[("x", &1.5), ("fill", &r#"<"&'>"#)]).into_string(),
+            "<rect x=\"1.5\" fill=\"&lt;&quot;&amp;'&gt;\"/>"
         );
     }
 
@@ -171,16 +184,18 @@ mod tests {
     #[test]
     fn citations_carry_their_pointer() {
         let v: Value = serde_json::from_str(r#"{"a": [1.5, 2], "s": "<x>", "t": true}"#).unwrap();
+        let cite = |file: &str, pointer: &str| cite(file, &v, pointer).into_string();
         assert_eq!(
-            cite("summary.json", &v, "/a/0"),
+            cite("summary.json", "/a/0"),
             "<span data-src=\"summary.json#/a/0\">1.5</span>"
         );
+        assert_eq!(cite("f", "/s"), "<span data-src=\"f#/s\">&lt;x&gt;</span>");
+        assert_eq!(cite("f", "/a"), "<span data-src=\"f#/a\">1.5, 2</span>");
+        assert_eq!(cite("f", "/t"), "<span data-src=\"f#/t\">yes</span>");
         assert_eq!(
-            cite("f", &v, "/s"),
-            "<span data-src=\"f#/s\">&lt;x&gt;</span>"
+            cite("a\"&", "/t"),
+            "<span data-src=\"a&quot;&amp;#/t\">yes</span>"
         );
-        assert_eq!(cite("f", &v, "/a"), "<span data-src=\"f#/a\">1.5, 2</span>");
-        assert_eq!(cite("f", &v, "/t"), "<span data-src=\"f#/t\">yes</span>");
-        assert!(cite("f", &v, "/zz").contains("not in file"));
+        assert!(cite("f", "/zz").contains("not in file"));
     }
 }

@@ -1,14 +1,17 @@
 //! The evidence report: one self-contained HTML file that shows what was
 //! analysed, how, what the knee-form can strike, and how accurate that is.
 //!
-//! * [`build_report`], [`write_report`]: a run directory (and any
-//!   verification directories) in, the page out; [`ReportOptions`] says
-//!   where things are;
-//! * [`render`]: the CPU renderer (orthographic, z-buffered, Lambert
-//!   shading) and its pixel ↔ part mapping;
-//! * [`views`]: the report's views of the part and how they are painted;
-//! * [`run`], [`verify`]: reading the run and verification files back;
-//! * [`html`]: escaping, number formatting and citations.
+//! * [`write_report`]: a run directory (and any verification directories)
+//!   in, the page out; [`ReportOptions`] says where things are, [`Report`]
+//!   what was drawn;
+//! * [`grid_spec`], [`STRIKE_RULE_KEYS`], [`MAIN_BORDER`]: what a reader
+//!   of the run's files and of the page needs to check them.
+//!
+//! Inside: `render` (the CPU renderer: orthographic, z-buffered, Lambert
+//! shading, and its pixel ↔ part mapping), `views` (the report's views of
+//! the part and how they are painted), `run` and `verify` (reading the run
+//! and verification files back), `document` (the page, a `maud` template)
+//! and `html` (number formatting and citations).
 //!
 //! **Invariant:** every value the report shows from a run comes from the
 //! run's files, cited by file and JSON pointer (`data-src`); the part is
@@ -17,20 +20,23 @@
 use std::path::{Path, PathBuf};
 
 mod document;
-pub mod html;
-pub mod render;
-pub mod run;
-pub mod verify;
-pub mod views;
+mod html;
+mod render;
+mod run;
+mod verify;
+mod views;
 
-pub use self::document::{MAIN_BORDER, SUMMARY, verify_label};
-pub use self::render::{Camera, DepthImage, RgbImage, View};
-pub use self::run::{NodeCounts, Run, grid_spec, read_part_file};
-pub use self::verify::{Verdict, Verification};
-pub use self::views::{Views, render_views, small_multiple_angles};
+pub use self::document::MAIN_BORDER;
+pub use self::run::grid_spec;
+pub use self::verify::STRIKE_RULE_KEYS;
+
+use self::render::RgbImage;
+use self::run::{NodeCounts, Run};
+use self::verify::Verification;
+use self::views::{render_views, small_multiple_angles};
 
 /// The images of the run directory embedded in the report, when present.
-pub const RUN_FIGURES: [&str; 2] = ["composite.png", "depth.png"];
+const RUN_FIGURES: [&str; 2] = ["composite.png", "depth.png"];
 
 /// Why a report could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -139,20 +145,20 @@ impl ReportOptions {
     }
 }
 
-/// A report, built.
-#[derive(Debug)]
+/// What a written report drew.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Report {
-    /// The page.
-    pub html: String,
-    /// The run it reports on.
-    pub run: Run,
-    /// The rendered views.
-    pub views: Views,
+    /// The part file drawn: the one the run analysed, its SHA-256 checked.
+    pub part_path: PathBuf,
+    /// Triangles in the part file.
+    pub triangles: usize,
+    /// Wall-clock time of rendering the views (seconds).
+    pub render_s: f64,
 }
 
 /// Reads the run and verification directories, renders the views and
-/// assembles the page.
-pub fn build_report(options: &ReportOptions) -> Result<Report, ReportError> {
+/// assembles the page; returns it with what it drew.
+fn build_report(options: &ReportOptions) -> Result<(String, Report), ReportError> {
     let mut run = Run::read(&options.run_dir, options.part.as_deref())?;
     let verifications = options
         .verify_dirs
@@ -193,13 +199,18 @@ pub fn build_report(options: &ReportOptions) -> Result<Report, ReportError> {
         pngs: &pngs,
         run_figures: &run_figures,
     });
-    Ok(Report { html, run, views })
+    let report = Report {
+        part_path: run.part_path,
+        triangles: run.part.triangles.len(),
+        render_s: views.render_s,
+    };
+    Ok((html, report))
 }
 
 /// Builds the report and writes it to `out` through a temporary file in the
 /// same directory, renamed into place: `out` is never half written.
 pub fn write_report(options: &ReportOptions, out: &Path) -> Result<Report, ReportError> {
-    let report = build_report(options)?;
+    let (html, report) = build_report(options)?;
     let io = |source| ReportError::Io {
         path: out.to_path_buf(),
         source,
@@ -210,7 +221,7 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<Report, Repor
     if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent).map_err(io)?;
     }
-    let written = std::fs::write(&tmp, &report.html).and_then(|()| std::fs::rename(&tmp, out));
+    let written = std::fs::write(&tmp, &html).and_then(|()| std::fs::rename(&tmp, out));
     if written.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
@@ -219,7 +230,7 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<Report, Repor
 }
 
 /// An RGB image as PNG bytes.
-pub fn encode_png(image: &RgbImage) -> Result<Vec<u8>, ReportError> {
+fn encode_png(image: &RgbImage) -> Result<Vec<u8>, ReportError> {
     let mut bytes = Vec::new();
     let mut encoder = png::Encoder::new(&mut bytes, image.width as u32, image.height as u32);
     encoder.set_color(png::ColorType::Rgb);

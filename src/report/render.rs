@@ -8,18 +8,15 @@
 //! ([`View::surface_point`]). So the painting (which nodes collide) never
 //! depends on the triangle order or on the shading.
 //!
-//! The rasterizer works on bands of 16 pixel rows in parallel:
-//! each triangle is binned into the bands its screen extent touches and
-//! each band owns its slice of the buffers, as [`crate::grid`] does for the
-//! height grid. A pixel is covered when its centre is inside a triangle
-//! (closed, within 1e-9 of its barycentric weights).
+//! The rasterizer is the crate's one z-buffer (`zbuffer.rs`), on a
+//! lattice of pixel centres. A pixel is covered when its centre is inside
+//! a triangle (closed, within 1e-9 of its barycentric weights).
 
+use nalgebra::Vector3;
 use rayon::prelude::*;
 
 use crate::mesh::Triangle;
-
-/// Rows of pixels per band of the parallel rasterizer.
-const BAND_ROWS: usize = 16;
+use crate::zbuffer::{Lattice, Weighting, zbuffer};
 
 /// A pixel centre within this of a barycentric weight of 0 is on the edge:
 /// shared edges are then covered by both of their triangles, never by none
@@ -38,20 +35,20 @@ pub type Rgb = [u8; 3];
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
     /// Screen x grows along this.
-    pub right: [f64; 3],
+    pub right: Vector3<f64>,
     /// Screen rows grow against this (row 0 is the top).
-    pub up: [f64; 3],
+    pub up: Vector3<f64>,
     /// The direction the camera looks in; smaller `p . forward` is nearer.
-    pub forward: [f64; 3],
+    pub forward: Vector3<f64>,
 }
 
 impl Camera {
     /// The camera looking along `forward` with `up_hint` projected to be
     /// the screen's up (the two must not be parallel).
-    pub fn looking(forward: [f64; 3], up_hint: [f64; 3]) -> Camera {
-        let f = normalize(forward);
-        let right = normalize(cross(f, up_hint));
-        let up = cross(right, f);
+    pub fn looking(forward: Vector3<f64>, up_hint: Vector3<f64>) -> Camera {
+        let f = forward.normalize();
+        let right = f.cross(&up_hint).normalize();
+        let up = right.cross(&f);
         Camera {
             right,
             up,
@@ -90,8 +87,8 @@ impl View {
             f64::INFINITY,
             f64::NEG_INFINITY,
         );
-        for p in triangles.iter().flatten() {
-            let (u, v) = (dot(*p, camera.right), dot(*p, camera.up));
+        for p in triangles.iter().flatten().map(|&p| Vector3::from(p)) {
+            let (u, v) = (p.dot(&camera.right), p.dot(&camera.up));
             u_lo = u_lo.min(u);
             u_hi = u_hi.max(u);
             v_lo = v_lo.min(v);
@@ -129,7 +126,7 @@ impl View {
     pub fn surface_point(&self, c: usize, r: usize, depth: f64) -> [f64; 3] {
         let (u, v) = self.pixel_centre(c, r);
         let cam = &self.camera;
-        std::array::from_fn(|k| cam.right[k] * u + cam.up[k] * v + cam.forward[k] * depth)
+        (cam.right * u + cam.up * v + cam.forward * depth).into()
     }
 }
 
@@ -148,6 +145,7 @@ pub struct DepthImage {
 
 impl DepthImage {
     /// Whether pixel `(c, r)` shows the part.
+    #[cfg(test)]
     pub fn covered(&self, c: usize, r: usize) -> bool {
         self.depth[r * self.view.width + c].is_finite()
     }
@@ -158,118 +156,76 @@ impl DepthImage {
 /// may wind its triangles either way).
 pub fn rasterize(triangles: &[Triangle], view: &View) -> DepthImage {
     let cam = view.camera;
-    let light = normalize([
-        -cam.forward[0] + 0.4 * cam.up[0] - 0.2 * cam.right[0],
-        -cam.forward[1] + 0.4 * cam.up[1] - 0.2 * cam.right[1],
-        -cam.forward[2] + 0.4 * cam.up[2] - 0.2 * cam.right[2],
-    ]);
+    let light = (-cam.forward + cam.up * 0.4 - cam.right * 0.2).normalize();
     // Screen coordinates: (column, row, depth), pixel centres at k + 0.5.
     let screen: Vec<([[f64; 3]; 3], f32)> = triangles
         .par_iter()
         .map(|t| {
+            let t = t.map(Vector3::from);
             let s = t.map(|p| {
                 [
-                    (dot(p, cam.right) - view.u_left) / view.mm_per_px,
-                    (view.v_top - dot(p, cam.up)) / view.mm_per_px,
-                    dot(p, cam.forward),
+                    (p.dot(&cam.right) - view.u_left) / view.mm_per_px,
+                    (view.v_top - p.dot(&cam.up)) / view.mm_per_px,
+                    p.dot(&cam.forward),
                 ]
             });
-            let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
-            let len = dot(n, n).sqrt();
+            let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
+            let len = n.norm();
             let lambert = if len > 0.0 {
-                (dot(n, light) / len).abs()
+                (n.dot(&light) / len).abs()
             } else {
                 0.0
             };
             (s, (AMBIENT + (1.0 - AMBIENT) * lambert) as f32)
         })
         .collect();
-    let (w, h) = (view.width, view.height);
-    let bands = h.div_ceil(BAND_ROWS);
-    let mut binned: Vec<Vec<u32>> = vec![Vec::new(); bands];
-    for (k, (s, _)) in screen.iter().enumerate() {
-        let (lo, hi) = min_max([s[0][1], s[1][1], s[2][1]]);
-        // Rows whose centre r + 0.5 lies in [lo, hi].
-        let r_lo = (lo - 0.5).ceil().max(0.0);
-        let r_hi = (hi - 0.5).floor().min(h as f64 - 1.0);
-        if r_lo > r_hi {
-            continue;
-        }
-        for bin in &mut binned[r_lo as usize / BAND_ROWS..=r_hi as usize / BAND_ROWS] {
-            bin.push(k as u32);
-        }
-    }
-    let mut depth = vec![f64::INFINITY; w * h];
-    let mut shade = vec![0f32; w * h];
-    depth
-        .par_chunks_mut(BAND_ROWS * w)
-        .zip(shade.par_chunks_mut(BAND_ROWS * w))
-        .zip(binned.par_iter())
-        .enumerate()
-        .for_each(|(band, ((depth, shade), bin))| {
-            let rows = band * BAND_ROWS..band * BAND_ROWS + depth.len() / w;
-            for &k in bin {
-                let (s, lit) = &screen[k as usize];
-                fill(s, *lit, w, rows.clone(), depth, shade);
-            }
-        });
+    let buffer = zbuffer(view, &screen, |&(s, lit)| (s, lit));
     DepthImage {
         view: *view,
-        depth,
-        shade,
+        depth: buffer.depth,
+        shade: buffer.tag,
     }
 }
 
-/// Writes one screen-space triangle into the band of `rows`, keeping the
-/// nearest depth.
-fn fill(
-    s: &[[f64; 3]; 3],
-    lit: f32,
-    w: usize,
-    rows: std::ops::Range<usize>,
-    depth: &mut [f64],
-    shade: &mut [f32],
-) {
-    let [a, b, c] = *s;
-    let area2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-    // Seen edge-on: covers no pixel centre robustly; its neighbours do.
-    if area2.abs() < 1e-12 {
-        return;
+/// The pixels of a view as a z-buffer lattice: pixel centres at `k + 0.5`,
+/// edges within [`EDGE_TOL`], and triangles seen edge-on skipped.
+impl Lattice for View {
+    const WEIGHTING: Weighting = Weighting::MultiplyByInverse;
+
+    fn size(&self) -> (usize, usize) {
+        (self.width, self.height)
     }
-    let (x_lo, x_hi) = min_max([a[0], b[0], c[0]]);
-    let (y_lo, y_hi) = min_max([a[1], b[1], c[1]]);
-    let c_lo = (x_lo - 0.5).ceil().max(0.0) as usize;
-    let c_hi = (x_hi - 0.5).floor().min(w as f64 - 1.0);
-    let r_lo = ((y_lo - 0.5).ceil().max(rows.start as f64)) as usize;
-    let r_hi = (y_hi - 0.5).floor().min(rows.end as f64 - 1.0);
-    if c_hi < c_lo as f64 || r_hi < r_lo as f64 {
-        return;
+
+    fn x(&self, c: usize) -> f64 {
+        c as f64 + 0.5
     }
-    let (c_hi, r_hi) = (c_hi as usize, r_hi as usize);
-    let inv = 1.0 / area2;
-    let weight = |u: [f64; 3], v: [f64; 3], x: f64, y: f64| {
-        ((v[0] - u[0]) * (y - u[1]) - (v[1] - u[1]) * (x - u[0])) * inv
-    };
-    for r in r_lo..=r_hi {
-        let y = r as f64 + 0.5;
-        let row = (r - rows.start) * w;
-        for col in c_lo..=c_hi {
-            let x = col as f64 + 0.5;
-            // Barycentric weights of a, b, c: each from the opposite edge.
-            let wa = weight(b, c, x, y);
-            let wb = weight(c, a, x, y);
-            let wc = weight(a, b, x, y);
-            if wa < -EDGE_TOL || wb < -EDGE_TOL || wc < -EDGE_TOL {
-                continue;
-            }
-            let d = wa * a[2] + wb * b[2] + wc * c[2];
-            let k = row + col;
-            if d < depth[k] {
-                depth[k] = d;
-                shade[k] = lit;
-            }
-        }
+
+    fn y(&self, r: usize) -> f64 {
+        r as f64 + 0.5
     }
+
+    fn columns(&self, lo: f64, hi: f64) -> Option<(usize, usize)> {
+        centres_within(self.width, lo, hi)
+    }
+
+    fn rows(&self, lo: f64, hi: f64) -> Option<(usize, usize)> {
+        centres_within(self.height, lo, hi)
+    }
+
+    fn degenerate(&self, area2: f64) -> bool {
+        area2.abs() < 1e-12
+    }
+
+    fn slack(&self, _: &[[[f64; 2]; 2]; 3], _: f64) -> [f64; 3] {
+        [-EDGE_TOL; 3]
+    }
+}
+
+/// The pixels `k` of `0..n` whose centre `k + 0.5` lies in `[lo, hi]`.
+fn centres_within(n: usize, lo: f64, hi: f64) -> Option<(usize, usize)> {
+    let k_lo = (lo - 0.5).ceil().max(0.0);
+    let k_hi = (hi - 0.5).floor().min(n as f64 - 1.0);
+    (k_lo <= k_hi).then_some((k_lo as usize, k_hi as usize))
 }
 
 /// An RGB image, row-major from the top, 3 bytes per pixel.
@@ -285,6 +241,7 @@ pub struct RgbImage {
 
 impl RgbImage {
     /// The colour of pixel `(c, r)`.
+    #[cfg(test)]
     pub fn at(&self, c: usize, r: usize) -> Rgb {
         let k = 3 * (r * self.width + c);
         [self.pixels[k], self.pixels[k + 1], self.pixels[k + 2]]
@@ -328,31 +285,6 @@ pub fn paint(image: &DepthImage, paint: impl Fn([f64; 3]) -> Option<Rgb> + Sync)
     }
 }
 
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn normalize(a: [f64; 3]) -> [f64; 3] {
-    let len = dot(a, a).sqrt();
-    a.map(|v| v / len)
-}
-
-fn min_max(v: [f64; 3]) -> (f64, f64) {
-    (v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -371,8 +303,8 @@ mod tests {
     #[test]
     fn a_rectangle_seen_face_on_covers_exactly_its_pixels() {
         let tris = rectangle(0.0);
-        let cam = Camera::looking([0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
-        assert_eq!(cam.right, [1.0, 0.0, 0.0]);
+        let cam = Camera::looking(Vector3::y(), Vector3::z());
+        assert_eq!(cam.right, Vector3::x());
         let view = View::fit(cam, &tris, 120, 10);
         // 100 mm over 100 pixels: 1 mm per pixel, 50 rows plus margins.
         assert_eq!(view.mm_per_px, 1.0);
@@ -393,7 +325,7 @@ mod tests {
     fn the_nearer_surface_wins_whatever_the_order() {
         let mut tris = rectangle(5.0);
         tris.extend(rectangle(-5.0));
-        let cam = Camera::looking([0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+        let cam = Camera::looking(Vector3::y(), Vector3::z());
         let view = View::fit(cam, &tris, 100, 0);
         let img = rasterize(&tris, &view);
         tris.reverse();
@@ -405,8 +337,8 @@ mod tests {
         );
         assert_eq!(img.depth, again.depth);
         // Seen from +y, the other one is in front.
-        let back = Camera::looking([0.0, -1.0, 0.0], [0.0, 0.0, 1.0]);
-        assert_eq!(back.right, [-1.0, 0.0, 0.0]);
+        let back = Camera::looking(-Vector3::y(), Vector3::z());
+        assert_eq!(back.right, -Vector3::x());
         let view = View::fit(back, &tris, 100, 0);
         let img = rasterize(&tris, &view);
         // Depth along -y: y = 5 is at depth -5 (interpolated: to rounding).
@@ -423,7 +355,7 @@ mod tests {
     #[test]
     fn paint_colours_the_surface_point_under_each_pixel() {
         let tris = rectangle(0.0);
-        let cam = Camera::looking([0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+        let cam = Camera::looking(Vector3::y(), Vector3::z());
         let view = View::fit(cam, &tris, 100, 0);
         let img = rasterize(&tris, &view);
         let red = paint(&img, |p| (p[0] < 30.0).then_some([250, 0, 0]));
@@ -451,7 +383,7 @@ mod tests {
                 [[0.0, 0.0, 0.0], a(k), a(k + 1)]
             })
             .collect();
-        let cam = Camera::looking([0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+        let cam = Camera::looking(Vector3::y(), Vector3::z());
         let view = View::fit(cam, &tris, 211, 0);
         let img = rasterize(&tris, &view);
         for r in 0..view.height {

@@ -69,6 +69,7 @@ impl NodeCounts {
     }
 
     /// Nodes with a count.
+    #[cfg(test)]
     pub fn nodes(&self) -> usize {
         self.count.iter().filter(|&&c| c > 0).count()
     }
@@ -175,8 +176,8 @@ impl Run {
 /// nodes on multiples of the pitch, so the origin's index `round(x0 / p)`
 /// and the pitch say exactly where every node is. `None` when the summary
 /// is not such a grid: a size of zero, a pitch that is not a positive
-/// number, or an origin further than [`ORIGIN_TOL`] (relative) from the
-/// multiple it rounds to.
+/// number, or an origin further than `ORIGIN_TOL` (1e-12, relative)
+/// from the multiple it rounds to.
 ///
 /// The origin is not compared with `==`: it was written as `p * I0`, and
 /// a reader without correctly rounded float parsing may get it back one

@@ -14,6 +14,8 @@
 //! pitches of the node's y, so faces that only share the node's x and z
 //! (the top of a console seen from above) stay grey.
 
+use nalgebra::Vector3;
+
 use crate::mesh::Side;
 use crate::output::count_colour;
 
@@ -58,13 +60,13 @@ pub struct Views {
 
 /// The camera of the side view: along the knee's push, z up.
 pub fn side_camera(side: Side) -> Camera {
-    Camera::looking([0.0, side.to_part(1.0), 0.0], [0.0, 0.0, 1.0])
+    Camera::looking(Vector3::new(0.0, side.to_part(1.0), 0.0), Vector3::z())
 }
 
 /// The camera of the oblique view: from the analysed side, in front of the
 /// part (towards -x) and above it, looking back at it.
 pub fn oblique_camera(side: Side) -> Camera {
-    Camera::looking([0.55, side.to_part(1.0), -0.45], [0.0, 0.0, 1.0])
+    Camera::looking(Vector3::new(0.55, side.to_part(1.0), -0.45), Vector3::z())
 }
 
 /// The number of colours of the composite's ramp: the angles analysed (or
@@ -165,13 +167,13 @@ mod tests {
     #[test]
     fn the_side_cameras_look_along_the_push_with_z_up() {
         let left = side_camera(Side::Left);
-        assert_eq!(left.forward, [0.0, 1.0, 0.0]);
-        assert_eq!(left.right, [1.0, 0.0, 0.0]);
-        assert_eq!(left.up, [0.0, 0.0, 1.0]);
+        assert_eq!(left.forward, Vector3::y());
+        assert_eq!(left.right, Vector3::x());
+        assert_eq!(left.up, Vector3::z());
         let right = side_camera(Side::Right);
-        assert_eq!(right.forward, [0.0, -1.0, 0.0]);
-        assert_eq!(right.right, [-1.0, 0.0, 0.0]);
-        assert_eq!(right.up, [0.0, 0.0, 1.0]);
+        assert_eq!(right.forward, -Vector3::y());
+        assert_eq!(right.right, -Vector3::x());
+        assert_eq!(right.up, Vector3::z());
         // The oblique camera sits on the analysed side, in front and above.
         let o = oblique_camera(Side::Left);
         assert!(o.forward[0] > 0.0 && o.forward[1] > 0.0 && o.forward[2] < 0.0);
