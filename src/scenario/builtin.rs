@@ -182,7 +182,7 @@ pub fn triangulate(scenario: Scenario, field: &HeightField) -> Vec<Triangle> {
     );
     let xs = axis(field.x_range, field.step, scenario.creases_x());
     let zs = axis(field.z_range, field.step, &[]);
-    tessellate(&xs, &zs, |x, z| height(scenario, x, z))
+    tessellate(&xs, &zs, |i, k| height(scenario, xs[i], zs[k]))
 }
 
 #[cfg(test)]

@@ -19,6 +19,10 @@
 //! * the built-in [`Scenario`]s, closed-form surfaces on a [`HeightField`]
 //!   that the integration tests were written against; the files reproduce
 //!   them (all but the console) within rounding.
+//!
+//! Both are tessellated by [`tessellate`], the one height-field
+//! tessellation, which the tests and the oracle's tests use for their own
+//! parts too.
 
 mod builtin;
 mod file;
@@ -38,6 +42,7 @@ pub use file::{
     Extent, MAX_TRIANGLES, ScenarioError, ScenarioFile, is_scenario_file, load, parse,
     triangles_from_file,
 };
+pub use lattice::tessellate;
 pub use primitive::{Boss, Bump, Console, Feature, Groove, Plane, Rib, Ridge, Step, Wave};
 
 /// Writes `triangles` (mm) as a binary STL at `path`, through a temporary
