@@ -15,7 +15,6 @@
 //!
 //! All lengths are mm and all angles degrees.
 
-pub mod console;
 pub mod engine;
 pub mod grid;
 pub mod harness;

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use kneeform::mesh::Triangle;
-use kneeform::scenario::{HeightField, Scenario, triangulate, write_stl};
+use kneeform::scenario::{Extent, ScenarioFile, builtin, write_stl};
 
 use crate::util::scratch_dir;
 
@@ -125,7 +125,7 @@ fn bad_input_gets_one_line_and_exit_2() {
     )
     .unwrap();
     let part = scratch.join("part.stl");
-    write_stl(&part, &triangulate(Scenario::Bump, &HeightField::default())).unwrap();
+    write_stl(&part, &builtin("bump").unwrap().triangulate(None)).unwrap();
     let (g, t, n, p, d) = (
         garbage.to_str().unwrap(),
         truncated.to_str().unwrap(),
@@ -198,11 +198,7 @@ fn analyse_to(part: &Path, dir: &Path, extra: &[&str]) -> Output {
 fn thread_count_does_not_change_any_byte() {
     let scratch = scratch_dir("threads");
     let part = scratch.join("part.stl");
-    write_stl(
-        &part,
-        &triangulate(Scenario::Depression, &HeightField::default()),
-    )
-    .unwrap();
+    write_stl(&part, &builtin("depression").unwrap().triangulate(None)).unwrap();
     analyse_to(&part, &scratch.join("one"), &["--threads", "1"]);
     analyse_to(&part, &scratch.join("many"), &[]);
     for f in [
@@ -245,12 +241,15 @@ fn mirrored(tris: &[Triangle], axis: usize) -> Vec<Triangle> {
 
 /// A part with features varying along z, so that the angle matters.
 fn asymmetric_part() -> Vec<Triangle> {
-    let field = HeightField {
-        x_range: (-150.0, 150.0),
-        z_range: (-40.0, 90.0),
-        step: 2.5,
+    let bump = ScenarioFile {
+        extent: Extent {
+            x: [-150.0, 150.0],
+            z: [-40.0, 90.0],
+            step: 2.5,
+        },
+        ..builtin("bump").unwrap()
     };
-    triangulate(Scenario::Bump, &field)
+    bump.triangulate(None)
         .into_iter()
         .map(|t| t.map(|[x, y, z]| [x, y - 0.05 * z * (x / 50.0).sin(), z]))
         .collect()

@@ -1,5 +1,5 @@
 //! The height-field tessellation ([`tessellate`], the only one: the
-//! scenario files, the built-ins, the tests and the oracle's tests use it),
+//! scenario files, the tests and the oracle's tests and examples use it),
 //! the lattice the scenario files are tessellated on (a square lattice at
 //! multiples of a step, with extra vertex lines at the surface's creases),
 //! and the exact profile functions the primitives are built from.
@@ -101,7 +101,8 @@ pub(super) fn refined_step(
 /// knee. Vertex y is exactly `height(i, k)`, evaluated once per vertex.
 ///
 /// This is the one height-field tessellation: the scenario files, the
-/// built-ins, the tests and the oracle's tests build their parts with it. `xs` and `zs` ascend; a value given twice makes a
+/// console, the tests and the oracle's tests and examples all build their
+/// parts with it. `xs` and `zs` ascend; a value given twice makes a
 /// vertical riser, its two copies taking the heights `height` gives their
 /// two indices (the cells between them have no extent in xz).
 pub fn tessellate(xs: &[f64], zs: &[f64], height: impl Fn(usize, usize) -> f64) -> Vec<Triangle> {
@@ -144,17 +145,7 @@ pub(super) fn sin_turns(t: f64) -> f64 {
 }
 
 /// 1 at `u = 0` falling smoothly to 0 at `|u| = 1`, 0 beyond:
-/// `0.5 (1 + cos(pi u))`. Exactly 1 at 0 and exactly 0 from 1 on.
-pub(super) fn cosine_bell(u: f64) -> f64 {
-    if u.abs() < 1.0 {
-        0.5 * (1.0 + (PI * u).cos())
-    } else {
-        0.0
-    }
-}
-
-/// The same bell written `cos^2(pi u / 2)`, as [`crate::console`] writes
-/// its bumps; equal to [`cosine_bell`] within rounding.
+/// `cos^2(pi u / 2)`. Exactly 1 at 0 and exactly 0 from 1 on.
 pub(super) fn cos2_bell(u: f64) -> f64 {
     if u.abs() < 1.0 {
         let c = (u * FRAC_PI_2).cos();
