@@ -1,5 +1,6 @@
 //! The `kneeform` binary end to end: real third-party meshes, bad input,
-//! determinism across thread counts, and the side and z symmetries.
+//! determinism across thread counts, the side and z symmetries, and the
+//! built-in scenario names.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -364,5 +365,66 @@ fn verify_warns_when_nothing_is_struck_on_either_side() {
     let ramp = run("ramp.toml", "ramp");
     let stderr = String::from_utf8_lossy(&ramp.stderr);
     assert!(!stderr.contains("strikes anything"), "{stderr}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Every scenario file's stem is a built-in name that works from any
+/// directory and writes exactly what the file writes; any other name is
+/// refused in one line that lists them all.
+#[test]
+fn built_in_names_are_the_scenario_files_from_any_directory() {
+    let dir = scratch_dir("builtin-names");
+    let scenarios = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    // Run from the scratch directory, where no `scenarios/` lies.
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_kneeform"))
+            .current_dir(&dir)
+            .args(args)
+            .output()
+            .expect("the binary runs")
+    };
+    let mut stems: Vec<String> = std::fs::read_dir(&scenarios)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| kneeform::scenario::is_scenario_file(p))
+        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+        .collect();
+    stems.sort();
+    assert!(stems.len() >= 14, "{stems:?}");
+    for stem in &stems {
+        let by_name = format!("{stem}-by-name.stl");
+        let by_file = format!("{stem}-by-file.stl");
+        let file = scenarios.join(format!("{stem}.toml"));
+        for args in [
+            vec!["scenario", stem, "--out", &by_name],
+            vec!["scenario", file.to_str().unwrap(), "--out", &by_file],
+        ] {
+            let out = run(&args);
+            assert!(
+                out.status.success(),
+                "{args:?}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+        let written = std::fs::read(dir.join(&by_name)).unwrap();
+        assert!(
+            written == std::fs::read(dir.join(&by_file)).unwrap(),
+            "{stem}: the name and the file write different parts"
+        );
+        // 84 bytes of header and count, 50 per triangle.
+        let count = builtin(stem).unwrap().triangle_count(None);
+        assert_eq!(written.len(), 84 + 50 * count, "{stem}");
+    }
+    let out = run(&["scenario", "no-such-part", "--out", "x.stl"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    for stem in &stems {
+        assert!(
+            stderr.contains(stem.as_str()),
+            "{stem} not listed: {stderr}"
+        );
+    }
+    assert!(!dir.join("x.stl").exists());
     std::fs::remove_dir_all(dir).unwrap();
 }
