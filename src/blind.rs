@@ -273,10 +273,10 @@ mod tests {
     #[test]
     fn a_plane_and_a_gentle_wave_have_none() {
         let xs = axis((-50.0, 50.0), 1.0, &[]);
-        let plane = tessellate(&xs, &xs, |x, z| 0.3 * x - 0.1 * z);
+        let plane = tessellate(&xs, &xs, |i, k| 0.3 * xs[i] - 0.1 * xs[k]);
         assert!(blind_spots(&plane, &sample(&plane, 4.0), 0.01).is_empty());
-        let wave = tessellate(&xs, &xs, |x, _| {
-            5.0 * (x / 100.0 * std::f64::consts::TAU).sin()
+        let wave = tessellate(&xs, &xs, |i, _| {
+            5.0 * (xs[i] / 100.0 * std::f64::consts::TAU).sin()
         });
         assert!(blind_spots(&wave, &sample(&wave, 4.0), 0.5).is_empty());
     }
@@ -287,8 +287,8 @@ mod tests {
         // between the 2 mm grid's nodes at 0 and 2.
         let xs = axis((-50.0, 50.0), 2.0, &[1.0, 1.3, 1.6]);
         let zs = axis((-50.0, 50.0), 2.0, &[]);
-        let rib = tessellate(&xs, &zs, |x, _| {
-            -5.0 * (1.0 - (x - 1.3).abs() / 0.3).max(0.0)
+        let rib = tessellate(&xs, &zs, |i, _| {
+            -5.0 * (1.0 - (xs[i] - 1.3).abs() / 0.3).max(0.0)
         });
         let grid = sample(&rib, 2.0);
         let spots = blind_spots(&rib, &grid, 0.5);

@@ -40,7 +40,6 @@
 
 pub mod analysis;
 pub mod blind;
-pub mod console;
 pub mod engine;
 pub mod grid;
 pub mod harness;

@@ -3,34 +3,42 @@
 //! the program.
 
 use kneeform::KneeForm;
-use kneeform::scenario::{HeightField, Scenario, height, triangulate};
+use kneeform::scenario::{Extent, ScenarioFile, builtin};
 
 use crate::util::{analyse, brute_force, mask_diff};
 
 const ANGLES: [f64; 5] = [-30.0, -7.0, 0.0, 12.0, 30.0];
 
-/// A smaller panel than the default, so the tests stay quick.
-fn field(step: f64) -> HeightField {
-    HeightField {
-        x_range: (-200.0, 200.0),
-        z_range: (-60.0, 60.0),
-        step,
+/// The built-in scenario `name` on `extent` instead of its own panel.
+fn on(name: &str, extent: Extent) -> ScenarioFile {
+    ScenarioFile {
+        extent,
+        ..builtin(name).expect("a built-in scenario")
     }
+}
+
+/// The built-in scenario `name` on a smaller panel than its own, so the
+/// tests stay quick: x in [-200, 200], z in [-60, 60] (mm).
+fn part(name: &str, step: f64) -> ScenarioFile {
+    on(
+        name,
+        Extent {
+            x: [-200.0, 200.0],
+            z: [-60.0, 60.0],
+            step,
+        },
+    )
 }
 
 #[test]
 fn sampled_heights_equal_the_surface_at_lattice_nodes() {
-    for scenario in [
-        Scenario::Wave,
-        Scenario::Bump,
-        Scenario::Depression,
-        Scenario::GrowingWave,
-    ] {
+    for scenario in ["wave", "bump", "depression", "growing-wave"] {
+        let part = part(scenario, 2.0);
         // Nodes on lattice vertices get the vertex height exactly; nodes
         // between them the linear interpolation, within its error bound
         // (curvature x step^2 / 8; 0.05 mm is generous for these surfaces).
         for (pitch, bound) in [(2.0, 1e-9), (1.0, 0.05)] {
-            let tris = triangulate(scenario, &field(2.0));
+            let tris = part.triangulate(None);
             let (grid, _) = analyse(&tris, pitch, &KneeForm::default(), &[0.0]);
             let mut checked = 0;
             for j in 0..grid.spec.nz {
@@ -40,10 +48,10 @@ fn sampled_heights_equal_the_surface_at_lattice_nodes() {
                     if !inside {
                         continue;
                     }
-                    let want = height(scenario, x, z);
+                    let want = part.height(x, z);
                     assert!(
                         (grid.at(i, j) - want).abs() <= bound,
-                        "{scenario:?} p={pitch} at ({x}, {z}): {} vs {want}",
+                        "{scenario} p={pitch} at ({x}, {z}): {} vs {want}",
                         grid.at(i, j)
                     );
                     checked += 1;
@@ -58,7 +66,7 @@ fn sampled_heights_equal_the_surface_at_lattice_nodes() {
 fn flat_wall_strikes_nothing() {
     // Every height equals the face level after the push: nothing is below it.
     let (_, masks) = analyse(
-        &triangulate(Scenario::FlatWall, &field(4.0)),
+        &part("flat-wall", 4.0).triangulate(None),
         2.0,
         &KneeForm::default(),
         &ANGLES,
@@ -81,7 +89,7 @@ fn ramp_strikes_every_node_with_a_finite_right_neighbour() {
     // finite right neighbour, and no start is placed beyond it.
     let p = 2.0;
     let (grid, masks) = analyse(
-        &triangulate(Scenario::Ramp, &field(4.0)),
+        &part("ramp", 4.0).triangulate(None),
         p,
         &KneeForm::default(),
         &ANGLES,
@@ -113,7 +121,7 @@ fn step_strikes_exactly_the_column_below_its_face() {
     // of its own row, when the level is already -10; and a start whose
     // footprint reaches the lower part has yr = -10 and strikes nothing.
     let (grid, masks) = analyse(
-        &triangulate(Scenario::Step, &field(4.0)),
+        &part("step", 4.0).triangulate(None),
         2.0,
         &KneeForm::default(),
         &ANGLES,
@@ -145,7 +153,7 @@ fn growing_wave_strikes_rising_flanks_never_hollows() {
     // [150, 200] behind it) has yr = 0 and strikes the crest's +x flank.
     let p = 2.0;
     let (grid, masks) = analyse(
-        &triangulate(Scenario::GrowingWave, &field(2.0)),
+        &part("growing-wave", 2.0).triangulate(None),
         p,
         &KneeForm::default(),
         &ANGLES,
@@ -192,25 +200,21 @@ fn scenario_grids_agree_with_brute_force() {
         radius: 12.0,
         thickness: 120.0,
     };
-    let small = HeightField {
-        x_range: (-60.0, 60.0),
-        z_range: (-30.0, 30.0),
+    let small = Extent {
+        x: [-60.0, 60.0],
+        z: [-30.0, 30.0],
         step: 3.0,
     };
-    for scenario in [
-        Scenario::Wave,
-        Scenario::Bump,
-        Scenario::Step,
-        Scenario::Depression,
-    ] {
-        let (grid, masks) = analyse(&triangulate(scenario, &small), 3.0, &knee, &ANGLES);
+    for scenario in ["wave", "bump", "step", "depression"] {
+        let tris = on(scenario, small).triangulate(None);
+        let (grid, masks) = analyse(&tris, 3.0, &knee, &ANGLES);
         for m in &masks {
             let rule = kneeform::StrikeRule::default();
             let (want, placed) = brute_force(&grid, &knee, m.angle_deg, rule.e0, rule.sigma);
             assert_eq!(
                 m.mask,
                 want,
-                "{scenario:?} angle {}: {}",
+                "{scenario} angle {}: {}",
                 m.angle_deg,
                 mask_diff(&grid, &m.mask, &want)
             );

@@ -1,11 +1,12 @@
 //! The `kneeform` binary end to end: real third-party meshes, bad input,
-//! determinism across thread counts, and the side and z symmetries.
+//! determinism across thread counts, the side and z symmetries, and the
+//! built-in scenario names.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use kneeform::mesh::Triangle;
-use kneeform::scenario::{HeightField, Scenario, triangulate, write_stl};
+use kneeform::scenario::{Extent, ScenarioFile, builtin, write_stl};
 
 use crate::util::scratch_dir;
 
@@ -125,7 +126,7 @@ fn bad_input_gets_one_line_and_exit_2() {
     )
     .unwrap();
     let part = scratch.join("part.stl");
-    write_stl(&part, &triangulate(Scenario::Bump, &HeightField::default())).unwrap();
+    write_stl(&part, &builtin("bump").unwrap().triangulate(None)).unwrap();
     let (g, t, n, p, d) = (
         garbage.to_str().unwrap(),
         truncated.to_str().unwrap(),
@@ -198,11 +199,7 @@ fn analyse_to(part: &Path, dir: &Path, extra: &[&str]) -> Output {
 fn thread_count_does_not_change_any_byte() {
     let scratch = scratch_dir("threads");
     let part = scratch.join("part.stl");
-    write_stl(
-        &part,
-        &triangulate(Scenario::Depression, &HeightField::default()),
-    )
-    .unwrap();
+    write_stl(&part, &builtin("depression").unwrap().triangulate(None)).unwrap();
     analyse_to(&part, &scratch.join("one"), &["--threads", "1"]);
     analyse_to(&part, &scratch.join("many"), &[]);
     for f in [
@@ -245,12 +242,15 @@ fn mirrored(tris: &[Triangle], axis: usize) -> Vec<Triangle> {
 
 /// A part with features varying along z, so that the angle matters.
 fn asymmetric_part() -> Vec<Triangle> {
-    let field = HeightField {
-        x_range: (-150.0, 150.0),
-        z_range: (-40.0, 90.0),
-        step: 2.5,
+    let bump = ScenarioFile {
+        extent: Extent {
+            x: [-150.0, 150.0],
+            z: [-40.0, 90.0],
+            step: 2.5,
+        },
+        ..builtin("bump").unwrap()
     };
-    triangulate(Scenario::Bump, &field)
+    bump.triangulate(None)
         .into_iter()
         .map(|t| t.map(|[x, y, z]| [x, y - 0.05 * z * (x / 50.0).sin(), z]))
         .collect()
@@ -365,5 +365,66 @@ fn verify_warns_when_nothing_is_struck_on_either_side() {
     let ramp = run("ramp.toml", "ramp");
     let stderr = String::from_utf8_lossy(&ramp.stderr);
     assert!(!stderr.contains("strikes anything"), "{stderr}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Every scenario file's stem is a built-in name that works from any
+/// directory and writes exactly what the file writes; any other name is
+/// refused in one line that lists them all.
+#[test]
+fn built_in_names_are_the_scenario_files_from_any_directory() {
+    let dir = scratch_dir("builtin-names");
+    let scenarios = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    // Run from the scratch directory, where no `scenarios/` lies.
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_kneeform"))
+            .current_dir(&dir)
+            .args(args)
+            .output()
+            .expect("the binary runs")
+    };
+    let mut stems: Vec<String> = std::fs::read_dir(&scenarios)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| kneeform::scenario::is_scenario_file(p))
+        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+        .collect();
+    stems.sort();
+    assert!(stems.len() >= 14, "{stems:?}");
+    for stem in &stems {
+        let by_name = format!("{stem}-by-name.stl");
+        let by_file = format!("{stem}-by-file.stl");
+        let file = scenarios.join(format!("{stem}.toml"));
+        for args in [
+            vec!["scenario", stem, "--out", &by_name],
+            vec!["scenario", file.to_str().unwrap(), "--out", &by_file],
+        ] {
+            let out = run(&args);
+            assert!(
+                out.status.success(),
+                "{args:?}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+        let written = std::fs::read(dir.join(&by_name)).unwrap();
+        assert!(
+            written == std::fs::read(dir.join(&by_file)).unwrap(),
+            "{stem}: the name and the file write different parts"
+        );
+        // 84 bytes of header and count, 50 per triangle.
+        let count = builtin(stem).unwrap().triangle_count(None);
+        assert_eq!(written.len(), 84 + 50 * count, "{stem}");
+    }
+    let out = run(&["scenario", "no-such-part", "--out", "x.stl"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    for stem in &stems {
+        assert!(
+            stderr.contains(stem.as_str()),
+            "{stem} not listed: {stderr}"
+        );
+    }
+    assert!(!dir.join("x.stl").exists());
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -45,21 +45,25 @@ fn max_of(c: &Comparison, metric: &str) -> f64 {
     c.stat(metric).max
 }
 
-/// The scenario's built-in part on a smaller panel, for quick studies.
-fn scenario(s: kneeform::scenario::Scenario) -> Vec<Triangle> {
-    let field = kneeform::scenario::HeightField {
-        x_range: (-200.0, 200.0),
-        z_range: (-80.0, 80.0),
-        step: 1.0,
+/// The built-in scenario `name` on a smaller panel than its own, for
+/// quick studies.
+fn scenario(name: &str) -> Vec<Triangle> {
+    use kneeform::scenario::{Extent, ScenarioFile, builtin};
+    let part = ScenarioFile {
+        extent: Extent {
+            x: [-200.0, 200.0],
+            z: [-80.0, 80.0],
+            step: 1.0,
+        },
+        ..builtin(name).expect("a built-in scenario")
     };
-    kneeform::scenario::triangulate(s, &field)
+    part.triangulate(None)
 }
 
 #[test]
 fn errors_shrink_with_the_pitch_on_smooth_parts() {
     use kneeform::harness::converge::fit_power_law;
-    use kneeform::scenario::Scenario;
-    for s in [Scenario::GrowingWave, Scenario::Depression] {
+    for s in ["growing-wave", "depression"] {
         // The coarsest grid's starts, shared by every pitch (grids nest).
         let options = ConvergeOptions {
             pitches: vec![4.0, 2.0, 1.0],
@@ -76,10 +80,10 @@ fn errors_shrink_with_the_pitch_on_smooth_parts() {
                 .map(|r| (r.pitch, max_of(&r.comparison, metric)))
                 .collect();
             let fit = fit_power_law(&points)
-                .unwrap_or_else(|| panic!("{s:?} {metric}: no fit from {points:?}"));
+                .unwrap_or_else(|| panic!("{s} {metric}: no fit from {points:?}"));
             assert!(
                 fit.alpha > 0.5,
-                "{s:?} {metric}: alpha {} from {points:?}",
+                "{s} {metric}: alpha {} from {points:?}",
                 fit.alpha
             );
         }
@@ -88,7 +92,7 @@ fn errors_shrink_with_the_pitch_on_smooth_parts() {
 
 #[test]
 fn comparisons_are_deterministic_for_a_seed_and_thread_count() {
-    let tris = scenario(kneeform::scenario::Scenario::Bump);
+    let tris = scenario("bump");
     let sel = StartSelection::Sample {
         count: 20,
         seed: 11,
@@ -148,12 +152,13 @@ fn thin_rib() -> Vec<Triangle> {
 }
 
 fn bump() -> Vec<Triangle> {
-    scenario(kneeform::scenario::Scenario::Bump)
+    scenario("bump")
 }
 
 fn tilted_wave() -> Vec<Triangle> {
-    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/tilted-wave.toml");
-    kneeform::scenario::triangles_from_file(std::path::Path::new(file), None).unwrap()
+    kneeform::scenario::builtin("tilted-wave")
+        .expect("a built-in scenario")
+        .triangulate(None)
 }
 
 /// What cannot converge by construction. (The step's riser and the tilted

@@ -6,7 +6,7 @@ use kneeform::mesh::Triangle;
 use kneeform::{Footprint, GridFootprint, GridSpec, HeightGrid, KneeForm, push_levels};
 use kneeform_oracle::{KneeFormDims, OracleOptions, StartStatus, evaluate};
 
-use crate::util::{Rng, SEEDS};
+use crate::util::{Rng, SEEDS, lattice_part};
 
 /// A random height-field part: a few bumps and dents of random size on a
 /// tilted plane, tessellated at a step that is not a multiple of the pitch.
@@ -38,18 +38,9 @@ fn random_part(seed: u64) -> Vec<Triangle> {
                 .sum::<f64>()
     };
     let (step, nx, nz) = (3.7, 60, 30);
-    let v = |i: usize, k: usize| {
-        let (x, z) = (-111.0 + step * i as f64, -55.5 + step * k as f64);
-        [x, g(x, z), z]
-    };
-    let mut tris = Vec::new();
-    for k in 0..nz {
-        for i in 0..nx {
-            tris.push([v(i, k), v(i + 1, k), v(i + 1, k + 1)]);
-            tris.push([v(i, k), v(i + 1, k + 1), v(i, k + 1)]);
-        }
-    }
-    tris
+    let xs: Vec<f64> = (0..=nx).map(|i| -111.0 + step * i as f64).collect();
+    let zs: Vec<f64> = (0..=nz).map(|k| -55.5 + step * k as f64).collect();
+    lattice_part(&xs, &zs, g)
 }
 
 #[test]

@@ -99,3 +99,45 @@ fn the_consoles_thin_rib_is_met_at_the_default_pitch() {
     );
     assert!(rib.iter().all(|s| !s.met_angles_deg.is_empty()));
 }
+
+#[test]
+fn the_pitch_chosen_for_a_tolerance_passes_verify_there() {
+    use kneeform::harness::{self, AutoPitch, StartSelection, TieBand, VerifyOptions};
+    // Smooth parts: the grid strikes the node in front of each exact
+    // contact, so the decided area distance is just under one pitch
+    // (results/README.md); a 1 mm tolerance needs a pitch of 1 mm.
+    let angles = vec![-30.0, 0.0, 30.0];
+    for name in ["wave", "depression"] {
+        let input = kneeform::read_part(&scenario(name), 1.0, Side::Left).unwrap();
+        let setup = Setup {
+            angles: angles.clone(),
+            ..Setup::default()
+        };
+        let auto = AutoPitch {
+            tolerance: 1.0,
+            budget_s: AutoPitch::DEFAULT_BUDGET_S,
+            starts: AutoPitch::DEFAULT_STARTS,
+        };
+        let choice = harness::choose_pitch(&input, &setup, &auto, &()).unwrap();
+        assert!(choice.pitch_mm <= 1.0, "{name}: {choice:?}");
+        assert!(choice.study.last().unwrap().meets);
+        // verify on other starts than the study's (another seed, more of
+        // them), at the chosen pitch.
+        let options = VerifyOptions {
+            selection: StartSelection::Sample { count: 60, seed: 2 },
+            tie_band_per_mm: TieBand::DEFAULT_PER_MM,
+            tolerance: 1.0,
+        };
+        let at_choice = Setup {
+            pitch: choice.pitch_mm,
+            ..setup.clone()
+        };
+        let verified = harness::verify(&input, &at_choice, &options, &()).unwrap();
+        let d = verified.summary.area_distance_decided_mm;
+        assert!(
+            d.is_some_and(|d| d <= 1.0),
+            "{name} at {} mm: {d:?}",
+            choice.pitch_mm
+        );
+    }
+}

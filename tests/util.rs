@@ -336,28 +336,14 @@ pub fn scratch_dir(name: &str) -> std::path::PathBuf {
 }
 
 /// A height-field part on the lattice `xs` x `zs` (sorted, mm), two
-/// triangles per cell, surface facing -y: put lattice lines on a feature's
-/// edges to make it sharp.
+/// triangles per cell, surface facing -y ([`kneeform::scenario::tessellate`]
+/// at `y(x, z)`): put lattice lines on a feature's edges to make it sharp.
 pub fn lattice_part(
     xs: &[f64],
     zs: &[f64],
     y: impl Fn(f64, f64) -> f64,
 ) -> Vec<kneeform::mesh::Triangle> {
-    let v = |x: f64, z: f64| [x, y(x, z), z];
-    let mut tris = Vec::new();
-    for zw in zs.windows(2) {
-        for xw in xs.windows(2) {
-            let (a, b, c, d) = (
-                v(xw[0], zw[0]),
-                v(xw[1], zw[0]),
-                v(xw[1], zw[1]),
-                v(xw[0], zw[1]),
-            );
-            tris.push([a, b, c]);
-            tris.push([a, c, d]);
-        }
-    }
-    tris
+    kneeform::scenario::tessellate(xs, zs, |i, k| y(xs[i], zs[k]))
 }
 
 /// `from..=to` by `step`, plus the `extra` lines, sorted and deduplicated.

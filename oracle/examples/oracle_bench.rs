@@ -1,56 +1,19 @@
-//! Benchmark of the exact oracle on a console-like part.
+//! Benchmark of the exact oracle on the benchmark console side.
 //!
-//! Builds a ~400k-triangle height field itself (1500 x 600 mm, waves and
-//! bumps, facing -y), then pushes and slides a sample of starts at a few
-//! angles, single-threaded and with 2 rayon threads, and prints shape casts
-//! per second and time per start (push + full slide trace).
+//! Builds the same part as `kneeform bench`: the built-in console
+//! (`scenarios/console.toml`, 1500 x 600 mm: a bulge, waves, a wavy ridge,
+//! switch-like bosses, a dip behind a protrusion, a thin rib, a groove and
+//! a diagonal ridge, facing -y) refined to the paper's 369,408+ triangles,
+//! then pushes and slides a sample of starts at a few angles,
+//! single-threaded and with 2 rayon threads, and prints shape casts per
+//! second and time per start (push + full slide trace).
 //!
 //! Run: `cargo run --release -p kneeform-oracle --example oracle_bench`
 
 use std::time::Instant;
 
+use kneeform::scenario::{PAPER_TRIANGLES, builtin};
 use kneeform_oracle::{OracleOptions, Part, StartStatus, StartTrace, evaluate};
-
-/// Cells along x and z: 2 * 707 * 283 = 400,162 triangles, ~2.1 mm cells.
-const NX: usize = 707;
-const NZ: usize = 283;
-const SIZE_X: f64 = 1500.0;
-const SIZE_Z: f64 = 600.0;
-
-/// The console side: a gentle bulge, waves along x and z, and a few round
-/// bosses sticking out towards the knee (towards -y).
-fn surface(x: f64, z: f64) -> f64 {
-    use std::f64::consts::TAU;
-    let bulge = 0.00002 * (x - 750.0).powi(2) + 0.00005 * (z - 300.0).powi(2);
-    let waves = 4.0 * (TAU * x / 180.0).sin() * (TAU * z / 260.0).cos();
-    let bosses = [
-        (300.0, 200.0, 40.0, 12.0),
-        (800.0, 420.0, 60.0, 18.0),
-        (1200.0, 250.0, 35.0, 9.0),
-    ]
-    .iter()
-    .map(|&(bx, bz, r, h): &(f64, f64, f64, f64)| {
-        let d2 = ((x - bx).powi(2) + (z - bz).powi(2)) / (r * r);
-        h * (-d2).exp()
-    })
-    .sum::<f64>();
-    bulge + waves - bosses
-}
-
-fn console() -> Vec<[[f64; 3]; 3]> {
-    let p = |i: usize, j: usize| {
-        let (x, z) = (SIZE_X * i as f64 / NX as f64, SIZE_Z * j as f64 / NZ as f64);
-        [x, surface(x, z), z]
-    };
-    let mut out = Vec::with_capacity(2 * NX * NZ);
-    for i in 0..NX {
-        for j in 0..NZ {
-            out.push([p(i, j), p(i + 1, j), p(i, j + 1)]);
-            out.push([p(i + 1, j), p(i + 1, j + 1), p(i, j + 1)]);
-        }
-    }
-    out
-}
 
 fn run(part: &Part, starts: &[[f64; 2]], angles: &[f64], options: &OracleOptions, threads: usize) {
     let pool = rayon::ThreadPoolBuilder::new()
@@ -98,7 +61,8 @@ fn run(part: &Part, starts: &[[f64; 2]], angles: &[f64], options: &OracleOptions
 
 fn main() {
     let clock = Instant::now();
-    let triangles = console();
+    let console = builtin("console").expect("the console is a built-in scenario");
+    let triangles: Vec<[[f64; 3]; 3]> = console.triangulate(Some(PAPER_TRIANGLES));
     let part = Part::from_triangles(&triangles).expect("the console builds");
     let (mins, maxs) = part.bounds();
     println!(

@@ -267,14 +267,7 @@ mod tests {
         xs.sort_by(f64::total_cmp);
         xs.dedup();
         let zs: Vec<f64> = (0..=8).map(|j| -400.0 + 100.0 * j as f64).collect();
-        let mut triangles = Vec::new();
-        for i in 0..xs.len() - 1 {
-            for j in 0..zs.len() - 1 {
-                let p = |i: usize, j: usize| [xs[i], g(xs[i]), zs[j]];
-                triangles.push([p(i, j), p(i + 1, j), p(i, j + 1)]);
-                triangles.push([p(i + 1, j), p(i + 1, j + 1), p(i, j + 1)]);
-            }
-        }
+        let triangles = kneeform::scenario::tessellate(&xs, &zs, |i, _| g(xs[i]));
         Part::from_triangles(&triangles).unwrap()
     }
 
@@ -290,14 +283,7 @@ mod tests {
         };
         let xs = [-600.0, -300.0, -w, 0.0, w, 300.0, 600.0];
         let zs: Vec<f64> = (0..=8).map(|j| -400.0 + 100.0 * j as f64).collect();
-        let mut triangles = Vec::new();
-        for i in 0..xs.len() - 1 {
-            for j in 0..zs.len() - 1 {
-                let p = |i: usize, j: usize| [xs[i], g(xs[i]), zs[j]];
-                triangles.push([p(i, j), p(i + 1, j), p(i, j + 1)]);
-                triangles.push([p(i + 1, j), p(i + 1, j + 1), p(i, j + 1)]);
-            }
-        }
+        let triangles = kneeform::scenario::tessellate(&xs, &zs, |i, _| g(xs[i]));
         Part::from_triangles(&triangles).unwrap()
     }
 

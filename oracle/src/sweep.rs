@@ -161,17 +161,9 @@ mod tests {
     /// A wavy height field facing -y, 600 x 400 mm, 10 mm cells.
     fn wavy() -> Part {
         let g = |x: f64, z: f64| 6.0 * (x / 37.0).sin() * (z / 23.0).cos() + 0.01 * x;
-        let p = |i: usize, j: usize| {
-            let (x, z) = (-300.0 + 10.0 * i as f64, -200.0 + 10.0 * j as f64);
-            [x, g(x, z), z]
-        };
-        let mut triangles = Vec::new();
-        for i in 0..60 {
-            for j in 0..40 {
-                triangles.push([p(i, j), p(i + 1, j), p(i, j + 1)]);
-                triangles.push([p(i + 1, j), p(i + 1, j + 1), p(i, j + 1)]);
-            }
-        }
+        let xs: Vec<f64> = (0..=60).map(|i| -300.0 + 10.0 * i as f64).collect();
+        let zs: Vec<f64> = (0..=40).map(|j| -200.0 + 10.0 * j as f64).collect();
+        let triangles = kneeform::scenario::tessellate(&xs, &zs, |i, j| g(xs[i], zs[j]));
         Part::from_triangles(&triangles).unwrap()
     }
 

@@ -2,10 +2,11 @@
 
 mod util;
 
+use kneeform::scenario::tessellate;
 use kneeform_oracle::{
     OracleOptions, Part, SlideEnd, StartStatus, StartTrace, evaluate, trace_start,
 };
-use util::{height_field, knots, linspace};
+use util::{knots, linspace};
 
 const R: f64 = 60.0;
 
@@ -37,7 +38,7 @@ fn flat_wall_gives_its_level_and_no_slide_contact() {
     let c = 37.5;
     let xs = linspace(-600.0, 600.0, 13);
     let zs = linspace(-400.0, 400.0, 9);
-    let part = Part::from_triangles(&height_field(&xs, &zs, |_, _| c)).unwrap();
+    let part = Part::from_triangles(&tessellate(&xs, &zs, |_, _| c)).unwrap();
     let starts = [[-200.0, -100.0], [0.0, 0.0], [150.0, 100.0], [333.3, 17.0]];
     let traces = evaluate(&part, &starts, &ANGLES, &OracleOptions::default()).unwrap();
     assert_eq!(traces.len(), ANGLES.len() * starts.len());
@@ -89,7 +90,7 @@ fn assert_well_formed(trace: &StartTrace, options: &OracleOptions) {
 fn tilted_wall(c: f64, k: f64, x_r: f64) -> Part {
     let xs = linspace(-600.0, 600.0, 25);
     let zs = linspace(-400.0, 400.0, 9);
-    Part::from_triangles(&height_field(&xs, &zs, |i, _| c + k * (xs[i] - x_r))).unwrap()
+    Part::from_triangles(&tessellate(&xs, &zs, |i, _| c + k * (xs[i] - x_r))).unwrap()
 }
 
 #[test]
@@ -154,7 +155,7 @@ fn ramp_ahead(c: f64, k: f64, x_w: f64) -> (Part, impl Fn(f64) -> f64) {
     let xs = knots(&[linspace(-400.0, x_w, 36), linspace(x_w, 600.0, 13)]);
     let zs = linspace(-400.0, 400.0, 9);
     let g = move |x: f64| if x < x_w { c - k * (x_w - x) } else { c };
-    let part = Part::from_triangles(&height_field(&xs, &zs, |i, _| g(xs[i]))).unwrap();
+    let part = Part::from_triangles(&tessellate(&xs, &zs, |i, _| g(xs[i]))).unwrap();
     (part, g)
 }
 
@@ -236,7 +237,7 @@ fn bumps_part(c: f64, bumps: &[Bump]) -> Part {
     xs.dedup();
     let zs = linspace(-400.0, 400.0, 9);
     let g = |x: f64| bumps.iter().find_map(|b| b.height(c, x)).unwrap_or(c);
-    Part::from_triangles(&height_field(&xs, &zs, |i, _| g(xs[i]))).unwrap()
+    Part::from_triangles(&tessellate(&xs, &zs, |i, _| g(xs[i]))).unwrap()
 }
 
 #[test]
@@ -358,7 +359,7 @@ fn step(c: f64, d: f64, x_e: f64) -> Part {
     let riser = xs.iter().position(|&x| x == x_e).unwrap();
     xs_riser.insert(riser, x_e);
     let zs = linspace(-400.0, 400.0, 9);
-    Part::from_triangles(&height_field(&xs_riser, &zs, |i, _| {
+    Part::from_triangles(&tessellate(&xs_riser, &zs, |i, _| {
         if i <= riser { c - d } else { c }
     }))
     .unwrap()
@@ -405,7 +406,7 @@ fn rounded_front_meets_an_edge_along_y_on_the_circle_of_radius_r() {
     let mut zs2 = zs.clone();
     zs2.insert(j_e, z_e);
     let block = |i: usize, j: usize| if i <= i_e && j <= j_e { c - d } else { c };
-    let part = Part::from_triangles(&height_field(&xs2, &zs2, block)).unwrap();
+    let part = Part::from_triangles(&tessellate(&xs2, &zs2, block)).unwrap();
     let options = options();
     let x0 = 100.0;
     for dz in [5.0, 12.0, 20.0, 29.0] {
@@ -516,7 +517,7 @@ fn a_right_hand_part_read_as_right_traces_like_its_left_hand_mirror() {
             0.0
         }
     };
-    let left = height_field(&xs, &zs, |i, _| g(xs[i]));
+    let left = tessellate(&xs, &zs, |i, _| g(xs[i]));
     let mirrored: Vec<[[f64; 3]; 3]> = left.iter().map(|t| t.map(|[x, y, z]| [x, -y, z])).collect();
     let read = |triangles: &[[[f64; 3]; 3]], side| {
         let text = ascii_stl(triangles);

@@ -28,7 +28,9 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
             starts: AutoPitch::DEFAULT_STARTS,
         }),
         (true, None) => bail!("--pitch auto needs --tolerance MM: the error it must meet"),
-        (false, Some(_)) => bail!("--tolerance is for --pitch auto; with a pitch given, `kneeform verify` measures the error"),
+        (false, Some(_)) => bail!(
+            "--tolerance is for --pitch auto; with a pitch given, `kneeform verify` measures the error"
+        ),
         (false, None) => None,
     };
     // Before any work: where the results go, so that an unwritable or
@@ -39,18 +41,22 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
     let mut choice = None;
     if let Some(auto) = &auto_pitch {
         let input = kneeform::read_part(&args.part.part, args.part.scale, args.part.side)?;
-        let chosen = harness::choose_pitch(&input, &setup, auto, &bars)
-            .map_err(super::harness_error)?;
+        let chosen =
+            harness::choose_pitch(&input, &setup, auto, &bars).map_err(super::harness_error)?;
         for row in &chosen.study {
             let mm = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
             eprintln!(
-                "kneeform: pitch study: {:>6} mm: exact area distance {} mm, change to the finer grid {} mm, analysis about {:.1} s, {:.2} GiB{}",
+                "kneeform: pitch study: {:>6} mm: exact area distance {} mm, change from the coarser grid {} mm, analysis about {:.1} s, {:.2} GiB{}",
                 row.pitch_mm,
                 mm(row.exact_area_distance_mm),
                 mm(row.grid_change_mm),
                 row.predicted_s,
                 row.memory_gib,
-                if row.meets { ": meets the tolerance" } else { "" }
+                if row.meets {
+                    ": meets the tolerance"
+                } else {
+                    ""
+                }
             );
         }
         eprintln!(

@@ -315,8 +315,9 @@ pub struct ConvergeArgs {
 #[derive(Debug, Args)]
 pub struct ScenarioArgs {
     /// The synthetic part: a scenario file (`.toml`, e.g.
-    /// scenarios/thin-rib.toml) or a built-in name (flat-wall, ramp, wave,
-    /// growing-wave, step, bump, depression, console).
+    /// scenarios/thin-rib.toml) or the name of one of scenarios/, built
+    /// into the binary (its stem: wave, thin-rib, console, ...; an unknown
+    /// name lists them all).
     #[arg(value_name = "NAME|FILE.toml")]
     pub part: String,
     /// Where to write the STL.

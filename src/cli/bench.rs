@@ -1,6 +1,7 @@
 //! `kneeform bench`: the paper-sized workload, built here so that anyone can
-//! rerun it: the console part at 369,408+ triangles, a 1538 x 801 grid at
-//! 1.24 mm, 61 angles. It times sampling and push-and-slide (median of
+//! rerun it: the built-in console (`scenarios/console.toml`, the oracle's
+//! benchmark part too) at 369,408+ triangles, a 1538 x 801 grid at 1.24 mm,
+//! 61 angles. It times sampling and push-and-slide (median of
 //! several runs), and the paper algorithm against the fast one on the same
 //! sample of start rows and angles in the same run (the paper algorithm
 //! scans every slide to the grid's end, so the full run is extrapolated and
@@ -9,15 +10,15 @@
 use std::fmt::Write as _;
 use std::time::Instant;
 
-use anyhow::ensure;
-use kneeform::console::{CONSOLE_SIZE, console_triangles};
+use anyhow::{Context, ensure};
 use kneeform::grid::GridSpec;
+use kneeform::scenario::{self, PAPER_TRIANGLES};
 use kneeform::{Algorithm, EngineOptions, GridFootprint, HeightGrid, KneeForm, colliding_masks};
 
 use super::args::BenchArgs;
 
-/// The paper's workload (Inui, Gunji and Umezu): triangles, grid, pitch.
-const PAPER_TRIANGLES: usize = 369_408;
+/// The paper's workload (Inui, Gunji and Umezu): grid and pitch (its
+/// triangle count is [`PAPER_TRIANGLES`]).
 const PAPER_GRID: [usize; 2] = [1538, 801];
 const PAPER_PITCH: f64 = 1.24;
 /// The paper's reported time for one console (s).
@@ -45,15 +46,14 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     let knee = KneeForm::default();
     let angles = super::args::parse_angles(&args.angles.angles)?;
     let t = Instant::now();
-    let triangles = console_triangles(PAPER_TRIANGLES);
+    let console = scenario::builtin("console").context("the console is a built-in scenario")?;
+    let triangles = console.triangulate(Some(PAPER_TRIANGLES));
     let build_s = t.elapsed().as_secs_f64();
     // The grid centred on the console.
-    let [lx, lz] = CONSOLE_SIZE;
     let [nx, nz] = PAPER_GRID;
-    let origin = [
-        (lx - (nx - 1) as f64 * PAPER_PITCH) / 2.0,
-        (lz - (nz - 1) as f64 * PAPER_PITCH) / 2.0,
-    ];
+    let centred =
+        |[lo, hi]: [f64; 2], n: usize| lo + (hi - lo - (n - 1) as f64 * PAPER_PITCH) / 2.0;
+    let origin = [centred(console.extent.x, nx), centred(console.extent.z, nz)];
     let spec = GridSpec::explicit(origin[0], origin[1], nx, nz, PAPER_PITCH);
     let footprints: Vec<GridFootprint> = angles
         .iter()
@@ -145,7 +145,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     writeln!(md, "| --- | --- |")?;
     writeln!(
         md,
-        "| part | console, {} triangles (built in {build_s:.2} s) |",
+        "| part | scenarios/console.toml, {} triangles (built in {build_s:.2} s) |",
         triangles.len()
     )?;
     writeln!(

@@ -47,11 +47,11 @@ fn max_of(c: &Comparison, metric: &str) -> f64 {
 
 /// A flat wall at y = 0, 300 x 200 mm.
 fn flat_wall() -> Vec<Triangle> {
-    tessellate(
-        &axis((-150.0, 150.0), 10.0, &[]),
-        &axis((-100.0, 100.0), 10.0, &[]),
-        |_, _| 0.0,
-    )
+    let (xs, zs) = (
+        axis((-150.0, 150.0), 10.0, &[]),
+        axis((-100.0, 100.0), 10.0, &[]),
+    );
+    tessellate(&xs, &zs, |_, _| 0.0)
 }
 
 #[test]
@@ -89,7 +89,7 @@ fn rib() -> Vec<Triangle> {
     };
     let xs = axis((-150.0, 150.0), 2.0, &[-60.1, -60.0]);
     let zs = axis((-100.0, 100.0), 10.0, &[-0.6, -0.5, 0.5, 0.6]);
-    tessellate(&xs, &zs, y)
+    tessellate(&xs, &zs, |i, k| y(xs[i], zs[k]))
 }
 
 #[test]
@@ -133,7 +133,7 @@ fn two_blocks() -> Vec<Triangle> {
     };
     let xs = axis((-150.0, 150.0), 2.0, &[-51.6, -51.5, -50.6, -50.5]);
     let zs = axis((-100.0, 100.0), 2.0, &[-25.1, -14.9, 14.9, 25.1]);
-    tessellate(&xs, &zs, y)
+    tessellate(&xs, &zs, |i, k| y(xs[i], zs[k]))
 }
 
 #[test]

@@ -200,7 +200,7 @@ impl ScenarioFile {
         let [rx, rz] = self.ranges();
         let xs = axis(rx, step, &cx);
         let zs = axis(rz, step, &cz);
-        tessellate(&xs, &zs, |x, z| self.height(x, z))
+        tessellate(&xs, &zs, |i, k| self.height(xs[i], zs[k]))
     }
 
     fn ranges(&self) -> [(f64, f64); 2] {

@@ -1,6 +1,7 @@
-//! The tessellation shared by the built-in scenarios and the scenario
-//! files: a square lattice at multiples of a step, with extra vertex lines
-//! at the surface's creases, two triangles per cell facing the knee (-y);
+//! The height-field tessellation ([`tessellate`], the only one: the
+//! scenario files, the tests and the oracle's tests and examples use it),
+//! the lattice the scenario files are tessellated on (a square lattice at
+//! multiples of a step, with extra vertex lines at the surface's creases),
 //! and the exact profile functions the primitives are built from.
 
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -93,20 +94,33 @@ pub(super) fn refined_step(
     lo
 }
 
-/// Samples `height` at every lattice vertex `(xs[i], zs[k])` and splits
-/// each cell into two triangles, counter-clockwise in (x, z) so their
-/// normals face -y, towards the knee. Vertex y is exactly `height(x, z)`.
-pub fn tessellate(xs: &[f64], zs: &[f64], height: impl Fn(f64, f64) -> f64) -> Vec<Triangle> {
-    let row = |z: f64| -> Vec<[f64; 3]> { xs.iter().map(|&x| [x, height(x, z), z]).collect() };
+/// Tessellates the height field `y = height(i, k)` over the lattice
+/// vertices `(xs[i], zs[k])` (mm, analysis frame): each cell splits into
+/// two triangles along its `(i, k)`-`(i + 1, k + 1)` diagonal,
+/// counter-clockwise in (x, z) so that their normals face -y, towards the
+/// knee. Vertex y is exactly `height(i, k)`, evaluated once per vertex.
+///
+/// This is the one height-field tessellation: the scenario files, the
+/// console, the tests and the oracle's tests and examples all build their
+/// parts with it. `xs` and `zs` ascend; a value given twice makes a
+/// vertical riser, its two copies taking the heights `height` gives their
+/// two indices (the cells between them have no extent in xz).
+pub fn tessellate(xs: &[f64], zs: &[f64], height: impl Fn(usize, usize) -> f64) -> Vec<Triangle> {
+    let row = |k: usize| -> Vec<[f64; 3]> {
+        xs.iter()
+            .enumerate()
+            .map(|(i, &x)| [x, height(i, k), zs[k]])
+            .collect()
+    };
     let cells = xs.len().saturating_sub(1) * zs.len().saturating_sub(1);
     let mut out = Vec::with_capacity(2 * cells);
-    let Some(&z0) = zs.first() else {
+    if zs.is_empty() {
         return out;
-    };
-    let mut below = row(z0);
-    for &z in &zs[1..] {
-        let above = row(z);
-        for i in 0..xs.len() - 1 {
+    }
+    let mut below = row(0);
+    for k in 1..zs.len() {
+        let above = row(k);
+        for i in 0..xs.len().saturating_sub(1) {
             // Counter-clockwise in (x, z), x right and z up: normal -y.
             let (a, b, c, d) = (below[i], below[i + 1], above[i + 1], above[i]);
             out.push([a, b, c]);
@@ -131,17 +145,7 @@ pub(super) fn sin_turns(t: f64) -> f64 {
 }
 
 /// 1 at `u = 0` falling smoothly to 0 at `|u| = 1`, 0 beyond:
-/// `0.5 (1 + cos(pi u))`. Exactly 1 at 0 and exactly 0 from 1 on.
-pub(super) fn cosine_bell(u: f64) -> f64 {
-    if u.abs() < 1.0 {
-        0.5 * (1.0 + (PI * u).cos())
-    } else {
-        0.0
-    }
-}
-
-/// The same bell written `cos^2(pi u / 2)`, as [`crate::console`] writes
-/// its bumps; equal to [`cosine_bell`] within rounding.
+/// `cos^2(pi u / 2)`. Exactly 1 at 0 and exactly 0 from 1 on.
 pub(super) fn cos2_bell(u: f64) -> f64 {
     if u.abs() < 1.0 {
         let c = (u * FRAC_PI_2).cos();
@@ -200,7 +204,7 @@ mod tests {
     fn cells_are_two_triangles_facing_the_knee() {
         let xs = [0.0, 1.0, 3.0];
         let zs = [0.0, 2.0];
-        let tris = tessellate(&xs, &zs, |x, z| x * z);
+        let tris = tessellate(&xs, &zs, |i, k| xs[i] * zs[k]);
         assert_eq!(tris.len(), 4);
         for [a, b, c] in tris {
             for v in [a, b, c] {
@@ -213,12 +217,31 @@ mod tests {
     }
 
     #[test]
+    fn a_repeated_line_is_a_vertical_riser() {
+        // A step 10 mm towards the knee for x < 1: x = 1 twice, the first
+        // copy at the step's top, the second at the wall.
+        let xs = [0.0, 1.0, 1.0, 2.0];
+        let zs = [0.0, 1.0];
+        let tris = tessellate(&xs, &zs, |i, _| if i <= 1 { -10.0 } else { 0.0 });
+        assert_eq!(tris.len(), 6);
+        // The riser's two triangles lie in the plane x = 1 and span y in
+        // [-10, 0] and z in [0, 1].
+        let riser: Vec<_> = tris
+            .iter()
+            .filter(|t| t.iter().all(|v| v[0] == 1.0))
+            .collect();
+        assert_eq!(riser.len(), 2);
+        let ys: Vec<f64> = riser.iter().flat_map(|t| t.map(|v| v[1])).collect();
+        assert!(ys.contains(&-10.0) && ys.contains(&0.0));
+    }
+
+    #[test]
     fn profiles_are_exact_where_it_matters() {
-        assert_eq!(cosine_bell(0.0), 1.0);
-        assert_eq!(cosine_bell(1.0), 0.0);
         assert_eq!(cos2_bell(0.0), 1.0);
         assert_eq!(cos2_bell(-1.0), 0.0);
-        assert!((cos2_bell(0.3) - cosine_bell(0.3)).abs() < 1e-15);
+        assert_eq!(cos2_bell(1.0), 0.0);
+        // cos^2(pi u / 2) = (1 + cos(pi u)) / 2, within rounding.
+        assert!((cos2_bell(0.3) - 0.5 * (1.0 + (0.3 * PI).cos())).abs() < 1e-15);
         assert_eq!(plateau(2.0, 2.0, 1.0), 1.0);
         assert_eq!(plateau(3.0, 2.0, 1.0), 0.0);
         assert!((plateau(2.5, 2.0, 1.0) - 0.5).abs() < 1e-15);

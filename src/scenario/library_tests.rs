@@ -1,14 +1,10 @@
-//! Tests of the scenario library itself, `scenarios/*.toml`: every file
-//! loads and tessellates exactly, each primitive's defining values are
-//! where its parameters put them, the built-ins are reproduced, and the
-//! files' "nothing collides" and "a coarse grid misses it" claims hold.
-
-use std::path::{Path, PathBuf};
+//! Tests of the scenario library itself, `scenarios/*.toml` (as built in):
+//! every file loads and tessellates exactly, each primitive's defining
+//! values are where its parameters put them, and the files' "nothing
+//! collides" and "a coarse grid misses it" claims hold.
 
 use super::*;
 use crate::mesh::Triangle;
-
-const LIBRARY: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios");
 
 /// The parts the library must hold (issue 4), by file stem.
 const REQUIRED: [&str; 11] = [
@@ -25,12 +21,8 @@ const REQUIRED: [&str; 11] = [
     "console",
 ];
 
-fn path(stem: &str) -> PathBuf {
-    Path::new(LIBRARY).join(format!("{stem}.toml"))
-}
-
 fn part(stem: &str) -> ScenarioFile {
-    load(&path(stem)).unwrap_or_else(|e| panic!("{e}"))
+    builtin(stem).unwrap_or_else(|| panic!("scenarios/{stem}.toml is not built in"))
 }
 
 /// Whether the mesh has a vertex at exactly `(x, y, z)`.
@@ -40,20 +32,11 @@ fn has_vertex(tris: &[Triangle], x: f64, y: f64, z: f64) -> bool {
 
 #[test]
 fn every_file_loads_and_tessellates_exactly() {
-    let mut stems: Vec<String> = std::fs::read_dir(LIBRARY)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| is_scenario_file(p))
-        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
-        .collect();
-    stems.sort();
+    let stems: Vec<&str> = builtin_names().collect();
     for stem in REQUIRED {
-        assert!(
-            stems.iter().any(|s| s == stem),
-            "scenarios/{stem}.toml is missing"
-        );
+        assert!(stems.contains(&stem), "scenarios/{stem}.toml is missing");
     }
-    for stem in &stems {
+    for stem in stems {
         // Lowercase-hyphen names.
         assert!(
             stem.chars().all(|c| c.is_ascii_lowercase() || c == '-'),
@@ -98,28 +81,29 @@ fn every_file_loads_and_tessellates_exactly() {
 }
 
 #[test]
-fn files_reproduce_the_builtins() {
-    // Same lattice (the files' creases are the built-ins' creases or
-    // lattice lines anyway), heights equal within rounding: the files
-    // write cos^2(pi u / 2) where the built-ins write (1 + cos(pi u)) / 2,
-    // and a phase of half a turn where they negate.
-    for (stem, scenario) in [
-        ("flat-wall", Scenario::FlatWall),
-        ("ramp", Scenario::Ramp),
-        ("wave", Scenario::Wave),
-        ("growing-wave", Scenario::GrowingWave),
-        ("step", Scenario::Step),
-        ("bump", Scenario::Bump),
-        ("depression", Scenario::Depression),
-    ] {
-        let from_file = part(stem).triangulate(None);
-        let builtin = triangulate(scenario, &scenario.default_field());
-        assert_eq!(from_file.len(), builtin.len(), "{stem}");
-        for (a, b) in from_file.iter().flatten().zip(builtin.iter().flatten()) {
-            assert_eq!((a[0], a[2]), (b[0], b[2]), "{stem}");
-            assert!((a[1] - b[1]).abs() <= 1e-12, "{stem} at {a:?} vs {b:?}");
-        }
+fn the_default_panel_is_600_by_300_at_2_mm() {
+    // Every part but the console lies on the same panel, centred on the
+    // origin where the features are.
+    for stem in builtin_names().filter(|&s| s != "console") {
+        let f = part(stem);
+        assert_eq!(
+            f.extent,
+            Extent {
+                x: [-300.0, 300.0],
+                z: [-150.0, 150.0],
+                step: 2.0
+            },
+            "{stem}"
+        );
     }
+    // The flat wall has no creases: exactly the 300 x 150 cells at 2 mm.
+    let tris = part("flat-wall").triangulate(None);
+    assert_eq!(tris.len(), 2 * 300 * 150);
+    assert!(
+        tris.iter()
+            .flatten()
+            .all(|v| v[0] % 2.0 == 0.0 && v[2] % 2.0 == 0.0)
+    );
 }
 
 #[test]
@@ -132,20 +116,35 @@ fn primitives_stand_where_their_parameters_put_them() {
 
     let f = part("ramp");
     assert_eq!(f.height(-100.0, 7.0), -20.0);
+    assert_eq!(f.height(100.0, 7.0), 20.0);
 
-    // y = 5 sin(2 pi x / 100): 5 mm proud at x = -25 and 75, 5 back at 25.
+    // y = 5 sin(2 pi x / 100): 5 mm proud at x = -25 and 75, 5 back at 25
+    // and -75; exactly 0 at the lattice's zeros.
     let f = part("wave");
     assert_eq!(f.height(-25.0, 0.0), -5.0);
     assert_eq!(f.height(75.0, 9.0), -5.0);
     assert_eq!(f.height(25.0, 9.0), 5.0);
+    assert_eq!(f.height(-75.0, 0.0), 5.0);
+    for x in [-300.0, -250.0, 0.0, 50.0, 100.0] {
+        assert_eq!(f.height(x, 0.0), 0.0, "x = {x}");
+    }
 
     // Crests at x = 25 mod 100, amplitude 2 + 0.01 (300 - x): 4.75 mm at
-    // x = 25, 7.75 at -275; the hollows between are flat.
+    // x = 25, 7.75 at -275, each further out than the one behind it; the
+    // hollows between are flat, and the zeros on the lattice exact.
     let f = part("growing-wave");
     assert!((f.height(25.0, 0.0) + 4.75).abs() < 1e-12);
     assert!((f.height(-275.0, 0.0) + 7.75).abs() < 1e-12);
+    let crests: Vec<f64> = [225.0, 25.0, -175.0, -275.0]
+        .iter()
+        .map(|&x| f.height(x, 0.0))
+        .collect();
+    assert!(crests.windows(2).all(|w| w[1] < w[0]), "{crests:?}");
     assert_eq!(f.height(-25.0, 0.0), 0.0);
     assert_eq!(f.height(-40.0, 0.0), 0.0);
+    for x in [-300.0, -250.0, 0.0, 50.0, 100.0] {
+        assert_eq!(f.height(x, 0.0), 0.0, "x = {x}");
+    }
 
     // Each boss's flat top, corners included, is exactly its height; the
     // shoulder ends 3 mm beyond it.
@@ -189,6 +188,7 @@ fn primitives_stand_where_their_parameters_put_them() {
     let f = part("depression");
     assert_eq!(f.height(0.0, 0.0), 5.0);
     assert_eq!(f.height(120.0, -150.0), -10.0);
+    assert_eq!(f.height(120.0, 77.0), -10.0);
     assert_eq!(f.height(160.0, 0.0), 0.0);
 
     // The diagonal ridge is 8 mm proud on its axis whatever the z, and the
@@ -349,7 +349,7 @@ fn the_console_reaches_the_paper_triangle_count() {
     }
     // It is the benchmark console plus its extra features: the rib's crest
     // stands 5 mm proud of the console there, the far corner is untouched.
-    let console = crate::console::console_height;
+    let console = super::console::console_height;
     assert_eq!(f.height(1000.3, 200.0), console(1000.3, 200.0) - 5.0);
     assert_eq!(f.height(1500.0, 0.0), console(1500.0, 0.0));
     assert!(

@@ -4,23 +4,31 @@
 //! Each part is a surface `y = g(x, z)` in SPEC's analysis frame (mm): the
 //! surface faces -y, the knee comes from -y, is pushed in +y and slides in
 //! -x (towards the vehicle front). So a feature that **sticks out towards
-//! the knee has a smaller y**. A part is tessellated on a square lattice
-//! (plus vertex lines at its creases, so thin features are in the mesh at
-//! any step), two triangles per cell facing -y, and stored with
-//! [`write_stl`] as a binary STL that the CLI reads like any other part.
+//! the knee has a smaller y**.
 //!
-//! Two sources of parts:
+//! The scenario files are the only definition of the parts: the library in
+//! `scenarios/*.toml`, one part per file, each a sum of named [`Feature`]
+//! primitives (plane, wave, bump, boss, ridge, groove, rib, step, console)
+//! over an [`Extent`] with its tessellation step and a one-line
+//! description. This module offers:
 //!
-//! * scenario files ([`load`], [`ScenarioFile`]): the library in
-//!   `scenarios/*.toml`, one part per file, each a sum of named
-//!   [`Feature`] primitives (plane, wave, bump, boss, ridge, groove, rib,
-//!   step, console) over an extent with its tessellation step and a
-//!   one-line description; `kneeform scenario FILE.toml` writes one;
-//! * the built-in [`Scenario`]s, closed-form surfaces on a [`HeightField`]
-//!   that the integration tests were written against; the files reproduce
-//!   them (all but the console) within rounding.
+//! * [`load`] and [`parse`]: a file read and checked into a
+//!   [`ScenarioFile`], whose [`ScenarioFile::height`] is the surface's
+//!   closed form and [`ScenarioFile::triangulate`] its mesh;
+//! * [`builtin`]: the same files embedded in the binary, by stem
+//!   ([`builtin_names`]: `wave`, `thin-rib`, `console`, ...), for
+//!   `kneeform scenario NAME`, the tests and the benchmark (the built-in
+//!   `console` at [`PAPER_TRIANGLES`]);
+//! * [`tessellate`]: the one height-field tessellation, two triangles per
+//!   lattice cell facing -y; the files use it on a square lattice with
+//!   vertex lines at their creases (so thin features are in the mesh at
+//!   any step), and the tests and the oracle's tests and examples on
+//!   lattices of their own;
+//! * [`write_stl`]: a mesh as a binary STL that the CLI reads like any
+//!   other part.
 
 mod builtin;
+mod console;
 mod file;
 mod lattice;
 mod primitive;
@@ -33,7 +41,7 @@ use std::path::Path;
 
 use crate::mesh::Triangle;
 
-pub use builtin::{HeightField, Scenario, height, triangulate};
+pub use builtin::{PAPER_TRIANGLES, builtin, builtin_names};
 pub use file::{
     Extent, MAX_TRIANGLES, ScenarioError, ScenarioFile, is_scenario_file, load, parse,
     triangles_from_file,
@@ -72,12 +80,15 @@ mod tests {
     fn stl_round_trips() {
         let dir = crate::output::temp_dir("scenario");
         let path = dir.join("bump.stl");
-        let field = HeightField {
-            x_range: (-300.0, 300.0),
-            z_range: (-20.0, 20.0),
-            step: 5.0,
+        let bump = ScenarioFile {
+            extent: Extent {
+                x: [-300.0, 300.0],
+                z: [-20.0, 20.0],
+                step: 5.0,
+            },
+            ..builtin("bump").unwrap()
         };
-        let tris = triangulate(Scenario::Bump, &field);
+        let tris = bump.triangulate(None);
         write_stl(&path, &tris).unwrap();
         // Only the final file remains.
         assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);

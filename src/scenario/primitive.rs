@@ -11,6 +11,7 @@
 
 use serde::Deserialize;
 
+use super::console::console_height;
 use super::lattice::{cos2_bell, plateau, sin_turns};
 use crate::kneeform::NODE_TOL;
 
@@ -38,7 +39,8 @@ pub enum Feature {
     Rib(Rib),
     /// A step across x: the part in front stands proud.
     Step(Step),
-    /// The benchmark console side of [`crate::console`].
+    /// The benchmark console side, 1500 x 600 mm: a bulge, waves, a wavy
+    /// ridge, switch-like bosses and a dip behind a protrusion.
     Console(Console),
 }
 
@@ -198,9 +200,12 @@ pub struct Step {
     pub height: f64,
 }
 
-/// `kind = "console"`: [`crate::console::console_height`] with its
-/// `(0, 0)` at `origin`; the console covers
-/// [`crate::console::CONSOLE_SIZE`] from there.
+/// `kind = "console"`: the benchmark console side, a closed-form height
+/// field 1500 x 600 mm (`src/scenario/console.rs`: a bulge towards the
+/// knee, waves growing towards the front, a narrow ridge with a wavy top,
+/// switch-like bosses 5-10 mm proud, a shallow dip behind a protrusion),
+/// with its `(0, 0)` at `origin`; it covers x in `[0, 1500]` and z in
+/// `[0, 600]` from there.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Console {
@@ -321,7 +326,7 @@ impl Feature {
                 }
             }
             Feature::Step(s) => -s.height * ((s.at - x) / s.width).clamp(0.0, 1.0),
-            Feature::Console(c) => crate::console::console_height(x - c.origin[0], z - c.origin[1]),
+            Feature::Console(c) => console_height(x - c.origin[0], z - c.origin[1]),
         }
     }
 

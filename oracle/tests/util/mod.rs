@@ -1,5 +1,8 @@
-//! Synthetic parts for the oracle's tests: height-field triangulations
-//! `y = g(x, z)` whose surface faces -y (the analysis frame).
+//! Synthetic parts for the oracle's tests: the lattices that the engine's
+//! height-field tessellation, [`kneeform::scenario::tessellate`], turns
+//! into parts `y = g(i, j)` whose surface faces -y (the analysis frame).
+//! Test fixtures only: the oracle's own geometry shares nothing with the
+//! engine.
 
 #![allow(dead_code)]
 
@@ -21,21 +24,6 @@ pub fn knots(runs: &[Vec<f64>]) -> Vec<f64> {
             if out.last() != Some(&v) {
                 out.push(v);
             }
-        }
-    }
-    out
-}
-
-/// Triangulates the height field `y = g(i, j)` over the vertices
-/// `(xs[i], zs[j])`, two triangles per cell, wound so that their normal is
-/// -y (facing the knee-form).
-pub fn height_field(xs: &[f64], zs: &[f64], g: impl Fn(usize, usize) -> f64) -> Vec<[[f64; 3]; 3]> {
-    let p = |i: usize, j: usize| [xs[i], g(i, j), zs[j]];
-    let mut out = Vec::new();
-    for i in 0..xs.len() - 1 {
-        for j in 0..zs.len() - 1 {
-            out.push([p(i, j), p(i + 1, j), p(i, j + 1)]);
-            out.push([p(i + 1, j), p(i + 1, j + 1), p(i, j + 1)]);
         }
     }
     out

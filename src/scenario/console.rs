@@ -1,16 +1,15 @@
-//! The benchmark part: a console side the size of the paper's (about
-//! 1500 x 600 mm), built as a height field with the features R21 worries
-//! about: a global bulge, waves, a ridge with a wavy top, switch-like bosses
-//! and a shallow depression behind a protrusion. Tessellated to any triangle
-//! count, the paper's 369,408 included.
+//! The closed form of the `console` primitive ([`super::Console`]): a
+//! console side the size of the paper's (1500 x 600 mm) as a height field
+//! with the features R21 worries about: a global bulge, waves, a ridge with
+//! a wavy top, switch-like bosses and a shallow depression behind a
+//! protrusion. `scenarios/console.toml`, the benchmark part, is this plus a
+//! thin rib, a groove and a diagonal ridge.
 //!
 //! Analysis frame: the surface faces -y, so a feature standing proud
 //! towards the knee has a *smaller* y.
 
-use crate::mesh::Triangle;
-
-/// The console's extent in x and z (mm).
-pub const CONSOLE_SIZE: [f64; 2] = [1500.0, 600.0];
+/// The console's extent in x and z (mm), from its own `(0, 0)`.
+pub(super) const CONSOLE_SIZE: [f64; 2] = [1500.0, 600.0];
 
 /// A smooth bump of unit height and radius `r` at `(cx, cz)`: `cos^2`
 /// falloff, zero outside.
@@ -38,7 +37,7 @@ fn boss(x: f64, z: f64, c: [f64; 2], half: [f64; 2], edge: f64) -> f64 {
 }
 
 /// The console's surface y(x, z) in mm, for x in [0, 1500], z in [0, 600].
-pub fn console_height(x: f64, z: f64) -> f64 {
+pub(super) fn console_height(x: f64, z: f64) -> f64 {
     use std::f64::consts::TAU;
     let [lx, lz] = CONSOLE_SIZE;
     // A bulge towards the knee in the middle of the panel.
@@ -60,49 +59,9 @@ pub fn console_height(x: f64, z: f64) -> f64 {
     y
 }
 
-/// Tessellates the console into at least `min_triangles` triangles: a
-/// regular lattice, two triangles per cell, cells as square as possible.
-pub fn console_triangles(min_triangles: usize) -> Vec<Triangle> {
-    let [lx, lz] = CONSOLE_SIZE;
-    let cells = min_triangles.div_ceil(2).max(1) as f64;
-    let nz = (cells * lz / lx).sqrt().ceil().max(1.0) as usize;
-    let nx = (cells / nz as f64).ceil() as usize;
-    let vertex = |i: usize, k: usize| {
-        let (x, z) = (lx * i as f64 / nx as f64, lz * k as f64 / nz as f64);
-        [x, console_height(x, z), z]
-    };
-    let mut triangles = Vec::with_capacity(2 * nx * nz);
-    for k in 0..nz {
-        for i in 0..nx {
-            let (a, b, c, d) = (
-                vertex(i, k),
-                vertex(i + 1, k),
-                vertex(i + 1, k + 1),
-                vertex(i, k + 1),
-            );
-            triangles.push([a, b, c]);
-            triangles.push([a, c, d]);
-        }
-    }
-    triangles
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn tessellates_to_at_least_the_paper_count() {
-        let t = console_triangles(369_408);
-        assert!(
-            t.len() >= 369_408 && t.len() < 369_408 + 2000,
-            "{}",
-            t.len()
-        );
-        for v in t.iter().flatten() {
-            assert_eq!(v[1], console_height(v[0], v[2]));
-        }
-    }
 
     #[test]
     fn features_stand_proud_towards_the_knee() {
