@@ -130,25 +130,40 @@ impl PartFile {
 /// and maps `side` into the analysis frame; the file's SHA-256 is taken
 /// from the same bytes.
 pub fn read_part(path: &Path, scale: f64, side: Side) -> Result<PartFile, MeshError> {
-    let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
-        path: name.clone(),
+        path: path.display().to_string(),
         source,
     })?;
-    let sha256 = sha2::Sha256::digest(&bytes)
+    read_part_bytes(path, &bytes, scale, side)
+}
+
+/// The SHA-256 of `bytes`, lowercase hex: a part file's identity.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    sha2::Sha256::digest(bytes)
         .iter()
         .map(|b| format!("{b:02x}"))
-        .collect();
+        .collect()
+}
+
+/// [`read_part`] of bytes already read from `path`.
+pub fn read_part_bytes(
+    path: &Path,
+    bytes: &[u8],
+    scale: f64,
+    side: Side,
+) -> Result<PartFile, MeshError> {
+    let name = path.display().to_string();
+    let sha256 = sha256_hex(bytes);
     let part = if crate::scenario::is_scenario_file(path) {
         let text =
-            std::str::from_utf8(&bytes).map_err(|e| crate::scenario::ScenarioError::Read {
+            std::str::from_utf8(bytes).map_err(|e| crate::scenario::ScenarioError::Read {
                 path: path.to_path_buf(),
                 cause: std::io::Error::new(std::io::ErrorKind::InvalidData, e),
             })?;
         let triangles = crate::scenario::parse(text, path)?.triangulate(None);
         Part::from_triangles(&name, triangles, scale, side)?
     } else {
-        Part::from_stl_bytes(&name, &bytes, scale, side)?
+        Part::from_stl_bytes(&name, bytes, scale, side)?
     };
     Ok(PartFile {
         path: path.to_path_buf(),

@@ -11,7 +11,7 @@ use std::process::{Command, Output, Stdio};
 use kneeform::summary::Summary;
 use serde_json::Value;
 
-use crate::util::{Rng, SEEDS, scratch_dir};
+use crate::util::{Image, Rng, SEEDS, scratch_dir};
 
 fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -91,20 +91,10 @@ fn quick<'a>(part: &'a str, out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
 /// Screenshots `page` in headless Chromium; the RGB pixels, or `None` when
 /// Chromium is not installed.
 fn screenshot(page: &Path, dir: &Path) -> Option<(usize, usize, Vec<[u8; 3]>)> {
-    crate::util::screenshot(page, dir).map(|png| decode_png(&png))
-}
-
-fn decode_png(bytes: &[u8]) -> (usize, usize, Vec<[u8; 3]>) {
-    let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
-    let mut reader = decoder.read_info().expect("a PNG");
-    let mut buf = vec![0; reader.output_buffer_size()];
-    let info = reader.next_frame(&mut buf).expect("a frame");
-    let channels = info.line_size / info.width as usize;
-    let pixels = buf[..info.buffer_size()]
-        .chunks(channels)
-        .map(|c| [c[0], c[1], c[2]])
-        .collect();
-    (info.width as usize, info.height as usize, pixels)
+    crate::util::screenshot(page, dir).map(|png| {
+        let image = Image::decode(&png);
+        (image.width, image.height, image.rgb())
+    })
 }
 
 #[test]
@@ -152,8 +142,8 @@ fn the_readme_first_command_analyses_and_reports_the_bundled_console() {
 
     // composite.png is cropped to the part: the pale of "no part" is a
     // small share of the image, where the whole grid made it most.
-    let (_, _, pixels) =
-        decode_png(&std::fs::read(dir.join("kneeform-out/composite.png")).unwrap());
+    let pixels =
+        Image::decode(&std::fs::read(dir.join("kneeform-out/composite.png")).unwrap()).rgb();
     let no_part = kneeform::output::NO_PART;
     let pale = pixels
         .iter()

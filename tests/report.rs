@@ -10,7 +10,7 @@ use std::process::{Command, Output};
 
 use serde_json::Value;
 
-use crate::util::scratch_dir;
+use crate::util::{Image, scratch_dir};
 
 /// Angles of the test runs: the paper's Figure 12 angles and two between.
 const ANGLES: &str = "--angles=-30,-15,0,15,30";
@@ -163,41 +163,6 @@ fn unbase64(text: &str) -> Vec<u8> {
         out.extend_from_slice(&n.to_be_bytes()[1..4 - pad]);
     }
     out
-}
-
-/// A decoded RGB(A) image.
-struct Image {
-    width: usize,
-    height: usize,
-    channels: usize,
-    pixels: Vec<u8>,
-}
-
-impl Image {
-    fn decode(bytes: &[u8]) -> Image {
-        let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
-        let mut reader = decoder.read_info().expect("a PNG");
-        let mut pixels = vec![0; reader.output_buffer_size()];
-        let info = reader.next_frame(&mut pixels).expect("a frame");
-        assert_eq!(info.bit_depth, png::BitDepth::Eight);
-        let channels = match info.color_type {
-            png::ColorType::Rgb => 3,
-            png::ColorType::Rgba => 4,
-            other => panic!("unexpected colour type {other:?}"),
-        };
-        pixels.truncate(info.buffer_size());
-        Image {
-            width: info.width as usize,
-            height: info.height as usize,
-            channels,
-            pixels,
-        }
-    }
-
-    fn at(&self, c: usize, r: usize) -> [u8; 3] {
-        let k = self.channels * (r * self.width + c);
-        [self.pixels[k], self.pixels[k + 1], self.pixels[k + 2]]
-    }
 }
 
 /// The value of attribute `name` in the tag `tag`.
@@ -362,6 +327,7 @@ fn report_of_a_scenario_run_has_every_section_embeds_every_figure_and_cites_the_
         "method",
         "per-angle",
         "accuracy",
+        "resolution",
         "runtime",
         "run-figures",
     ] {

@@ -141,3 +141,57 @@ fn the_pitch_chosen_for_a_tolerance_passes_verify_there() {
         );
     }
 }
+
+#[test]
+fn blind_spots_are_written_crossed_and_reported() {
+    // The thin ribs at 4 mm, through the command a user runs: the CSV
+    // scripts read, the crosses on composite.png, the report's sentence.
+    let dir = crate::util::scratch_dir("blind-report");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_kneeform"))
+        .current_dir(&dir)
+        .args(["analyze"])
+        .arg(scenario("thin-rib"))
+        .args([
+            "--pitch",
+            "4",
+            "--angles=-30,0,30",
+            "--out",
+            "run",
+            "--report",
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    // Loud: the knee-form meets the ribs the grid cannot see.
+    assert!(
+        stderr.contains("blind spots the knee-form meets"),
+        "{stderr}"
+    );
+    let csv = std::fs::read_to_string(dir.join("run/blind_spots.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    for column in ["x", "z", "depth_missed_mm", "resolving_pitch_mm"] {
+        assert!(header.split(',').any(|c| c == column), "{header}");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("run/summary.json")).unwrap())
+            .unwrap();
+    let count = summary["blind_spots"].as_u64().unwrap();
+    assert_eq!(count as usize, csv.lines().count() - 1);
+    assert!(count > 90, "{count}");
+    let png = crate::util::Image::decode(&std::fs::read(dir.join("run/composite.png")).unwrap());
+    let magenta = kneeform::output::BLIND_COLOUR;
+    let crossed = png
+        .rgb()
+        .iter()
+        .filter(|p| **p == [magenta.0, magenta.1, magenta.2])
+        .count();
+    assert!(crossed > 100, "{crossed} magenta pixels");
+    let html = std::fs::read_to_string(dir.join("run/report.html")).unwrap();
+    assert!(html.contains("<section id=\"resolution\">"));
+    assert!(
+        html.contains("2 features narrower than the pitch"),
+        "the two ribs are two features"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -405,3 +405,46 @@ pub fn screenshot(page: &std::path::Path, dir: &std::path::Path) -> Option<Vec<u
     );
     Some(std::fs::read(&shot).expect("the screenshot"))
 }
+
+/// A decoded RGB(A) image.
+pub struct Image {
+    pub width: usize,
+    pub height: usize,
+    pub channels: usize,
+    pub pixels: Vec<u8>,
+}
+
+impl Image {
+    pub fn decode(bytes: &[u8]) -> Image {
+        let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+        let mut reader = decoder.read_info().expect("a PNG");
+        let mut pixels = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut pixels).expect("a frame");
+        assert_eq!(info.bit_depth, png::BitDepth::Eight);
+        let channels = match info.color_type {
+            png::ColorType::Rgb => 3,
+            png::ColorType::Rgba => 4,
+            other => panic!("unexpected colour type {other:?}"),
+        };
+        pixels.truncate(info.buffer_size());
+        Image {
+            width: info.width as usize,
+            height: info.height as usize,
+            channels,
+            pixels,
+        }
+    }
+
+    pub fn at(&self, c: usize, r: usize) -> [u8; 3] {
+        let k = self.channels * (r * self.width + c);
+        [self.pixels[k], self.pixels[k + 1], self.pixels[k + 2]]
+    }
+
+    /// Every pixel's RGB, row by row from the top.
+    pub fn rgb(&self) -> Vec<[u8; 3]> {
+        self.pixels
+            .chunks(self.channels)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect()
+    }
+}

@@ -35,8 +35,8 @@ pub use self::ply::write_colliding_area_ply;
 pub(crate) use self::png::count_colour;
 pub(crate) use self::png::register_font;
 pub use self::png::{
-    CROP_MARGIN, NO_PART, PngError, RING_BELOW, RING_COLOUR, Window, composite_key, crop_window,
-    depth_bar_ends, view_line, write_composite_png, write_depth_png,
+    BLIND_COLOUR, CROP_MARGIN, NO_PART, PngError, RING_BELOW, RING_COLOUR, Window, composite_key,
+    crop_window, depth_bar_ends, view_line, write_composite_png, write_depth_png,
 };
 pub use self::results::{write_analysis, write_convergence, write_verification};
 pub(crate) use self::stl::to_stl_triangle;

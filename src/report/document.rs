@@ -14,6 +14,9 @@
 //!   table of the colliding area per angle;
 //! * `accuracy`: each verification run's metrics against its tolerance
 //!   with the verdict, the convergence study and its recommended pitch;
+//! * `resolution`: what the grid cannot see at its pitch (the blind spots,
+//!   also magenta on the main image), the pitch study when `--pitch auto`
+//!   chose the pitch, and the one sentence a regulator reads;
 //! * `runtime`: the run's timings;
 //! * `run-figures`: the images the run wrote.
 
@@ -103,6 +106,7 @@ pub fn document(inputs: &Inputs) -> String {
                 (method_section(run))
                 (per_angle_section(inputs))
                 (accuracy_section(inputs.verifications))
+                (resolution_section(inputs))
                 (runtime_section(run))
                 (run_figures_section(inputs.run_figures))
                 footer {
@@ -190,6 +194,10 @@ fn result_section(inputs: &Inputs) -> Markup {
                     ", z up. Colour: the number of knee-form angles (of " (n)
                     ") whose sliding knee-form strikes the point (the paper's Figure 13); grey: never struck. A point is coloured when it lies within half a pitch, in x and z, of a colliding grid node of "
                     code { "composite.csv" } "."
+                    @if !run.blind_spots.is_empty() {
+                        " Magenta: blind spots, grid cells where the part sticks out between the nodes unseen ("
+                        code { "blind_spots.csv" } ", section 6)."
+                    }
                 }
                 "\n"
             }
@@ -715,12 +723,199 @@ fn csv_table(name: &str, text: &str) -> Markup {
     }
 }
 
+/// Section 6: what the grid cannot see, how the pitch was chosen, and the
+/// sentence a regulator reads.
+fn resolution_section(inputs: &Inputs) -> Markup {
+    let run = inputs.run;
+    let j = &run.summary_json;
+    let blind = &run.blind_spots;
+    // The accuracy at this pitch: a verification's decided area distance
+    // at the run's pitch, else the pitch study's at the chosen pitch.
+    let verified = inputs.verifications.iter().enumerate().find_map(|(k, v)| {
+        let json = v.verify.as_ref()?;
+        json.get("area_distance_decided_mm")?.as_f64()?;
+        Some(cite(
+            &verify_label(k, "verify.json"),
+            json,
+            "/area_distance_decided_mm",
+        ))
+    });
+    let study_len = j
+        .pointer("/pitch_study/study")
+        .and_then(Value::as_array)
+        .map_or(0, Vec::len);
+    let studied = (study_len > 0)
+        .then(|| {
+            let pointer = format!(
+                "/pitch_study/study/{}/exact_area_distance_mm",
+                study_len - 1
+            );
+            j.pointer(&pointer)?.as_f64()?;
+            Some(cite(SUMMARY, j, &pointer))
+        })
+        .flatten();
+    let features = blind_features(blind);
+    let places: Vec<String> = features
+        .iter()
+        .take(6)
+        .map(|f| {
+            let span = |lo: f64, hi: f64| {
+                if hi - lo < 1.0 {
+                    format!("{lo:.1}")
+                } else {
+                    format!("{lo:.0}..{hi:.0}")
+                }
+            };
+            format!("x = {}, z = {}", span(f[0], f[1]), span(f[2], f[3]))
+        })
+        .collect();
+    let met = blind.iter().filter(|b| b.met_angles > 0).count();
+    let finest = blind
+        .iter()
+        .map(|b| b.resolving_pitch_mm)
+        .fold(f64::INFINITY, f64::min);
+    let worst: Vec<&super::run::BlindRow> = {
+        let mut v: Vec<&super::run::BlindRow> = blind.iter().collect();
+        v.sort_by(|a, b| b.depth_mm.total_cmp(&a.depth_mm));
+        v.truncate(12);
+        v
+    };
+    html! {
+        section id="resolution" {
+            "\n"
+            h2 { "6. Resolution" }
+            "\n"
+            p class="headline" {
+                "At this pitch (" (cite(SUMMARY, j, "/pitch_mm")) " mm), "
+                @if let Some(x) = &verified {
+                    "every decided strike is within " b { (x) " mm" } " of the exact one (verification run)"
+                } @else if let Some(x) = &studied {
+                    "every decided strike is within " b { (x) " mm" } " of the exact one on the pitch study's sampled starts"
+                } @else {
+                    "the distance of the grid's strikes to the exact ones is not measured here (no verification run given)"
+                }
+                "; " (features.len()) " features narrower than the pitch, sticking out more than "
+                (cite(SUMMARY, j, "/blind_depth_mm")) " mm between the nodes ("
+                (cite(SUMMARY, j, "/blind_spots")) " grid cells), were flagged"
+                @if !places.is_empty() {
+                    " at " (places.join("; "))
+                    @if features.len() > places.len() { "; and " (features.len() - places.len()) " more" }
+                    " (mm)"
+                }
+                "."
+            }
+            "\n"
+            @if !blind.is_empty() {
+                p {
+                    (met) " of these cells the knee-form meets at some angle (their strikes are missing from the colliding area above); a pitch of "
+                    (fmt_num(finest)) " mm resolves every one (a node lands on each wherever it lies). The deepest, from "
+                    code { "blind_spots.csv" } ":"
+                }
+                "\n"
+                table class="compact" {
+                    "\n"
+                    tr { th { "x (mm)" } th { "z (mm)" } th { "depth missed (mm)" } th { "width (mm)" } th { "resolving pitch (mm)" } th { "angles meeting it" } }
+                    "\n"
+                    @for b in &worst {
+                        tr { td { (fmt_num(b.x)) } td { (fmt_num(b.z)) } td { (fmt_num(b.depth_mm)) } td { (fmt_num(b.width_mm)) } td { (fmt_num(b.resolving_pitch_mm)) } td { (b.met_angles) } }
+                        "\n"
+                    }
+                }
+                "\n"
+            }
+            @if study_len > 0 {
+                p {
+                    "The pitch was chosen by a pitch study for a tolerance of "
+                    (cite(SUMMARY, j, "/pitch_study/tolerance_mm")) " mm: "
+                    (cite(SUMMARY, j, "/pitch_study/reason")) "."
+                }
+                "\n"
+                table class="compact" {
+                    "\n"
+                    tr { th { "pitch (mm)" } th { "area distance to exact (mm)" } th { "change from the coarser grid (mm)" } th { "predicted analysis (s)" } th { "memory (GiB)" } th { "meets" } }
+                    "\n"
+                    @for k in 0..study_len {
+                        @let c = |f: &str| cite(SUMMARY, j, &format!("/pitch_study/study/{k}/{f}"));
+                        tr { td { (c("pitch_mm")) } td { (c("exact_area_distance_mm")) } td { (c("grid_change_mm")) } td { (c("predicted_s")) } td { (c("memory_gib")) } td { (c("meets")) } }
+                        "\n"
+                    }
+                }
+                "\n"
+            }
+        }
+        "\n"
+    }
+}
+
+/// The blind spots grouped into features (cells touching, corners
+/// included), each as its lowest points' extent `[x_lo, x_hi, z_lo, z_hi]`
+/// (mm), largest first.
+fn blind_features(blind: &[super::run::BlindRow]) -> Vec<[f64; 4]> {
+    let index: std::collections::HashMap<(usize, usize), usize> = blind
+        .iter()
+        .enumerate()
+        .map(|(k, b)| ((b.i, b.j), k))
+        .collect();
+    let mut feature = vec![usize::MAX; blind.len()];
+    let mut out: Vec<([f64; 4], usize)> = Vec::new();
+    for start in 0..blind.len() {
+        if feature[start] != usize::MAX {
+            continue;
+        }
+        let id = out.len();
+        let mut extent = [
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        let mut cells = 0;
+        let mut stack = vec![start];
+        feature[start] = id;
+        while let Some(k) = stack.pop() {
+            let b = &blind[k];
+            extent = [
+                extent[0].min(b.x),
+                extent[1].max(b.x),
+                extent[2].min(b.z),
+                extent[3].max(b.z),
+            ];
+            cells += 1;
+            for (di, dj) in [
+                (-1, -1),
+                (-1, 0),
+                (-1, 1),
+                (0, -1),
+                (0, 1),
+                (1, -1),
+                (1, 0),
+                (1, 1),
+            ] {
+                let (Some(i), Some(j)) = (b.i.checked_add_signed(di), b.j.checked_add_signed(dj))
+                else {
+                    continue;
+                };
+                if let Some(&n) = index.get(&(i, j))
+                    && feature[n] == usize::MAX
+                {
+                    feature[n] = id;
+                    stack.push(n);
+                }
+            }
+        }
+        out.push((extent, cells));
+    }
+    out.sort_by_key(|f| std::cmp::Reverse(f.1));
+    out.into_iter().map(|(e, _)| e).collect()
+}
+
 fn runtime_section(run: &Run) -> Markup {
     let j = &run.summary_json;
     let labels = [
         ("read_s", "Reading and hashing the part"),
         ("sample_s", "Sampling the height grid"),
         ("push_slide_s", "Push and slide, every angle"),
+        ("blind_s", "Finding the blind spots"),
         ("write_s", "Writing the result files"),
         ("total_s", "Total"),
     ];
@@ -741,7 +936,7 @@ fn runtime_section(run: &Run) -> Markup {
     html! {
         section id="runtime" {
             "\n"
-            h2 { "6. Runtime" }
+            h2 { "7. Runtime" }
             "\n"
             table class="compact" {
                 "\n"
@@ -763,7 +958,7 @@ fn run_figures_section(figures: &[(String, Vec<u8>)]) -> Markup {
         @if !figures.is_empty() {
             section id="run-figures" {
                 "\n"
-                h2 { "7. Figures written by the run" }
+                h2 { "8. Figures written by the run" }
                 "\n"
                 @for (name, png) in figures {
                     figure {

@@ -215,17 +215,13 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<Report, Repor
         path: out.to_path_buf(),
         source,
     };
-    let mut tmp_name = out.file_name().unwrap_or_default().to_os_string();
-    tmp_name.push(format!(".tmp-{}", std::process::id()));
-    let tmp = out.with_file_name(tmp_name);
     if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent).map_err(io)?;
     }
-    let written = std::fs::write(&tmp, &html).and_then(|()| std::fs::rename(&tmp, out));
-    if written.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    written.map_err(io)?;
+    crate::output::write_file_atomically(out, |file| {
+        std::io::Write::write_all(file, html.as_bytes())
+    })
+    .map_err(io)?;
     Ok(report)
 }
 

@@ -6,10 +6,8 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use sha2::Digest;
-
 use crate::grid::GridSpec;
-use crate::mesh::{Part, Side};
+use crate::mesh::{Part, Side, read_part_bytes, sha256_hex};
 use crate::summary::Summary;
 
 use super::ReportError;
@@ -75,26 +73,6 @@ impl NodeCounts {
     }
 }
 
-/// Reads a part file as `analyze` does, an STL mesh or a scenario file
-/// (`.toml`, tessellated as `analyze` would), into triangles in the part's
-/// own frame, scaled by `scale` to mm and never mirrored: the report draws
-/// the part as it is.
-pub fn read_part_file(path: &Path, bytes: &[u8], scale: f64) -> Result<Part, ReportError> {
-    let name = path.display().to_string();
-    let failed = |reason: String| ReportError::Part {
-        path: path.to_path_buf(),
-        reason,
-    };
-    let part = if crate::scenario::is_scenario_file(path) {
-        let triangles =
-            crate::scenario::triangles_from_file(path, None).map_err(|e| failed(e.to_string()))?;
-        Part::from_triangles(&name, triangles, scale, Side::Left)
-    } else {
-        Part::from_stl_bytes(&name, bytes, scale, Side::Left)
-    };
-    part.map_err(|e| failed(e.to_string()))
-}
-
 /// A run directory, read.
 #[derive(Debug)]
 pub struct Run {
@@ -112,13 +90,36 @@ pub struct Run {
     pub part_path: PathBuf,
     /// The part in its own frame (mm, after the run's scale; not mirrored).
     pub part: Part,
+    /// `blind_spots.csv` (empty for runs of versions that wrote none).
+    pub blind_spots: Vec<BlindRow>,
+}
+
+/// One row of `blind_spots.csv`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlindRow {
+    /// The cell's first corner node.
+    pub i: usize,
+    /// Its row.
+    pub j: usize,
+    /// The lowest point's x (mm).
+    pub x: f64,
+    /// Its z (mm).
+    pub z: f64,
+    /// Depth missed (mm).
+    pub depth_mm: f64,
+    /// Width of the proud part (mm).
+    pub width_mm: f64,
+    /// The pitch resolving it (mm).
+    pub resolving_pitch_mm: f64,
+    /// How many angles meet it.
+    pub met_angles: usize,
 }
 
 impl Run {
     /// Reads `dir`. The part is looked for at `part` when given, else at the
     /// run's `input_file` as given (relative to the current directory) and
     /// relative to the run directory's parent; the first file whose SHA-256
-    /// is the run's is used ([`read_part_file`]).
+    /// is the run's is used ([`crate::mesh::read_part_bytes`]).
     pub fn read(dir: &Path, part: Option<&Path>) -> Result<Run, ReportError> {
         let summary_path = dir.join("summary.json");
         let text = read_text(&summary_path)?;
@@ -137,6 +138,12 @@ impl Run {
         })?;
         let composite = read_composite(&dir.join("composite.csv"), spec)?;
         let (part_path, part) = find_part(dir, part, &summary)?;
+        let blind_path = dir.join("blind_spots.csv");
+        let blind_spots = if blind_path.is_file() {
+            read_blind_spots(&blind_path, spec)?
+        } else {
+            Vec::new()
+        };
         Ok(Run {
             dir: dir.to_path_buf(),
             summary,
@@ -145,6 +152,7 @@ impl Run {
             composite,
             part_path,
             part,
+            blind_spots,
         })
     }
 
@@ -226,6 +234,41 @@ fn read_composite(path: &Path, spec: GridSpec) -> Result<NodeCounts, ReportError
         counts.y[k] = rows.parse(&row, 3)?;
     }
     Ok(counts)
+}
+
+fn read_blind_spots(path: &Path, spec: GridSpec) -> Result<Vec<BlindRow>, ReportError> {
+    let mut rows = CsvRows::open(
+        path,
+        &[
+            "i",
+            "j",
+            "x",
+            "z",
+            "depth_missed_mm",
+            "width_mm",
+            "resolving_pitch_mm",
+            "met_angles_deg",
+        ],
+    )?;
+    let mut out = Vec::new();
+    while let Some(row) = rows.next_row()? {
+        let (i, j): (usize, usize) = (rows.parse(&row, 0)?, rows.parse(&row, 1)?);
+        if i + 1 >= spec.nx || j + 1 >= spec.nz {
+            return Err(rows.bad(format!("cell ({i}, {j}) is not a cell of the run's grid")));
+        }
+        let met = row.get(rows.columns[7]).unwrap_or("");
+        out.push(BlindRow {
+            i,
+            j,
+            x: rows.parse(&row, 2)?,
+            z: rows.parse(&row, 3)?,
+            depth_mm: rows.parse(&row, 4)?,
+            width_mm: rows.parse(&row, 5)?,
+            resolving_pitch_mm: rows.parse(&row, 6)?,
+            met_angles: met.split(';').filter(|a| !a.is_empty()).count(),
+        });
+    }
+    Ok(out)
 }
 
 /// A CSV file read row by row, its columns located by name.
@@ -349,12 +392,19 @@ fn find_part(
         let Ok(bytes) = std::fs::read(path) else {
             continue;
         };
-        let sha = hex(&sha2::Sha256::digest(&bytes));
+        let sha = sha256_hex(&bytes);
         if sha != summary.sha256 {
             mismatched.push((path.clone(), sha));
             continue;
         }
-        let part = read_part_file(path, &bytes, summary.scale)?;
+        // As `analyze` read it, scaled but never mirrored: the report
+        // draws the part as it is.
+        let part = read_part_bytes(path, &bytes, summary.scale, Side::Left)
+            .map_err(|e| ReportError::Part {
+                path: path.clone(),
+                reason: e.to_string(),
+            })?
+            .part;
         return Ok((path.clone(), part));
     }
     if let Some((path, sha)) = mismatched.into_iter().next() {
@@ -375,10 +425,6 @@ fn read_text(path: &Path) -> Result<String, ReportError> {
         path: path.to_path_buf(),
         source,
     })
-}
-
-pub(super) fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 #[cfg(test)]

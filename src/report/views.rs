@@ -76,6 +76,14 @@ pub fn ramp_len(run: &Run) -> usize {
     run.summary.angles_deg.len().max(usize::from(max)).max(1)
 }
 
+/// The blind spots' colour on the rendered part: the composite image's
+/// magenta.
+pub const BLIND_COLOUR: Rgb = [
+    crate::output::BLIND_COLOUR.0,
+    crate::output::BLIND_COLOUR.1,
+    crate::output::BLIND_COLOUR.2,
+];
+
 /// The colour of composite count `c` (of [`ramp_len`]).
 pub fn composite_colour(c: u16, n: usize) -> Rgb {
     let rgb = count_colour(usize::from(c), n);
@@ -89,7 +97,22 @@ pub fn render_views(run: &Run, masks: &[(f64, NodeCounts)]) -> Views {
     let tris = &run.part.triangles;
     let n = ramp_len(run);
     let composite = &run.composite;
+    // Blind spots over the composite: the cells the grid cannot see into.
+    let blind: std::collections::HashSet<(i64, i64)> = run
+        .blind_spots
+        .iter()
+        .map(|b| (b.i as i64, b.j as i64))
+        .collect();
+    let spec = run.spec;
+    let in_blind_cell = |p: [f64; 3]| {
+        let i = ((p[0] - spec.x(0)) / spec.pitch).floor() as i64;
+        let j = ((p[2] - spec.z(0)) / spec.pitch).floor() as i64;
+        blind.contains(&(i, j))
+    };
     let by_count = |p: [f64; 3]| {
+        if in_blind_cell(p) {
+            return Some(BLIND_COLOUR);
+        }
         composite
             .at(p[0], p[2])
             .map(|(c, _)| composite_colour(c, n))

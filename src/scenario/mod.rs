@@ -53,23 +53,13 @@ pub use primitive::{Boss, Bump, Console, Feature, Groove, Plane, Rib, Ridge, Ste
 /// file in the same directory renamed into place, so `path` is never a
 /// partial file.
 pub fn write_stl(path: &Path, triangles: &[Triangle]) -> io::Result<()> {
-    let mut tmp_name = path.file_name().unwrap_or_default().to_os_string();
-    tmp_name.push(format!(".tmp-{}", std::process::id()));
-    let tmp = path.with_file_name(tmp_name);
-    let written = (|| {
-        let mut file = std::fs::File::create(&tmp)?;
+    crate::output::write_file_atomically(path, |file| {
         let stl: Vec<stl_io::Triangle> = triangles
             .iter()
             .map(crate::output::to_stl_triangle)
             .collect();
-        stl_io::write_stl(&mut file, stl.iter())?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if written.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    written
+        stl_io::write_stl(file, stl.iter())
+    })
 }
 
 #[cfg(test)]
