@@ -75,9 +75,14 @@ pub fn blind_spots(triangles: &[Triangle], grid: &HeightGrid, threshold: f64) ->
             let mut row = vec![(f64::INFINITY, [0.0; 2]); cx];
             for &k in bin {
                 let t = &triangles[k as usize];
+                // No point of the triangle lies lower than its lowest vertex.
+                let lowest = t[0][1].min(t[1][1]).min(t[2][1]);
                 for i in cell_columns(t, grid) {
+                    if lowest >= row[i].0 {
+                        continue;
+                    }
                     let clipped = clip_to_cell(t, grid, i, j);
-                    for &[x, y, z] in &clipped {
+                    for &[x, y, z] in clipped.points() {
                         if y < row[i].0 {
                             row[i] = (y, [x, z]);
                         }
@@ -187,14 +192,52 @@ fn range(v: [f64; 3]) -> (f64, f64) {
     (v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]))
 }
 
+/// A convex polygon of at most [`Polygon::MAX`] vertices: a triangle cut
+/// by up to five lines (each adds at most one vertex to a convex polygon;
+/// the room beyond is for rounding at near-degenerate cuts), without
+/// allocating.
+#[derive(Clone, Copy)]
+struct Polygon {
+    v: [[f64; 3]; Polygon::MAX],
+    n: usize,
+}
+
+impl Polygon {
+    /// Three vertices, plus one per cut, with room to spare.
+    const MAX: usize = 16;
+
+    fn points(&self) -> &[[f64; 3]] {
+        &self.v[..self.n]
+    }
+
+    fn is_empty(&self) -> bool {
+        self.n == 0
+    }
+
+    /// Appends `p`; beyond [`Polygon::MAX`] (only rounding at a cut along
+    /// an edge could get there) the vertex is dropped.
+    fn push(&mut self, p: [f64; 3]) {
+        if self.n < Polygon::MAX {
+            self.v[self.n] = p;
+            self.n += 1;
+        }
+    }
+}
+
 /// The triangle clipped to the cell's closed xz square: the vertices of the
 /// intersection polygon with y interpolated along the triangle (empty when
 /// they do not meet).
-fn clip_to_cell(t: &Triangle, grid: &HeightGrid, i: usize, j: usize) -> Vec<[f64; 3]> {
+fn clip_to_cell(t: &Triangle, grid: &HeightGrid, i: usize, j: usize) -> Polygon {
     let spec = grid.spec;
     let (x0, x1) = (spec.x(i), spec.x(i + 1));
     let (z0, z1) = (spec.z(j), spec.z(j + 1));
-    let mut poly: Vec<[f64; 3]> = t.to_vec();
+    let mut poly = Polygon {
+        v: [[0.0; 3]; Polygon::MAX],
+        n: 0,
+    };
+    for &p in t {
+        poly.push(p);
+    }
     // The square's four edges, each keeping the side towards the cell.
     for (axis, bound, sign) in [(0, x0, 1.0), (0, x1, -1.0), (2, z0, 1.0), (2, z1, -1.0)] {
         poly = clip(&poly, axis, bound, sign);
@@ -208,11 +251,15 @@ fn clip_to_cell(t: &Triangle, grid: &HeightGrid, i: usize, j: usize) -> Vec<[f64
 /// One Sutherland-Hodgman step: the polygon's part where
 /// `sign * (v[axis] - bound) >= 0`, with points on the cut interpolated
 /// linearly (so y stays on the triangle).
-fn clip(poly: &[[f64; 3]], axis: usize, bound: f64, sign: f64) -> Vec<[f64; 3]> {
+fn clip(poly: &Polygon, axis: usize, bound: f64, sign: f64) -> Polygon {
     let s = |v: &[f64; 3]| sign * (v[axis] - bound);
-    let mut out = Vec::with_capacity(poly.len() + 2);
-    for (k, a) in poly.iter().enumerate() {
-        let b = &poly[(k + 1) % poly.len()];
+    let mut out = Polygon {
+        v: [[0.0; 3]; Polygon::MAX],
+        n: 0,
+    };
+    let points = poly.points();
+    for (k, a) in points.iter().enumerate() {
+        let b = &points[(k + 1) % points.len()];
         let (sa, sb) = (s(a), s(b));
         if sa >= 0.0 {
             out.push(*a);
@@ -245,7 +292,7 @@ fn proud_width(
         if clipped.is_empty() {
             continue;
         }
-        for [x, _, z] in clip(&clipped, 1, level, -1.0) {
+        for &[x, _, z] in clip(&clipped, 1, level, -1.0).points() {
             lo = [lo[0].min(x), lo[1].min(z)];
             hi = [hi[0].max(x), hi[1].max(z)];
         }

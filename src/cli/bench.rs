@@ -13,7 +13,9 @@ use std::time::Instant;
 use anyhow::{Context, ensure};
 use kneeform::grid::GridSpec;
 use kneeform::scenario::{self, PAPER_TRIANGLES};
-use kneeform::{Algorithm, EngineOptions, GridFootprint, HeightGrid, KneeForm, colliding_masks};
+use kneeform::{
+    Algorithm, EngineOptions, GridFootprint, HeightGrid, KneeForm, Setup, colliding_masks,
+};
 
 use super::args::BenchArgs;
 
@@ -62,6 +64,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     let fast = EngineOptions::default();
 
     let mut sample_s = Vec::new();
+    let mut blind_s = Vec::new();
+    let mut blind_count = 0;
     let mut slide_s = Vec::new();
     let mut grid = None;
     let mut composite_nodes = 0;
@@ -70,6 +74,10 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         let g = HeightGrid::sample(&triangles, spec);
         sample_s.push(t.elapsed().as_secs_f64());
         let t = Instant::now();
+        blind_count =
+            kneeform::blind::blind_spots(&triangles, &g, Setup::DEFAULT_BLIND_DEPTH).len();
+        blind_s.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
         let masks = colliding_masks(&g, &footprints, &fast, &|| {});
         slide_s.push(t.elapsed().as_secs_f64());
         composite_nodes = kneeform::composite(&masks)
@@ -77,15 +85,20 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             .filter(|&&c| c > 0)
             .count();
         eprintln!(
-            "run {}/{}: sample {:.3} s, push+slide {:.3} s",
+            "run {}/{}: sample {:.3} s, blind spots {:.3} s, push+slide {:.3} s",
             run + 1,
             args.runs,
             sample_s[run],
+            blind_s[run],
             slide_s[run]
         );
         grid = Some(g);
     }
     let grid = grid.expect("at least one run");
+    // The ratio of each run's pair, then its median: the two were timed
+    // back to back, so a load on this shared machine cancels out.
+    let blind_ratio = median(blind_s.iter().zip(&sample_s).map(|(b, s)| b / s).collect());
+    let blind = median(blind_s);
     let (sample, slide) = (median(sample_s), median(slide_s));
     let total = sample + slide;
 
@@ -161,6 +174,11 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     )?;
     writeln!(md, "| threads | {threads} |")?;
     writeln!(md, "| sampling (median of {}) | {sample:.3} s |", args.runs)?;
+    writeln!(
+        md,
+        "| blind-spot sampling, conservative per cell (median) | {blind:.3} s, {blind_ratio:.1}x the node sampling in the same runs; {blind_count} blind spots at {} mm |",
+        Setup::DEFAULT_BLIND_DEPTH
+    )?;
     writeln!(
         md,
         "| push + slide, {} angles (median) | {slide:.3} s |",
