@@ -31,6 +31,19 @@ use rayon::prelude::*;
 use crate::grid::HeightGrid;
 use crate::mesh::Triangle;
 
+/// The columns of `blind_spots.csv`, as the writer writes them and the
+/// report reads them.
+pub const CSV_COLUMNS: [&str; 8] = [
+    "i",
+    "j",
+    "x",
+    "z",
+    "depth_missed_mm",
+    "width_mm",
+    "resolving_pitch_mm",
+    "met_angles_deg",
+];
+
 /// One grid cell in which the mesh sticks out past the cell's sampled
 /// corners by more than the threshold.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]

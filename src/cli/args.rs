@@ -270,15 +270,22 @@ impl StartArgs {
     }
 }
 
-/// `kneeform verify`.
+/// What `verify` and `converge` compare: a part, a setup, starts.
 #[derive(Debug, Args)]
-pub struct VerifyArgs {
+pub struct StudyArgs {
     #[command(flatten)]
     pub part: PartArgs,
     #[command(flatten)]
     pub setup: SetupArgs,
     #[command(flatten)]
     pub starts: StartArgs,
+}
+
+/// `kneeform verify`.
+#[derive(Debug, Args)]
+pub struct VerifyArgs {
+    #[command(flatten)]
+    pub study: StudyArgs,
     /// Largest error allowed for every decided metric (mm): push, first
     /// contact, miss, false alarm and the area distance, over decided
     /// strikes.
@@ -293,11 +300,7 @@ pub struct VerifyArgs {
 #[derive(Debug, Args)]
 pub struct ConvergeArgs {
     #[command(flatten)]
-    pub part: PartArgs,
-    #[command(flatten)]
-    pub setup: SetupArgs,
-    #[command(flatten)]
-    pub starts: StartArgs,
+    pub study: StudyArgs,
     /// Pitches to compare (mm), each dividing the coarsest so that grids
     /// nest, e.g. 8,4,2,1,0.5. Overrides --pitch.
     #[arg(long, default_value = "8,4,2,1", value_name = "MM,MM,...")]

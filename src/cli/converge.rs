@@ -30,11 +30,11 @@ pub fn parse_pitches(s: &str) -> anyhow::Result<Vec<f64>> {
 pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
     let options = ConvergeOptions {
         pitches: parse_pitches(&args.pitches)?,
-        selection: args.starts.validate()?,
-        tie_band_per_mm: args.starts.tie_band,
+        selection: args.study.starts.validate()?,
+        tie_band_per_mm: args.study.starts.tie_band,
         tolerance: args.tolerance,
     };
-    let (input, setup) = super::study_inputs(&args.part, &args.setup, options.validate())?;
+    let (input, setup) = super::study_inputs(&args.study, options.validate())?;
     let study = harness::converge(&input, &setup, &options, &Bars::default())
         .map_err(super::harness_error)?;
     eprintln!(

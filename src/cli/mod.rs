@@ -16,7 +16,7 @@ use kneeform::harness::HarnessError;
 use kneeform::report::ReportOptions;
 use kneeform::{PartFile, Setup};
 
-use args::{PartArgs, SetupArgs};
+use args::StudyArgs;
 
 /// Writes the report of `options` to `out` and says so on stderr, naming
 /// the file `shown_as` (where it will be once staged files are moved):
@@ -42,10 +42,10 @@ pub fn write_report(options: &ReportOptions, out: &Path, shown_as: &Path) -> any
 /// The start `verify` and `converge` share: every flag checked (the
 /// command's own options by `check`), the thread pool sized, the part read.
 pub fn study_inputs(
-    part: &PartArgs,
-    setup: &SetupArgs,
+    study: &StudyArgs,
     check: Result<(), HarnessError>,
 ) -> anyhow::Result<(PartFile, Setup)> {
+    let (part, setup) = (&study.part, &study.setup);
     part.validate()?;
     anyhow::ensure!(
         setup.pitch != args::PitchArg::Auto,

@@ -43,11 +43,11 @@ fn resolving_pitch(pitch: f64, tolerance: f64, metric: &str, value: f64) -> Stri
 
 pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
     let options = VerifyOptions {
-        selection: args.starts.validate()?,
-        tie_band_per_mm: args.starts.tie_band,
+        selection: args.study.starts.validate()?,
+        tie_band_per_mm: args.study.starts.tie_band,
         tolerance: args.tolerance,
     };
-    let (input, setup) = super::study_inputs(&args.part, &args.setup, options.validate())?;
+    let (input, setup) = super::study_inputs(&args.study, options.validate())?;
     let result = harness::verify(&input, &setup, &options, &Bars::default())
         .map_err(super::harness_error)?;
     output::write_verification(&args.out, &result)?;

@@ -29,12 +29,12 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::compare::{CompareOptions, StartSelection, compare_grid};
+use super::compare::StartSelection;
+use super::converge::Ladder;
 use super::nearest::PointSet;
-use super::verify::{oracle_options, run_oracle, start_positions};
 use super::{HarnessError, TieBand};
 use crate::analysis::{Progress, Setup};
-use crate::engine::{AngleMask, EngineOptions, colliding_masks};
+use crate::engine::AngleMask;
 use crate::grid::{BYTES_PER_NODE, GridSpec, HeightGrid};
 use crate::mesh::PartFile;
 
@@ -122,42 +122,21 @@ pub fn choose_pitch(
         .map(|k| p0 / f64::from(1u32 << k))
         .collect();
     let angles = study_angles(&setup.angles);
-    let study_setup = |pitch: f64| Setup {
-        pitch,
-        angles: angles.clone(),
-        ..setup.clone()
-    };
-    let coarse_setup = study_setup(p0);
-    coarse_setup.validate()?;
-    let triangles = &input.part.triangles;
-    let coarse = coarse_setup.grid_spec(&input.part.bbox())?;
-    let spec_at = |p: f64| {
-        let r = (p0 / p).round() as usize;
-        GridSpec::explicit(
-            coarse.x(0),
-            coarse.z(0),
-            (coarse.nx - 1) * r + 1,
-            (coarse.nz - 1) * r + 1,
-            p,
-        )
-    };
-    let coarse_grid = HeightGrid::sample(triangles, coarse);
-    let starts = start_positions(
-        &coarse_grid,
-        &coarse_setup.footprints(&coarse),
+    let ladder = Ladder::new(
+        input,
+        &Setup {
+            pitch: p0,
+            angles: angles.clone(),
+            ..setup.clone()
+        },
+        pitches[pitches.len() - 1],
         &StartSelection::Sample {
             count: auto.starts,
             seed: 1,
         },
+        TieBand::DEFAULT_PER_MM,
+        progress,
     )?;
-    drop(coarse_grid);
-    let oracle = oracle_options(&setup.knee, pitches[pitches.len() - 1], coarse.x(0));
-    let (traces, _) = run_oracle(triangles, &starts, &angles, &oracle, progress)?;
-    let compare = CompareOptions {
-        knee: setup.knee,
-        rule: setup.rule,
-        tie_band_per_mm: TieBand::DEFAULT_PER_MM,
-    };
     let scale = setup.angles.len() as f64 / angles.len() as f64;
     let memory = |spec: &GridSpec| spec.nx as f64 * spec.nz as f64 * BYTES_PER_NODE;
 
@@ -165,7 +144,7 @@ pub fn choose_pitch(
     // The struck points per angle at the previous (coarser) pitch.
     let mut previous: Option<Vec<Vec<[f64; 2]>>> = None;
     for &p in &pitches {
-        let spec = spec_at(p);
+        let spec = ladder.spec_at(p);
         let need = memory(&spec);
         // Cost grows as p^-3 (nodes p^-2, footprint rows p^-1).
         let predicted_here = rows.last().map_or(0.0, |r| r.predicted_s * 8.0);
@@ -177,28 +156,11 @@ pub fn choose_pitch(
                 memory_gib: need / f64::from(1u32 << 30),
                 budget_s: auto.budget_s,
                 max_memory_gib: setup.max_memory_bytes / f64::from(1u32 << 30),
+                studied: studied(&rows),
             });
         }
-        progress.begin(
-            &format!("pitch study: {p} mm, {} x {} grid", spec.nx, spec.nz),
-            None,
-        );
-        let t = Instant::now();
-        let grid = HeightGrid::sample(triangles, spec);
-        let footprints = study_setup(p).footprints(&spec);
-        let masks = colliding_masks(
-            &grid,
-            &footprints,
-            &EngineOptions {
-                rule: setup.rule,
-                ..EngineOptions::default()
-            },
-            &|| {},
-        );
-        let seconds = t.elapsed().as_secs_f64();
-        let comparison = compare_grid(&grid, &footprints, &starts, &traces, &compare);
-        progress.end();
-        let comparison = comparison?;
+        let (result, masks, grid) = ladder.measure(p, progress)?;
+        let (comparison, seconds) = (&result.comparison, result.seconds);
         let decided = comparison.stat("area_distance_decided").max;
         let finite = comparison
             .area
@@ -227,7 +189,7 @@ pub fn choose_pitch(
                     "the coarsest pitch whose decided area distance to the exact knee-form is within {} mm ({:.3} mm on {} sampled starts at angles {:?})",
                     auto.tolerance,
                     decided,
-                    starts.len(),
+                    ladder.starts.len(),
                     angles
                 ),
             });
@@ -237,7 +199,24 @@ pub fn choose_pitch(
     Err(HarnessError::PitchNotFound {
         tolerance: auto.tolerance,
         finest: pitches[pitches.len() - 1],
+        studied: studied(&rows),
     })
+}
+
+/// The study's exact errors in words: `4 mm: 3.997 mm, 2 mm: ...`.
+fn studied(rows: &[PitchStudyRow]) -> String {
+    let words: Vec<String> = rows
+        .iter()
+        .map(|r| match r.exact_area_distance_mm {
+            Some(d) => format!("{} mm: {d:.3} mm", r.pitch_mm),
+            None => format!("{} mm: infinite (one side strikes nothing)", r.pitch_mm),
+        })
+        .collect();
+    if words.is_empty() {
+        "none measured".into()
+    } else {
+        words.join(", ")
+    }
 }
 
 /// The study's angles: the setup's first, middle and last (distinct).

@@ -15,9 +15,10 @@ use super::verify::{
     tie_band_rule,
 };
 use crate::analysis::{Progress, Setup};
-use crate::engine::{EngineOptions, colliding_masks};
+use crate::engine::{AngleMask, EngineOptions, colliding_masks};
 use crate::grid::{GridSpec, HeightGrid};
-use crate::mesh::PartFile;
+use crate::mesh::{PartFile, Triangle};
+use kneeform_oracle::StartTrace;
 
 /// One pitch of a convergence study.
 #[derive(Debug, Clone)]
@@ -147,6 +148,109 @@ pub struct ConvergeSummary {
     pub seconds: Vec<f64>,
 }
 
+/// Nested grids over the coarsest grid's extent (pitches dividing its
+/// pitch), sharing its starts and the oracle's traces of them: what
+/// [`converge`] and [`super::choose_pitch`] measure at each pitch.
+pub(super) struct Ladder<'a> {
+    triangles: &'a [Triangle],
+    /// The study's setup at the coarsest pitch.
+    setup: Setup,
+    coarse: GridSpec,
+    /// The starts (mm), nodes of every grid of the ladder.
+    pub starts: Vec<[f64; 2]>,
+    traces: Vec<StartTrace>,
+    /// Seconds the oracle took.
+    pub oracle_s: f64,
+    compare: CompareOptions,
+}
+
+impl<'a> Ladder<'a> {
+    /// The coarsest grid of `setup` (its pitch) on `input`, the starts of
+    /// `selection` on it, and their exact traces at `setup`'s angles with
+    /// the oracle resolving `finest` (mm).
+    pub(super) fn new(
+        input: &'a PartFile,
+        setup: &Setup,
+        finest: f64,
+        selection: &StartSelection,
+        tie_band_per_mm: f64,
+        progress: &dyn Progress,
+    ) -> Result<Ladder<'a>, HarnessError> {
+        setup.validate()?;
+        let triangles = &input.part.triangles;
+        let coarse = setup.grid_spec(&input.part.bbox())?;
+        let coarse_grid = HeightGrid::sample(triangles, coarse);
+        let starts = start_positions(&coarse_grid, &setup.footprints(&coarse), selection)?;
+        drop(coarse_grid);
+        let oracle = oracle_options(&setup.knee, finest, coarse.x(0));
+        let (traces, oracle_s) = run_oracle(triangles, &starts, &setup.angles, &oracle, progress)?;
+        Ok(Ladder {
+            triangles,
+            setup: setup.clone(),
+            coarse,
+            starts,
+            traces,
+            oracle_s,
+            compare: CompareOptions {
+                knee: setup.knee,
+                rule: setup.rule,
+                tie_band_per_mm,
+            },
+        })
+    }
+
+    /// The grid at pitch `p`: exactly the coarse grid's extent from its
+    /// origin.
+    pub(super) fn spec_at(&self, p: f64) -> GridSpec {
+        let c = &self.coarse;
+        let r = (c.pitch / p).round() as usize;
+        GridSpec::explicit(c.x(0), c.z(0), (c.nx - 1) * r + 1, (c.nz - 1) * r + 1, p)
+    }
+
+    /// The grid at pitch `p` sampled, the engine timed over the ladder's
+    /// angles, and the comparison on the ladder's starts; with the masks
+    /// and the grid.
+    pub(super) fn measure(
+        &self,
+        p: f64,
+        progress: &dyn Progress,
+    ) -> Result<(PitchResult, Vec<AngleMask>, HeightGrid), HarnessError> {
+        let spec = self.spec_at(p);
+        progress.begin(
+            &format!("pitch {p} mm: {} x {} grid", spec.nx, spec.nz),
+            None,
+        );
+        let grid = HeightGrid::sample(self.triangles, spec);
+        let footprints = self.setup.footprints(&spec);
+        let t = Instant::now();
+        let masks = colliding_masks(
+            &grid,
+            &footprints,
+            &EngineOptions {
+                rule: self.setup.rule,
+                ..EngineOptions::default()
+            },
+            &|| {},
+        );
+        let seconds = t.elapsed().as_secs_f64();
+        let comparison = compare_grid(
+            &grid,
+            &footprints,
+            &self.starts,
+            &self.traces,
+            &self.compare,
+        );
+        progress.end();
+        let result = PitchResult {
+            pitch: p,
+            comparison: comparison?,
+            seconds,
+            nodes: spec.len(),
+        };
+        Ok((result, masks, grid))
+    }
+}
+
 /// How to run a convergence study, beside the analysis [`Setup`] (whose
 /// pitch it ignores).
 #[derive(Debug, Clone, PartialEq)]
@@ -229,74 +333,25 @@ pub fn converge(
 ) -> Result<Convergence, HarnessError> {
     options.validate()?;
     let pitches = &options.pitches;
-    let coarse_setup = Setup {
-        pitch: pitches[0],
-        ..setup.clone()
-    };
-    coarse_setup.validate()?;
-    let triangles = &input.part.triangles;
-    let coarse = coarse_setup.grid_spec(&input.part.bbox())?;
-    // Finer grids cover exactly the coarse grid's extent from its origin.
-    let specs: Vec<GridSpec> = pitches
-        .iter()
-        .map(|&p| {
-            let r = (pitches[0] / p).round() as usize;
-            GridSpec::explicit(
-                coarse.x(0),
-                coarse.z(0),
-                (coarse.nx - 1) * r + 1,
-                (coarse.nz - 1) * r + 1,
-                p,
-            )
-        })
-        .collect();
-    for spec in &specs {
-        spec.check_fits(setup.max_memory_bytes)?;
-    }
-    let coarse_grid = HeightGrid::sample(triangles, coarse);
-    let starts = start_positions(
-        &coarse_grid,
-        &coarse_setup.footprints(&coarse),
+    let ladder = Ladder::new(
+        input,
+        &Setup {
+            pitch: pitches[0],
+            ..setup.clone()
+        },
+        pitches[pitches.len() - 1],
         &options.selection,
+        options.tie_band_per_mm,
+        progress,
     )?;
-    drop(coarse_grid);
-    let finest = pitches[pitches.len() - 1];
-    let oracle = oracle_options(&setup.knee, finest, coarse.x(0));
-    let (traces, oracle_s) = run_oracle(triangles, &starts, &setup.angles, &oracle, progress)?;
-    let compare = CompareOptions {
-        knee: setup.knee,
-        rule: setup.rule,
-        tie_band_per_mm: options.tie_band_per_mm,
-    };
-    let mut results = Vec::new();
-    for (&pitch, spec) in pitches.iter().zip(&specs) {
-        progress.begin(
-            &format!("pitch {pitch} mm: {} x {} grid", spec.nx, spec.nz),
-            None,
-        );
-        let grid = HeightGrid::sample(triangles, *spec);
-        let footprints = setup.footprints(spec);
-        let t = Instant::now();
-        let masks = colliding_masks(
-            &grid,
-            &footprints,
-            &EngineOptions {
-                rule: setup.rule,
-                ..EngineOptions::default()
-            },
-            &|| {},
-        );
-        let seconds = t.elapsed().as_secs_f64();
-        drop(masks);
-        let comparison = compare_grid(&grid, &footprints, &starts, &traces, &compare);
-        progress.end();
-        results.push(PitchResult {
-            pitch,
-            comparison: comparison?,
-            seconds,
-            nodes: spec.len(),
-        });
+    for &p in pitches {
+        ladder.spec_at(p).check_fits(setup.max_memory_bytes)?;
     }
+    let mut results = Vec::new();
+    for &pitch in pitches {
+        results.push(ladder.measure(pitch, progress)?.0);
+    }
+    let (starts, oracle_s) = (&ladder.starts, ladder.oracle_s);
     let fits = fits(&results);
     let recommended = options
         .tolerance

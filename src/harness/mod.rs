@@ -101,7 +101,7 @@ pub enum HarnessError {
     Budget(f64),
     /// The pitch a tolerance needs exceeds the time budget or memory.
     #[error(
-        "a tolerance of {tolerance} mm needs a pitch of {pitch} mm or finer: about {predicted_s:.0} s and {memory_gib:.1} GiB for the analysis, beyond the budget of {budget_s} s or the {max_memory_gib:.1} GiB allowed (raise --budget-s or --max-memory, or accept a larger --tolerance)"
+        "a tolerance of {tolerance} mm needs a pitch of {pitch} mm or finer: about {predicted_s:.0} s and {memory_gib:.1} GiB for the analysis, beyond the budget of {budget_s} s or the {max_memory_gib:.1} GiB allowed (raise --budget-s or --max-memory, or accept a larger --tolerance); decided area distance to the exact knee-form at the pitches studied: {studied}"
     )]
     PitchBudget {
         /// The tolerance (mm).
@@ -116,16 +116,20 @@ pub enum HarnessError {
         budget_s: f64,
         /// The memory limit (GiB).
         max_memory_gib: f64,
+        /// The study so far, in words.
+        studied: String,
     },
     /// No pitch of the study meets the tolerance.
     #[error(
-        "no pitch down to {finest} mm meets a tolerance of {tolerance} mm: the disagreement does not shrink with the pitch here (see the pitch study, and results/README.md on what does not converge)"
+        "no pitch down to {finest} mm meets a tolerance of {tolerance} mm: decided area distance to the exact knee-form {studied} (results/README.md says what does not converge)"
     )]
     PitchNotFound {
         /// The tolerance (mm).
         tolerance: f64,
         /// The finest pitch studied (mm).
         finest: f64,
+        /// The study, in words.
+        studied: String,
     },
     /// A strip of start rows whose bounds are not finite and ordered.
     #[error("a strip of starts needs finite z bounds Z0 <= Z1 (mm), got {0:?}")]

@@ -137,16 +137,7 @@ pub fn write_convergence(dir: &Path, convergence: &Convergence) -> Result<(), Wr
 fn write_blind_spots(path: &Path, analysis: &Analysis) -> Result<(), WriteError> {
     (|| -> csv::Result<()> {
         let mut csv = csv::Writer::from_path(path)?;
-        csv.write_record([
-            "i",
-            "j",
-            "x",
-            "z",
-            "depth_missed_mm",
-            "width_mm",
-            "resolving_pitch_mm",
-            "met_angles_deg",
-        ])?;
+        csv.write_record(crate::blind::CSV_COLUMNS)?;
         for b in &analysis.blind_spots {
             let angles: Vec<String> = b.met_angles_deg.iter().map(f64::to_string).collect();
             csv.write_record([

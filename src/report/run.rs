@@ -237,19 +237,7 @@ fn read_composite(path: &Path, spec: GridSpec) -> Result<NodeCounts, ReportError
 }
 
 fn read_blind_spots(path: &Path, spec: GridSpec) -> Result<Vec<BlindRow>, ReportError> {
-    let mut rows = CsvRows::open(
-        path,
-        &[
-            "i",
-            "j",
-            "x",
-            "z",
-            "depth_missed_mm",
-            "width_mm",
-            "resolving_pitch_mm",
-            "met_angles_deg",
-        ],
-    )?;
+    let mut rows = CsvRows::open(path, &crate::blind::CSV_COLUMNS)?;
     let mut out = Vec::new();
     while let Some(row) = rows.next_row()? {
         let (i, j): (usize, usize) = (rows.parse(&row, 0)?, rows.parse(&row, 1)?);
