@@ -12,14 +12,15 @@
 
 use std::time::Instant;
 
+use crate::assembly::{PartSource, colliding_nodes_per_file};
 use crate::blind::{BlindSpot, blind_spots};
 use crate::engine::{Algorithm, AngleMask, EngineOptions, Probe, colliding_masks, composite};
 use crate::grid::{GridError, GridSpec, HeightGrid};
 use crate::kneeform::{Footprint, GridFootprint, KneeForm};
-use crate::mesh::{Bbox, MeshError, PartFile, read_part};
+use crate::mesh::{Bbox, MeshError, PartFile};
 use crate::sanity::{self, Warning};
 use crate::strike::StrikeRule;
-use crate::summary::{AngleSummary, Summary, Timings};
+use crate::summary::{AngleSummary, FileSummary, Summary, Timings};
 
 /// Where the grid lies.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -280,6 +281,10 @@ pub struct Analysis {
     pub grid: HeightGrid,
     /// The footprints, laid on `grid`, in the order of `setup.angles`.
     pub footprints: Vec<GridFootprint>,
+    /// For an assembly ([`crate::assembly`]): per grid node, the index
+    /// (into the assembly's files) of the file whose surface set its
+    /// height, the lowest index on a tie; `None` for one file.
+    pub node_file: Option<Vec<u32>>,
     /// The colliding mask per angle, in the order of `setup.angles`.
     pub masks: Vec<AngleMask>,
     /// Per node, the number of angles at which it collides.
@@ -297,7 +302,7 @@ pub struct Analysis {
 }
 
 impl Analysis {
-    /// Reads the part at `path` ([`read_part`]) and analyses it.
+    /// Reads the part at `path` ([`crate::read_part`]) and analyses it.
     pub fn of_file(
         path: &std::path::Path,
         scale: f64,
@@ -305,7 +310,18 @@ impl Analysis {
         setup: &Setup,
         progress: &dyn Progress,
     ) -> Result<Analysis, AnalysisError> {
+        Analysis::of_source(&PartSource::file(path, scale, side.into()), setup, progress)
+    }
+
+    /// Reads the part's file or files ([`PartSource::read`]: a frame, an
+    /// assembly, files disregarded) and analyses it.
+    pub fn of_source(
+        source: &PartSource,
+        setup: &Setup,
+        progress: &dyn Progress,
+    ) -> Result<Analysis, AnalysisError> {
         setup.validate()?;
+        let scale = source.scale;
         if !(scale.is_finite() && scale > 0.0) {
             return Err(SetupError::NotPositive {
                 field: "scale",
@@ -318,7 +334,7 @@ impl Analysis {
             progress.warn(w);
         }
         let t = Instant::now();
-        let input = read_part(path, scale, side)?;
+        let input = source.read()?;
         let read_s = t.elapsed().as_secs_f64();
         let mut analysis = Analysis::run_checked(input, setup, progress, angle_warnings)?;
         analysis.timings.read_s = read_s;
@@ -354,7 +370,16 @@ impl Analysis {
 
         let t = Instant::now();
         let spec = setup.grid_spec(&input.part.bbox())?;
-        let grid = HeightGrid::sample(&input.part.triangles, spec);
+        // An assembly's grid is the same heights, each node tagged with
+        // the file that set it.
+        let (grid, node_file) = match &input.assembly {
+            None => (HeightGrid::sample(&input.part.triangles, spec), None),
+            Some(a) => {
+                let (grid, files) =
+                    HeightGrid::sample_attributed(&input.part.triangles, &a.file_of, spec);
+                (grid, Some(files))
+            }
+        };
         let footprints = setup.footprints(&spec);
         let sample_s = t.elapsed().as_secs_f64();
 
@@ -397,6 +422,7 @@ impl Analysis {
             input,
             setup: setup.clone(),
             grid,
+            node_file,
             footprints,
             masks,
             composite,
@@ -432,25 +458,51 @@ impl Analysis {
         let spec = self.grid.spec;
         let area = spec.pitch * spec.pitch;
         let part = &self.input.part;
-        let bbox = part.bbox();
-        // Back to the part's frame: a mirrored side swaps the y bounds.
         let side = self.input.side;
-        let (y0, y1) = (side.to_part(bbox.min[1]), side.to_part(bbox.max[1]));
+        let (bbox_min, bbox_max) = self.part_bbox();
         let composite_nodes = self.composite_nodes();
         let setup = &self.setup;
+        let (input_file, files) = match (&self.input.assembly, &self.node_file) {
+            (Some(assembly), Some(node_file)) => {
+                let nodes = colliding_nodes_per_file(assembly, node_file, &self.composite);
+                let files: Vec<FileSummary> = assembly
+                    .files
+                    .iter()
+                    .zip(nodes)
+                    .map(|(f, nodes)| FileSummary {
+                        path: f.path.display().to_string(),
+                        sha256: f.sha256.clone(),
+                        triangles: f.triangles,
+                        degenerate_triangles: f.degenerate,
+                        ignored: f.ignored,
+                        colliding_nodes: nodes,
+                        colliding_area_mm2: nodes as f64 * area,
+                    })
+                    .collect();
+                let names: Vec<&str> = files
+                    .iter()
+                    .filter(|f| !f.ignored)
+                    .map(|f| f.path.as_str())
+                    .collect();
+                (names.join(" + "), files)
+            }
+            _ => (self.input.path.display().to_string(), Vec::new()),
+        };
         Summary {
             kneeform_version: env!("CARGO_PKG_VERSION").into(),
             run_unix_time: std::time::SystemTime::now()
                 .duration_since(std::time::UNIX_EPOCH)
                 .map_or(0, |d| d.as_secs()),
-            input_file: self.input.path.display().to_string(),
+            input_file,
             sha256: self.input.sha256.clone(),
+            files,
             triangles: part.file_triangles,
             degenerate_triangles: part.degenerate,
-            bbox_min: [bbox.min[0], y0.min(y1), bbox.min[2]],
-            bbox_max: [bbox.max[0], y0.max(y1), bbox.max[2]],
+            bbox_min,
+            bbox_max,
             scale: self.input.scale,
             side,
+            frame: self.input.frame.record(),
             triangle_side_mm: setup.knee.triangle_side,
             triangle_side_assumed: setup.knee.triangle_side == KneeForm::default().triangle_side,
             radius_mm: setup.knee.radius,
@@ -489,6 +541,34 @@ impl Analysis {
             timings: self.timings.clone(),
             warnings: self.warnings.iter().map(ToString::to_string).collect(),
         }
+    }
+}
+
+impl Analysis {
+    /// The part's bounding box in its own frame (mm), smallest and largest
+    /// corner.
+    fn part_bbox(&self) -> ([f64; 3], [f64; 3]) {
+        let part = &self.input.part;
+        if self.input.frame.is_none() {
+            // A mirrored side only swaps the y bounds.
+            let bbox = part.bbox();
+            let side = self.input.side;
+            let (y0, y1) = (side.to_part(bbox.min[1]), side.to_part(bbox.max[1]));
+            return (
+                [bbox.min[0], y0.min(y1), bbox.min[2]],
+                [bbox.max[0], y0.max(y1), bbox.max[2]],
+            );
+        }
+        // A rotation does not map boxes to boxes: map every vertex back.
+        let placement = self.input.placement();
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for &v in part.triangles.iter().flatten() {
+            for (k, c) in placement.to_part(v).into_iter().enumerate() {
+                lo[k] = lo[k].min(c);
+                hi[k] = hi[k].max(c);
+            }
+        }
+        (lo, hi)
     }
 }
 

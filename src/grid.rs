@@ -163,6 +163,31 @@ impl HeightGrid {
         HeightGrid { spec, h }
     }
 
+    /// [`HeightGrid::sample`], and per node the tag (`tags[k]` of triangle
+    /// `k`: an assembly's file index) of the triangle that set its height;
+    /// of equal heights, the first triangle's. The heights are
+    /// [`HeightGrid::sample`]'s to the bit; the tag is 0 where the height is
+    /// `+inf`.
+    pub fn sample_attributed(
+        triangles: &[Triangle],
+        tags: &[u32],
+        spec: GridSpec,
+    ) -> (HeightGrid, Vec<u32>) {
+        assert_eq!(triangles.len(), tags.len(), "one tag per triangle");
+        let index: Vec<u32> = (0..triangles.len() as u32).collect();
+        let buffer = zbuffer(&spec, &index, |&k| {
+            let t = &triangles[k as usize];
+            (t.map(|v| [v[0], v[2], v[1]]), tags[k as usize])
+        });
+        (
+            HeightGrid {
+                spec,
+                h: buffer.depth,
+            },
+            buffer.tag,
+        )
+    }
+
     /// The height at node `(i, j)`.
     pub fn at(&self, i: usize, j: usize) -> f64 {
         self.h[j * self.spec.nx + i]
@@ -263,6 +288,19 @@ mod tests {
         assert_eq!(g.at(2, 2), 1.0); // on the hypotenuse: closed triangle
         assert_eq!(g.at(3, 2), f64::INFINITY);
         assert_eq!(g.at(5, 5), f64::INFINITY);
+    }
+
+    #[test]
+    fn attribution_names_the_lowest_triangle_and_the_first_of_a_tie() {
+        let tri = |y: f64| [[0.0, y, 0.0], [4.0, y, 0.0], [0.0, y, 4.0]];
+        let far = [[0.0, 9.0, 0.0], [6.0, 9.0, 0.0], [0.0, 9.0, 6.0]];
+        let tris = [tri(3.0), tri(1.0), tri(1.0), far];
+        let (g, tag) = HeightGrid::sample_attributed(&tris, &[7, 5, 2, 4], spec(7, 7, 1.0));
+        assert_eq!(g.h, HeightGrid::sample(&tris, spec(7, 7, 1.0)).h);
+        // Triangles 1 and 2 tie at y = 1: the first (tag 5) keeps the node.
+        assert_eq!((g.at(0, 0), tag[0]), (1.0, 5));
+        // Only the far triangle covers (5, 0).
+        assert_eq!((g.at(5, 0), tag[5]), (9.0, 4));
     }
 
     #[test]

@@ -4,7 +4,8 @@
 //! The pipeline, each step named as in SPEC.md and the paper:
 //!
 //! * [`mesh`]: STL in, triangles in the analysis frame (mm, knee pushed in
-//!   +y, sliding in -x);
+//!   +y, sliding in -x); [`frame`]: parts in other coordinates
+//!   (`--frame`); [`assembly`]: several files as one part;
 //! * [`grid`]: step 1, the height grid (an orthographic depth buffer);
 //! * [`kneeform`]: the knee-form, its footprint per angle and row intervals;
 //! * [`push`] and [`slide`]: step 2, the fast path; [`paper`]: the
@@ -39,8 +40,10 @@
 //! ```
 
 pub mod analysis;
+pub mod assembly;
 pub mod blind;
 pub mod engine;
+pub mod frame;
 pub mod grid;
 pub mod harness;
 pub mod kneeform;
@@ -59,7 +62,9 @@ pub mod summary;
 mod zbuffer;
 
 pub use analysis::{Analysis, AnalysisError, GridPlacement, Progress, Setup, SetupError, Status};
+pub use assembly::PartSource;
 pub use engine::{Algorithm, AngleMask, EngineOptions, colliding_masks, composite, push_levels};
+pub use frame::{Frame, Placement};
 pub use grid::{GridSpec, HeightGrid};
 pub use kneeform::{Footprint, GridFootprint, KneeForm};
 pub use mesh::{Part, PartFile, Side, read_part};

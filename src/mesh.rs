@@ -9,6 +9,9 @@ use std::path::{Path, PathBuf};
 
 use sha2::Digest;
 
+use crate::assembly::Assembly;
+use crate::frame::{Frame, Placement};
+
 /// One triangle, three vertices (x, y, z) in mm.
 pub type Triangle = [[f64; 3]; 3];
 
@@ -71,6 +74,9 @@ pub enum MeshError {
     /// A scenario file could not be read or tessellated.
     #[error(transparent)]
     Scenario(#[from] crate::scenario::ScenarioError),
+    /// The files of an assembly cannot be read as one part.
+    #[error(transparent)]
+    Assembly(#[from] crate::assembly::AssemblyError),
     /// Every triangle is degenerate.
     #[error("{path}: all {count} triangles are degenerate (zero area)")]
     AllDegenerate {
@@ -105,6 +111,14 @@ pub struct PartFile {
     /// The side the part was read for (mirrored into the analysis frame
     /// for [`Side::Right`]).
     pub side: Side,
+    /// The map from the file's coordinates into vehicle coordinates
+    /// (`--frame`; none for a part already in them), applied before the
+    /// side's mirror: [`crate::frame`].
+    pub frame: Frame,
+    /// For a part read from several files ([`crate::assembly`]): every
+    /// file, and which file each triangle of `part` came from; `None` for
+    /// one file.
+    pub assembly: Option<Assembly>,
     /// The part, in mm and the analysis frame.
     pub part: Part,
 }
@@ -120,7 +134,18 @@ impl PartFile {
             sha256: String::new(),
             scale: 1.0,
             side: Side::Left,
+            frame: Frame::none(),
+            assembly: None,
             part,
+        }
+    }
+
+    /// How the file's coordinates map into the analysis frame: its frame,
+    /// then its side.
+    pub fn placement(&self) -> Placement {
+        Placement {
+            side: self.side,
+            frame: self.frame.clone(),
         }
     }
 }
@@ -143,6 +168,26 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
         .iter()
         .map(|b| format!("{b:02x}"))
         .collect()
+}
+
+/// [`read_part`] into a [`Placement`]: the file's coordinates (mm, after
+/// `scale`) mapped by its frame, then its side. Without a frame this is
+/// `read_part` itself, to the bit.
+pub fn read_part_placed(
+    path: &Path,
+    scale: f64,
+    placement: &Placement,
+) -> Result<PartFile, MeshError> {
+    if placement.frame.is_none() {
+        return read_part(path, scale, placement.side);
+    }
+    let mut file = read_part(path, scale, Side::Left)?;
+    for v in file.part.triangles.iter_mut().flatten() {
+        *v = placement.to_analysis(*v);
+    }
+    file.side = placement.side;
+    file.frame = placement.frame.clone();
+    Ok(file)
 }
 
 /// [`read_part`] of bytes already read from `path`.
@@ -170,6 +215,8 @@ pub fn read_part_bytes(
         sha256,
         scale,
         side,
+        frame: Frame::none(),
+        assembly: None,
         part,
     })
 }

@@ -16,6 +16,28 @@ pub struct AngleSummary {
     pub colliding_area_mm2: f64,
 }
 
+/// One file of an assembly ([`crate::assembly`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FileSummary {
+    /// The file as given.
+    pub path: String,
+    /// SHA-256 of its bytes (hex).
+    pub sha256: String,
+    /// Triangles in the file.
+    pub triangles: usize,
+    /// Of those, skipped for zero area.
+    pub degenerate_triangles: usize,
+    /// Disregarded by the regulation (`--ignore`: softer than 50 Shore
+    /// A): not in the height grid, so it never collides.
+    pub ignored: bool,
+    /// Composite nodes whose height this file's surface set (the lowest
+    /// file index where two files set the same height): the `file` column
+    /// of the CSV files.
+    pub colliding_nodes: usize,
+    /// Their area, `colliding_nodes * pitch^2` (mm^2).
+    pub colliding_area_mm2: f64,
+}
+
 /// Wall-clock time per stage (seconds).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Timings {
@@ -44,8 +66,14 @@ pub struct Summary {
     pub run_unix_time: u64,
     /// The part file as given.
     pub input_file: String,
-    /// SHA-256 of the part file's bytes (hex).
+    /// SHA-256 of the part file's bytes (hex); empty for an assembly,
+    /// whose files are in `files`.
     pub sha256: String,
+    /// An assembly's files (`analyze a.stl b.stl`, or any `--ignore`), in
+    /// order: each one's path, SHA-256 and colliding area. Absent for one
+    /// file.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub files: Vec<FileSummary>,
     /// Triangles in the file.
     pub triangles: usize,
     /// Triangles skipped for zero area.
@@ -58,6 +86,11 @@ pub struct Summary {
     pub scale: f64,
     /// `left` or `right`.
     pub side: crate::Side,
+    /// `--frame`: the map from the part's coordinates into vehicle
+    /// coordinates, applied before the side's mirror. Absent without one
+    /// (the part is in vehicle coordinates).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame: Option<crate::frame::FrameRecord>,
     /// Knee-form triangle side L (mm).
     pub triangle_side_mm: f64,
     /// True when L is the assumed default of 200 mm.

@@ -18,7 +18,7 @@ use super::progress::Bars;
 pub const REPORT_FAILED: u8 = 3;
 
 pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
-    args.part.validate()?;
+    let source = args.part.validate(&args.parts, &args.ignore)?;
     let (mut setup, threads) = args.setup.validate()?;
     let auto = args.setup.pitch == PitchArg::Auto;
     let auto_pitch = match (auto, args.tolerance) {
@@ -40,7 +40,7 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
     let bars = Bars::default();
     let mut choice = None;
     if let Some(auto) = &auto_pitch {
-        let input = kneeform::read_part(&args.part.part, args.part.scale, args.part.side)?;
+        let input = source.read()?;
         let chosen =
             harness::choose_pitch(&input, &setup, auto, &bars).map_err(super::harness_error)?;
         for row in &chosen.study {
@@ -66,13 +66,7 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         setup.pitch = chosen.pitch_mm;
         choice = Some(chosen);
     }
-    let mut analysis = Analysis::of_file(
-        &args.part.part,
-        args.part.scale,
-        args.part.side,
-        &setup,
-        &bars,
-    )?;
+    let mut analysis = Analysis::of_source(&source, &setup, &bars)?;
     analysis.pitch_choice = choice;
     let summary = output::write_analysis(&out, &analysis)?;
     out.commit()
@@ -104,7 +98,9 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         // From the committed run, so the analysis stands whatever the
         // report meets; report.html itself appears whole or not at all.
         let options = kneeform::report::ReportOptions {
-            part: Some(args.part.part.clone()),
+            // One file: the one just analysed; an assembly's files are
+            // found from summary.json.
+            part: source.is_single().then(|| args.parts[0].clone()),
             ..kneeform::report::ReportOptions::new(&args.out)
         };
         let report = args.out.join("report.html");

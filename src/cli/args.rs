@@ -6,7 +6,10 @@ use std::path::PathBuf;
 use anyhow::{Context, ensure};
 use clap::{Args, Parser, Subcommand};
 use kneeform::strike::RateEstimate;
-use kneeform::{Algorithm, GridPlacement, KneeForm, Setup, SetupError, Side, StrikeRule};
+use kneeform::{
+    Algorithm, Frame, GridPlacement, KneeForm, PartSource, Placement, Setup, SetupError, Side,
+    StrikeRule,
+};
 
 /// UN Regulation No. 21 knee-form inspection: which areas of an interior
 /// part a sliding knee-form strikes (push-and-slide on a height grid, after
@@ -42,20 +45,31 @@ pub enum Command {
     Report(ReportArgs),
 }
 
-/// The part and how to read it.
+/// How to read the part's files: units, frame and side.
 #[derive(Debug, Args)]
 pub struct PartArgs {
-    /// The part: an STL file (binary or ASCII), or a scenario file
-    /// (`scenarios/*.toml`, tessellated on the fly).
-    pub part: PathBuf,
     /// Factor taking the file's units to mm (e.g. 1000 for metres).
     #[arg(long, default_value_t = 1.0, value_name = "FACTOR")]
     pub scale: f64,
     /// Side of the vehicle the analysed surface is on: `left` faces -y (the
     /// knee is pushed in +y); `right` faces +y and is mirrored y -> -y for
-    /// the analysis, results are mirrored back.
+    /// the analysis, results are mirrored back. With --frame, the side is
+    /// applied after the frame, in vehicle coordinates.
     #[arg(long, value_enum, default_value_t = Side::Left)]
     pub side: Side,
+    /// The part's axes in vehicle coordinates (front -x, z up), for a part
+    /// not modelled in them: three signed part axes, one per vehicle axis
+    /// x, y, z (`x,-z,y`: vehicle x is the part's x, vehicle y its -z,
+    /// vehicle z its y), or @FILE holding a 4x4 or 3x4 rigid transform
+    /// (row by row; part coordinates in mm, after --scale, to vehicle
+    /// coordinates). A proper rotation only (orthonormal, determinant +1,
+    /// within 1e-9): a mirror is --side right. The part is mapped by the
+    /// frame first, then mirrored by --side; every result (CSV, STL, PLY,
+    /// summary's bounding box) is mapped back to the part's own
+    /// coordinates; the images and the report are drawn in vehicle
+    /// coordinates.
+    #[arg(long, value_name = "AXES|@FILE", allow_hyphen_values = true)]
+    pub frame: Option<String>,
 }
 
 /// `--pitch`: a length, or `auto`.
@@ -174,6 +188,20 @@ pub struct SetupArgs {
 /// `kneeform analyze`.
 #[derive(Debug, Args)]
 pub struct AnalyzeArgs {
+    /// The part: an STL file (binary or ASCII), or a scenario file
+    /// (`scenarios/*.toml`, tessellated on the fly). Several files are
+    /// analysed as one part (an assembly): each colliding node is
+    /// attributed to the file whose surface set its height (the first
+    /// file given where two set the same height), in summary.json, the
+    /// CSV files' `file` column and the report.
+    #[arg(required = true, value_name = "PART")]
+    pub parts: Vec<PathBuf>,
+    /// A file of the assembly that the regulation disregards (a material
+    /// softer than 50 Shore A): identified in summary.json (path, SHA-256)
+    /// but kept out of the height grid, so the knee-form passes through
+    /// it. Repeatable; it may also be among the PART files.
+    #[arg(long, value_name = "FILE")]
+    pub ignore: Vec<PathBuf>,
     #[command(flatten)]
     pub part: PartArgs,
     #[command(flatten)]
@@ -273,6 +301,11 @@ impl StartArgs {
 /// What `verify` and `converge` compare: a part, a setup, starts.
 #[derive(Debug, Args)]
 pub struct StudyArgs {
+    /// The part: an STL file (binary or ASCII), or a scenario file
+    /// (`scenarios/*.toml`, tessellated on the fly). One file: an
+    /// assembly is analysed with `analyze`.
+    #[arg(value_name = "PART")]
+    pub path: PathBuf,
     #[command(flatten)]
     pub part: PartArgs,
     #[command(flatten)]
@@ -407,14 +440,27 @@ pub fn with_flag(err: SetupError) -> anyhow::Error {
 }
 
 impl PartArgs {
-    /// Validates the flags.
-    pub fn validate(&self) -> anyhow::Result<()> {
+    /// Validates the flags into where the part's files are read from:
+    /// `files`, less `ignored`, scaled, framed and sided.
+    pub fn validate(&self, files: &[PathBuf], ignored: &[PathBuf]) -> anyhow::Result<PartSource> {
         ensure!(
             self.scale.is_finite() && self.scale > 0.0,
             "--scale must be a finite number > 0, got {}",
             self.scale
         );
-        Ok(())
+        let frame = match &self.frame {
+            None => Frame::none(),
+            Some(value) => Frame::parse(value).context("--frame")?,
+        };
+        Ok(PartSource {
+            files: files.to_vec(),
+            ignored: ignored.to_vec(),
+            scale: self.scale,
+            placement: Placement {
+                side: self.side,
+                frame,
+            },
+        })
     }
 }
 

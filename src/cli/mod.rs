@@ -46,7 +46,7 @@ pub fn study_inputs(
     check: Result<(), HarnessError>,
 ) -> anyhow::Result<(PartFile, Setup)> {
     let (part, setup) = (&study.part, &study.setup);
-    part.validate()?;
+    let source = part.validate(std::slice::from_ref(&study.path), &[])?;
     anyhow::ensure!(
         setup.pitch != args::PitchArg::Auto,
         "--pitch auto is for analyze: give verify and converge a pitch (mm)"
@@ -54,7 +54,7 @@ pub fn study_inputs(
     let (setup, threads) = setup.validate()?;
     check.map_err(harness_error)?;
     set_threads(threads)?;
-    let input = kneeform::read_part(&part.part, part.scale, part.side)?;
+    let input = source.read()?;
     Ok((input, setup))
 }
 

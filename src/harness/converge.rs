@@ -115,6 +115,10 @@ pub struct ConvergeSummary {
     /// `left` or `right`.
     #[serde(default = "super::verify::left_side")]
     pub side: crate::Side,
+    /// `--frame`: the map from the part's coordinates into vehicle
+    /// coordinates; absent without one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame: Option<crate::frame::FrameRecord>,
     /// Knee-form L, R, W (mm).
     #[serde(default)]
     pub knee_form_mm: [f64; 3],
@@ -363,6 +367,7 @@ pub fn converge(
         input_sha256: input.sha256.clone(),
         scale: input.scale,
         side: input.side,
+        frame: input.frame.record(),
         knee_form_mm: [
             setup.knee.triangle_side,
             setup.knee.radius,

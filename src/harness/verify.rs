@@ -212,6 +212,7 @@ impl VerifySummary {
             input_sha256: input.sha256.clone(),
             scale: input.scale,
             side: input.side,
+            frame: input.frame.record(),
             pitch_mm: setup.pitch,
             tolerance_mm: options.tolerance,
             pass: comparison.passes(options.tolerance),
@@ -295,6 +296,10 @@ pub struct VerifySummary {
     /// `left` or `right`.
     #[serde(default = "left_side")]
     pub side: crate::Side,
+    /// `--frame`: the map from the part's coordinates into vehicle
+    /// coordinates; absent without one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame: Option<crate::frame::FrameRecord>,
     /// Grid pitch (mm).
     pub pitch_mm: f64,
     /// The tolerance every metric's max is held to (mm).

@@ -13,14 +13,15 @@
 
 use std::io::{self, Write};
 
+use crate::frame::Placement;
 use crate::grid::HeightGrid;
-use crate::mesh::Side;
 
 use super::count_colour;
 use super::surface::{AreaSurface, to_part, wound};
 
 /// Writes the composite area (nodes with `composite > 0`) as an ASCII PLY
-/// mesh in the part's coordinates (mm; vertex `(x, side.to_part(h), z)`),
+/// mesh in the part's coordinates (mm; vertex `(x, h, z)` mapped back by
+/// [`Placement::to_part`]),
 /// faces wound towards the knee, every vertex coloured by its node's count
 /// of `n_angles`. Returns the number of faces written.
 ///
@@ -31,7 +32,7 @@ pub fn write_colliding_area_ply<W: Write>(
     grid: &HeightGrid,
     composite: &[u16],
     n_angles: usize,
-    side: Side,
+    placement: &Placement,
 ) -> io::Result<usize> {
     let mesh = AreaSurface::new(grid, composite)?;
     let max_count = composite.iter().copied().max().unwrap_or(0);
@@ -55,7 +56,7 @@ pub fn write_colliding_area_ply<W: Write>(
     writeln!(w, "property list uchar int vertex_indices")?;
     writeln!(w, "end_header")?;
     for &(v, count) in &mesh.vertices {
-        let [x, y, z] = to_part(v, side);
+        let [x, y, z] = to_part(v, placement);
         let c = count_colour(usize::from(count), n);
         // -0 is written as 0, as in the CSV files: mirroring a zero height
         // must not change the file.
@@ -72,7 +73,7 @@ pub fn write_colliding_area_ply<W: Write>(
         )?;
     }
     for &f in &mesh.faces {
-        let [a, b, c] = wound(f, side);
+        let [a, b, c] = wound(f, placement.side);
         writeln!(w, "3 {a} {b} {c}")?;
     }
     w.flush()?;
@@ -82,6 +83,7 @@ pub fn write_colliding_area_ply<W: Write>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::Side;
 
     fn grid() -> HeightGrid {
         crate::output::surface::test_grid(3)
@@ -103,7 +105,8 @@ mod tests {
         composite[4] = 3;
         composite[8] = 3;
         let mut out = Vec::new();
-        let faces = write_colliding_area_ply(&mut out, &g, &composite, 3, Side::Left).unwrap();
+        let faces =
+            write_colliding_area_ply(&mut out, &g, &composite, 3, &Side::Left.into()).unwrap();
         let text = String::from_utf8(out).unwrap();
         assert!(text.starts_with("ply\nformat ascii 1.0\n"));
         assert!(text.contains("element vertex 8\n"), "{text}");
@@ -128,8 +131,8 @@ mod tests {
         let composite = vec![1u16; 9];
         let mut left = Vec::new();
         let mut right = Vec::new();
-        write_colliding_area_ply(&mut left, &g, &composite, 1, Side::Left).unwrap();
-        write_colliding_area_ply(&mut right, &g, &composite, 1, Side::Right).unwrap();
+        write_colliding_area_ply(&mut left, &g, &composite, 1, &Side::Left.into()).unwrap();
+        write_colliding_area_ply(&mut right, &g, &composite, 1, &Side::Right.into()).unwrap();
         let (left, right) = (
             String::from_utf8(left).unwrap(),
             String::from_utf8(right).unwrap(),
@@ -142,7 +145,7 @@ mod tests {
         let (fl, fr) = (face(l[9]), face(r[9]));
         assert_eq!((fl[1], fl[2], fl[3]), (fr[1], fr[3], fr[2]));
         assert!(matches!(
-            write_colliding_area_ply(Vec::new(), &g, &[1], 1, Side::Left),
+            write_colliding_area_ply(Vec::new(), &g, &[1], 1, &Side::Left.into()),
             Err(e) if e.kind() == io::ErrorKind::InvalidInput
         ));
     }

@@ -24,6 +24,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
+use crate::frame::Placement;
 use crate::grid::{GridSpec, HeightGrid};
 use crate::mesh::Side;
 
@@ -114,7 +115,13 @@ pub enum PngError {
 /// which is closer), in the part's own y (mm), nodes that miss the part in
 /// a pale neutral (in the key), mm axes, the side and viewing direction in
 /// the title, cropped to the part (see the module docs).
-pub fn write_depth_png(path: &Path, grid: &HeightGrid, side: Side) -> Result<(), PngError> {
+pub fn write_depth_png(
+    path: &Path,
+    grid: &HeightGrid,
+    placement: &Placement,
+) -> Result<(), PngError> {
+    let side = placement.side;
+    let frame = placement.frame.record().map(|r| r.given);
     let (h_lo, h_hi) = finite_range(&grid.h);
     let window = crop_window(grid, None);
     let shown = window.crop(grid);
@@ -144,12 +151,19 @@ pub fn write_depth_png(path: &Path, grid: &HeightGrid, side: Side) -> Result<(),
         pixels: &pixels,
         title: &title,
         side,
+        frame: frame.as_deref(),
         key: &[(NO_PART, "no part (the node's line misses it)")],
         rings: &[],
         marks: &[],
     };
     draw_plot(path, &plot, |area, bar_top, bar_bottom| {
-        let mut bar = colour_bar(area, "y (mm, part frame)", y_lo..y_hi)?;
+        // With a frame the picture is in vehicle coordinates, and so is y.
+        let label = if frame.is_some() {
+            "y (mm, vehicle frame)"
+        } else {
+            "y (mm, part frame)"
+        };
+        let mut bar = colour_bar(area, label, y_lo..y_hi)?;
         bar.configure_mesh()
             .disable_mesh()
             .disable_x_axis()
@@ -214,9 +228,11 @@ pub fn write_composite_png(
     composite: &[u16],
     n_angles: usize,
     title: &str,
-    side: Side,
+    placement: &Placement,
     blind: &[(usize, usize)],
 ) -> Result<(), PngError> {
+    let side = placement.side;
+    let frame = placement.frame.record().map(|r| r.given);
     if composite.len() != grid.spec.len() {
         return Err(PngError::Length {
             expected: grid.spec.len(),
@@ -267,6 +283,7 @@ pub fn write_composite_png(
         pixels: &pixels,
         title,
         side,
+        frame: frame.as_deref(),
         key: &key,
         rings: &rings,
         marks: &marks,
@@ -492,6 +509,9 @@ struct Plot<'a> {
     title: &'a str,
     /// Which way the knee looks: the right side is drawn with x reversed.
     side: Side,
+    /// The `--frame` given, if any: the axes are then the vehicle's, not
+    /// the part file's, and the view line says so.
+    frame: Option<&'a str>,
     /// Swatches under the plot: colour and meaning.
     key: &'a [(RGBColor, &'a str)],
     /// Pixels (indices into `pixels`) to circle.
@@ -539,8 +559,15 @@ fn draw_plot(
             &(FONT, 20).into_text_style(&root),
             (MARGIN as i32, 10),
         )?;
+        let view = match plot.frame {
+            None => view_line(plot.side).to_string(),
+            Some(given) => format!(
+                "{}; vehicle axes (part placed by --frame {given})",
+                view_line(plot.side)
+            ),
+        };
         root.draw_text(
-            view_line(plot.side),
+            &view,
             &(FONT, 15).into_text_style(&root),
             (MARGIN as i32, 36),
         )?;
@@ -600,13 +627,21 @@ fn draw_plot(
         } else {
             "x (mm), vehicle front \u{2190}"
         };
+        // With a frame the axes are the vehicle's, not the part file's.
+        let (x_desc, z_desc) = match plot.frame {
+            None => (x_desc.to_string(), "z (mm), up".to_string()),
+            Some(_) => (
+                format!("vehicle {x_desc}"),
+                "vehicle z (mm), up".to_string(),
+            ),
+        };
         chart
             .configure_mesh()
             .disable_mesh()
             .x_label_formatter(&x_label)
             .y_label_formatter(&tick)
             .x_desc(x_desc)
-            .y_desc("z (mm), up")
+            .y_desc(z_desc)
             .label_style((FONT, 13))
             .axis_desc_style((FONT, 14))
             .draw()?;
@@ -752,14 +787,14 @@ mod tests {
         let mut composite = vec![0u16; g.spec.len()];
         composite[30 * 120 + 60] = 3;
         composite[10 * 120 + 20] = 61;
-        write_depth_png(&dir.join("depth.png"), &g, Side::Left).unwrap();
+        write_depth_png(&dir.join("depth.png"), &g, &Side::Left.into()).unwrap();
         write_composite_png(
             &dir.join("composite.png"),
             &g,
             &composite,
             61,
             "Composite, 61 angles",
-            Side::Left,
+            &Side::Left.into(),
             &[(40, 20)],
         )
         .unwrap();
@@ -799,7 +834,7 @@ mod tests {
             &vec![1; g.spec.len()],
             1,
             "all",
-            Side::Left,
+            &Side::Left.into(),
             &[],
         )
         .unwrap();
@@ -916,7 +951,16 @@ mod tests {
         let mut composite = vec![0u16; nx * nz];
         composite[300 * nx + 1000] = 5;
         let path = dir.join("one.png");
-        write_composite_png(&path, &g, &composite, 61, "one node", Side::Left, &[]).unwrap();
+        write_composite_png(
+            &path,
+            &g,
+            &composite,
+            61,
+            "one node",
+            &Side::Left.into(),
+            &[],
+        )
+        .unwrap();
         let (_, _, pixels) = decode(&path);
         // The ring: 2 px wide, radius 9: well over 50 pixels.
         assert!(count_of(&pixels, RING_COLOUR) > 50, "no ring");
@@ -926,7 +970,7 @@ mod tests {
         assert!(count_of(&pixels, swatch) >= 14 * 14 - 4 * 14);
         // Many struck nodes: no rings.
         let many = vec![1u16; nx * nz];
-        write_composite_png(&path, &g, &many, 61, "all", Side::Left, &[]).unwrap();
+        write_composite_png(&path, &g, &many, 61, "all", &Side::Left.into(), &[]).unwrap();
         let (_, _, pixels) = decode(&path);
         assert_eq!(count_of(&pixels, RING_COLOUR), 0);
         std::fs::remove_dir_all(dir).unwrap();
@@ -942,7 +986,7 @@ mod tests {
         let mut first_column = Vec::new();
         for side in [Side::Left, Side::Right] {
             let path = dir.join("side.png");
-            write_composite_png(&path, &g, &composite, 1, "side", side, &[]).unwrap();
+            write_composite_png(&path, &g, &composite, 1, "side", &side.into(), &[]).unwrap();
             let (w, _, pixels) = decode(&path);
             let cols: Vec<usize> = (0..pixels.len())
                 .filter(|&k| pixels[k] == [struck.0, struck.1, struck.2])
@@ -971,7 +1015,7 @@ mod tests {
         let g = grid(60, 60, |i, _| i as f64);
         for side in [Side::Left, Side::Right] {
             let path = dir.join("depth.png");
-            write_depth_png(&path, &g, side).unwrap();
+            write_depth_png(&path, &g, &side.into()).unwrap();
             let (w, h, pixels) = decode(&path);
             // The bar: the image's right strip; its brightest (closest)
             // colour nearest the end the words say.

@@ -17,7 +17,8 @@ use crate::summary::Summary;
 /// the writing time. Returns the summary written.
 pub fn write_analysis(out: &OutputDir, analysis: &Analysis) -> Result<Summary, WriteError> {
     let t = Instant::now();
-    let side = analysis.input.side;
+    let placement = analysis.input.placement();
+    let node_file = analysis.node_file.as_deref();
     let grid = &analysis.grid;
     let (masks, counts) = (&analysis.masks, &analysis.composite);
     let file =
@@ -32,18 +33,22 @@ pub fn write_analysis(out: &OutputDir, analysis: &Analysis) -> Result<Summary, W
                 .map_err(WriteError::at(&path))
         };
     file("colliding_points.csv", &|w| {
-        Ok(super::write_colliding_points(w, grid, masks, side)?)
+        Ok(super::write_colliding_points(
+            w, grid, masks, &placement, node_file,
+        )?)
     })?;
     file("composite.csv", &|w| {
-        Ok(super::write_composite(w, grid, counts, side)?)
+        Ok(super::write_composite(
+            w, grid, counts, &placement, node_file,
+        )?)
     })?;
     file("colliding_area.stl", &|w| {
-        super::write_colliding_area(w, grid, counts, side).map(drop)
+        super::write_colliding_area(w, grid, counts, &placement).map(drop)
     })?;
     file("colliding_area.ply", &|w| {
-        super::write_colliding_area_ply(w, grid, counts, masks.len(), side).map(drop)
+        super::write_colliding_area_ply(w, grid, counts, masks.len(), &placement).map(drop)
     })?;
-    super::write_depth_png(&out.path("depth.png"), grid, side)?;
+    super::write_depth_png(&out.path("depth.png"), grid, &placement)?;
     let title = format!(
         "Composite colliding area, {} angles (L = {} mm)",
         masks.len(),
@@ -56,7 +61,7 @@ pub fn write_analysis(out: &OutputDir, analysis: &Analysis) -> Result<Summary, W
         counts,
         masks.len(),
         &title,
-        side,
+        &placement,
         &blind,
     )?;
     write_blind_spots(&out.path("blind_spots.csv"), analysis)?;

@@ -12,12 +12,13 @@
 use std::io::{self, Write};
 
 use super::surface::{AreaSurface, to_part, wound};
+use crate::frame::Placement;
 use crate::grid::HeightGrid;
-use crate::mesh::{Side, Triangle};
+use crate::mesh::Triangle;
 
 /// Writes the composite area (nodes with `composite > 0`) as a binary STL
-/// in the part's coordinates (mm; vertex `(x, side.to_part(h), z)`), facing
-/// the knee. Returns the number of triangles written.
+/// in the part's coordinates (mm; vertex `(x, h, z)` mapped back by
+/// [`Placement::to_part`]), facing the knee. Returns the number of triangles written.
 ///
 /// Fails with [`io::ErrorKind::InvalidInput`] when `composite` does not have
 /// one entry per grid node.
@@ -25,14 +26,17 @@ pub fn write_colliding_area<W: Write>(
     mut w: W,
     grid: &HeightGrid,
     composite: &[u16],
-    side: Side,
+    placement: &Placement,
 ) -> io::Result<usize> {
     let surface = AreaSurface::new(grid, composite)?;
     let triangles: Vec<stl_io::Triangle> = surface
         .faces
         .iter()
         .map(|&f| {
-            to_stl_triangle(&wound(f, side).map(|v| to_part(surface.vertices[v as usize].0, side)))
+            to_stl_triangle(
+                &wound(f, placement.side)
+                    .map(|v| to_part(surface.vertices[v as usize].0, placement)),
+            )
         })
         .collect();
     stl_io::write_stl(&mut w, triangles.iter())?;
@@ -65,6 +69,7 @@ pub(crate) fn to_stl_triangle(t: &Triangle) -> stl_io::Triangle {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::Side;
 
     fn grid() -> HeightGrid {
         crate::output::surface::test_grid(4)
@@ -93,7 +98,7 @@ mod tests {
 
     fn write(composite: &[u16], side: Side) -> (usize, Vec<stl_io::Triangle>) {
         let mut buf = Vec::new();
-        let n = write_colliding_area(&mut buf, &grid(), composite, side).unwrap();
+        let n = write_colliding_area(&mut buf, &grid(), composite, &side.into()).unwrap();
         assert_eq!(buf.len(), 84 + 50 * n);
         (n, read_back(&buf))
     }

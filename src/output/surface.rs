@@ -11,6 +11,7 @@
 
 use std::io;
 
+use crate::frame::Placement;
 use crate::grid::HeightGrid;
 use crate::mesh::Side;
 
@@ -94,14 +95,16 @@ impl AreaSurface {
     }
 }
 
-/// A vertex in the part's frame: y mirrored back for the right side.
-pub(crate) fn to_part([x, y, z]: [f64; 3], side: Side) -> [f64; 3] {
-    [x, side.to_part(y), z]
+/// A vertex in the part's frame: y mirrored back for the right side, then
+/// the frame undone ([`Placement::to_part`]).
+pub(crate) fn to_part(v: [f64; 3], placement: &Placement) -> [f64; 3] {
+    placement.to_part(v)
 }
 
 /// A face wound towards the knee in the part's frame: a mirror (the right
 /// side) reverses the sense of rotation, so two vertices are swapped and
-/// normal and winding still agree (right-hand rule).
+/// normal and winding still agree (right-hand rule). A frame is a proper
+/// rotation, which keeps the sense: only the side matters.
 pub(crate) fn wound([a, b, c]: [u32; 3], side: Side) -> [u32; 3] {
     match side {
         Side::Left => [a, b, c],

@@ -7,7 +7,7 @@
 //! * `result`: the analysed side painted with the composite (the main
 //!   image, `#main-view`), its legend, and the oblique view;
 //! * `part`: the part's identity (file, SHA-256, triangles, bounding box,
-//!   units);
+//!   units, frame; an assembly's files with each one's colliding area);
 //! * `method`: the knee-form (the assumed triangle side called out), grid,
 //!   angles, side, software version and run date;
 //! * `per-angle`: small multiples at -30, 0 and +30 degrees, a chart and a
@@ -272,6 +272,7 @@ fn row(label: &str, value: Markup) -> Markup {
 
 fn part_section(run: &Run) -> Markup {
     let j = &run.summary_json;
+    let files = &run.summary.files;
     let c = |p: &str| cite(SUMMARY, j, p);
     let corner = |name: &str| {
         html! {
@@ -289,7 +290,9 @@ fn part_section(run: &Run) -> Markup {
             table class="compact" {
                 "\n"
                 (row("File", html! { code { (c("/input_file")) } }))
-                (row("SHA-256", html! { code { (c("/sha256")) } }))
+                @if files.is_empty() {
+                    (row("SHA-256", html! { code { (c("/sha256")) } }))
+                }
                 (row("Re-read for this report", html! {
                     code { (run.part_path.display().to_string()) } " (SHA-256 matches the run's)"
                 }))
@@ -299,8 +302,35 @@ fn part_section(run: &Run) -> Markup {
                 (row("Bounding box, max x, y, z (mm)", corner("bbox_max")))
                 (row("Units", html! { "file units " (TIMES) " " (c("/scale")) " = mm" }))
                 (row("Analysed side", c("/side")))
+                @if run.summary.frame.is_some() {
+                    (row("Frame (--frame)", html! {
+                        code { (c("/frame/given")) }
+                        ": the part's axes in vehicle coordinates; the pictures are drawn in vehicle coordinates, the CSV, STL and PLY files are in the part's"
+                    }))
+                }
             }
             "\n"
+            @if !files.is_empty() {
+                p { "The part is an assembly of these files; each colliding node is the file's whose surface set its height (the first file listed where two set the same height):" }
+                "\n"
+                table class="compact" {
+                    "\n"
+                    tr { th { "file" } th { "SHA-256" } th { "triangles" } th { "colliding nodes" } th { "colliding area (mm" (SUP2) ")" } th { "" } }
+                    "\n"
+                    @for (k, f) in files.iter().enumerate() {
+                        tr {
+                            td { code { (c(&format!("/files/{k}/path"))) } }
+                            td { code { (c(&format!("/files/{k}/sha256"))) } }
+                            td { (c(&format!("/files/{k}/triangles"))) }
+                            td { (c(&format!("/files/{k}/colliding_nodes"))) }
+                            td { (c(&format!("/files/{k}/colliding_area_mm2"))) }
+                            td { @if f.ignored { "ignored (--ignore): not in the height grid" } }
+                        }
+                        "\n"
+                    }
+                }
+                "\n"
+            }
         }
         "\n"
     }

@@ -6,6 +6,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use crate::frame::Frame;
 use crate::grid::GridSpec;
 use crate::mesh::{Part, Side, read_part_bytes, sha256_hex};
 use crate::summary::Summary;
@@ -88,8 +89,12 @@ pub struct Run {
     pub composite: NodeCounts,
     /// The part file that was re-read (its SHA-256 matched the run's).
     pub part_path: PathBuf,
-    /// The part in its own frame (mm, after the run's scale; not mirrored).
+    /// The part (an assembly's analysed files merged) in vehicle
+    /// coordinates: its own frame mapped by the run's `--frame`, if any
+    /// (mm, after the run's scale; not mirrored).
     pub part: Part,
+    /// The run's `--frame` (none when it had none).
+    pub frame: Frame,
     /// `blind_spots.csv` (empty for runs of versions that wrote none).
     pub blind_spots: Vec<BlindRow>,
 }
@@ -136,8 +141,16 @@ impl Run {
                 summary.grid_origin, summary.grid_size, summary.pitch_mm
             ),
         })?;
-        let composite = read_composite(&dir.join("composite.csv"), spec)?;
-        let (part_path, part) = find_part(dir, part, &summary)?;
+        let frame = run_frame(&summary, &summary_path)?;
+        let composite = read_composite(&dir.join("composite.csv"), spec, &frame)?;
+        let (part_path, mut part) = find_parts(dir, part, &summary)?;
+        // With a frame, the part is drawn where the analysis put it: in
+        // vehicle coordinates (the side's mirror aside, as ever).
+        if !frame.is_none() {
+            for v in part.triangles.iter_mut().flatten() {
+                *v = frame.to_vehicle(*v);
+            }
+        }
         let blind_path = dir.join("blind_spots.csv");
         let blind_spots = if blind_path.is_file() {
             read_blind_spots(&blind_path, spec)?
@@ -152,6 +165,7 @@ impl Run {
             composite,
             part_path,
             part,
+            frame,
             blind_spots,
         })
     }
@@ -168,9 +182,9 @@ impl Run {
         while let Some(row) = rows.next_row()? {
             let angle: f64 = rows.parse(&row, 0)?;
             if let Some(mask) = masks.get_mut(&angle.to_bits()) {
-                let k = rows.node(&row, self.spec)?;
+                let (k, y) = rows.node(&row, self.spec, &self.frame)?;
                 mask.count[k] = 1;
-                mask.y[k] = rows.parse(&row, 4)?;
+                mask.y[k] = y;
             }
         }
         Ok(angles
@@ -225,15 +239,27 @@ pub fn same_coordinate(v: f64, node: f64, pitch: f64) -> bool {
     (v - node).abs() <= ORIGIN_TOL * node.abs().max(pitch)
 }
 
-fn read_composite(path: &Path, spec: GridSpec) -> Result<NodeCounts, ReportError> {
+fn read_composite(path: &Path, spec: GridSpec, frame: &Frame) -> Result<NodeCounts, ReportError> {
     let mut counts = NodeCounts::empty(spec);
     let mut rows = CsvRows::open(path, &["i", "j", "x", "y", "z", "angles"])?;
     while let Some(row) = rows.next_row()? {
-        let k = rows.node(&row, spec)?;
+        let (k, y) = rows.node(&row, spec, frame)?;
         counts.count[k] = rows.parse(&row, 5)?;
-        counts.y[k] = rows.parse(&row, 3)?;
+        counts.y[k] = y;
     }
     Ok(counts)
+}
+
+/// The run's `--frame`, checked as `analyze` checked it.
+fn run_frame(summary: &Summary, path: &Path) -> Result<Frame, ReportError> {
+    summary
+        .frame
+        .as_ref()
+        .map_or(Ok(Frame::none()), Frame::from_record)
+        .map_err(|e| ReportError::Inconsistent {
+            path: path.to_path_buf(),
+            reason: format!("frame: {e}"),
+        })
 }
 
 fn read_blind_spots(path: &Path, spec: GridSpec) -> Result<Vec<BlindRow>, ReportError> {
@@ -328,10 +354,16 @@ impl CsvRows {
             .map_err(|_| self.bad(format!("{} = {field:?} is not a number", self.names[n])))
     }
 
-    /// The node index of a row with `i`, `j`, `x`, `z` among its wanted
-    /// columns (by those names), checked against the grid: a CSV of another
-    /// grid must not be painted on this one.
-    fn node(&self, row: &csv::StringRecord, spec: GridSpec) -> Result<usize, ReportError> {
+    /// The node index of a row with `i`, `j`, `x`, `y`, `z` among its
+    /// wanted columns (by those names), checked against the grid (a CSV of
+    /// another grid must not be painted on this one), and the node's y in
+    /// vehicle coordinates: the row's point (part frame) mapped by `frame`.
+    fn node(
+        &self,
+        row: &csv::StringRecord,
+        spec: GridSpec,
+        frame: &Frame,
+    ) -> Result<(usize, f64), ReportError> {
         let col = |name: &str| {
             self.names
                 .iter()
@@ -341,7 +373,9 @@ impl CsvRows {
         let i: usize = self.parse(row, col("i"))?;
         let j: usize = self.parse(row, col("j"))?;
         let x: f64 = self.parse(row, col("x"))?;
+        let y: f64 = self.parse(row, col("y"))?;
         let z: f64 = self.parse(row, col("z"))?;
+        let [x, y, z] = frame.to_vehicle([x, y, z]);
         if i >= spec.nx
             || j >= spec.nz
             || !same_coordinate(x, spec.x(i), spec.pitch)
@@ -352,17 +386,70 @@ impl CsvRows {
                 spec.nx, spec.nz
             )));
         }
-        Ok(j * spec.nx + i)
+        Ok((j * spec.nx + i, y))
     }
 }
 
-/// Finds the part file and reads it in its own frame.
-fn find_part(
+/// Finds the run's part file, or an assembly's analysed files (merged, in
+/// order), and reads them in their own frame; the path is the (first)
+/// file's.
+fn find_parts(
     dir: &Path,
     given: Option<&Path>,
     summary: &Summary,
 ) -> Result<(PathBuf, Part), ReportError> {
-    let named = PathBuf::from(&summary.input_file);
+    if summary.files.is_empty() {
+        return find_part(
+            dir,
+            given,
+            &summary.input_file,
+            &summary.sha256,
+            summary.scale,
+        );
+    }
+    if let Some(path) = given {
+        return Err(ReportError::Part {
+            path: path.to_path_buf(),
+            reason: format!(
+                "the run is an assembly of {} files, found by their paths and SHA-256 in summary.json; --part names one file",
+                summary.files.len()
+            ),
+        });
+    }
+    let mut first = None;
+    let mut triangles = Vec::new();
+    let (mut file_triangles, mut degenerate) = (0, 0);
+    for f in summary.files.iter().filter(|f| !f.ignored) {
+        let (path, part) = find_part(dir, None, &f.path, &f.sha256, summary.scale)?;
+        first.get_or_insert(path);
+        triangles.extend(part.triangles);
+        file_triangles += part.file_triangles;
+        degenerate += part.degenerate;
+    }
+    let first = first.ok_or_else(|| ReportError::Part {
+        path: dir.join("summary.json"),
+        reason: "every file of the assembly is ignored".into(),
+    })?;
+    Ok((
+        first,
+        Part {
+            triangles,
+            file_triangles,
+            degenerate,
+        },
+    ))
+}
+
+/// Finds the part file named `input_file` with SHA-256 `sha256` (at
+/// `given` when given) and reads it in its own frame.
+fn find_part(
+    dir: &Path,
+    given: Option<&Path>,
+    input_file: &str,
+    sha256: &str,
+    scale: f64,
+) -> Result<(PathBuf, Part), ReportError> {
+    let named = PathBuf::from(input_file);
     let candidates: Vec<PathBuf> = match given {
         Some(p) => vec![p.to_path_buf()],
         None => {
@@ -381,13 +468,13 @@ fn find_part(
             continue;
         };
         let sha = sha256_hex(&bytes);
-        if sha != summary.sha256 {
+        if sha != sha256 {
             mismatched.push((path.clone(), sha));
             continue;
         }
         // As `analyze` read it, scaled but never mirrored: the report
         // draws the part as it is.
-        let part = read_part_bytes(path, &bytes, summary.scale, Side::Left)
+        let part = read_part_bytes(path, &bytes, scale, Side::Left)
             .map_err(|e| ReportError::Part {
                 path: path.clone(),
                 reason: e.to_string(),
@@ -398,12 +485,12 @@ fn find_part(
     if let Some((path, sha)) = mismatched.into_iter().next() {
         return Err(ReportError::PartChanged {
             path,
-            expected: summary.sha256.clone(),
+            expected: sha256.to_string(),
             found: sha,
         });
     }
     Err(ReportError::PartMissing {
-        input_file: summary.input_file.clone(),
+        input_file: input_file.to_string(),
         tried: candidates,
     })
 }

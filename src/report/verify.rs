@@ -126,6 +126,14 @@ impl Verification {
             file: file.to_string(),
             reason,
         };
+        // verify and converge read one file: an assembly's run is of
+        // several, whatever its first file.
+        if let Some(Value::Array(files)) = run.get("files") {
+            return Err(refuse(format!(
+                "the run is an assembly of {} files, and a verification checks one part file",
+                files.len()
+            )));
+        }
         match (json.get("input_sha256"), run.get("sha256")) {
             (Some(Value::String(a)), Some(Value::String(b))) if a == b => {}
             (Some(Value::String(a)), Some(Value::String(b))) => {
@@ -139,6 +147,25 @@ impl Verification {
                 return Err(refuse(
                     "it does not record the part's SHA-256 (input_sha256; written by an earlier kneeform), so it may be of another part: run it again".into(),
                 ));
+            }
+        }
+        // A frame moves the part in the analysis frame: another setup.
+        // Absent is no frame, on either side.
+        let frame = |v: &Value| {
+            v.get("frame")
+                .and_then(|f| f.get("part_to_vehicle"))
+                .cloned()
+        };
+        match (frame(json), frame(run)) {
+            (None, None) => {}
+            (Some(a), Some(b)) if same(&a, &b) => {}
+            (a, b) => {
+                let say = |f: Option<Value>| f.map_or("none".to_string(), |f| f.to_string());
+                return Err(refuse(format!(
+                    "its frame (part to vehicle) is {}, the run's {}",
+                    say(a),
+                    say(b)
+                )));
             }
         }
         for key in ["scale", "side"] {
@@ -357,6 +384,30 @@ mod tests {
         );
         assert!(refused(&|v| v["scale"] = 1000.0.into()).contains("scale"));
         assert!(refused(&|v| v["side"] = "right".into()).contains("side"));
+        let turned = serde_json::json!({"given": "x,-z,y", "part_to_vehicle":
+            [[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, -1.0, 0.0], [0.0, 1.0, 0.0, 0.0]]});
+        assert!(refused(&|v| v["frame"] = turned.clone()).contains("frame"));
+        // The same frame on both sides is the same setup.
+        let mut framed_run = run.clone();
+        framed_run["frame"] = turned.clone();
+        let mut framed = matching_verify();
+        framed["frame"] = turned;
+        verification(Some(framed.clone()), None)
+            .check_against(&framed_run)
+            .unwrap();
+        // A run without the frame is another setup.
+        assert!(
+            verification(Some(framed), None)
+                .check_against(&run)
+                .is_err()
+        );
+        // An assembly's run matches no verification of one file.
+        let mut assembly = run.clone();
+        assembly["files"] = serde_json::json!([{}, {}]);
+        let err = verification(Some(matching_verify()), None)
+            .check_against(&assembly)
+            .unwrap_err();
+        assert!(err.to_string().contains("assembly of 2 files"), "{err}");
         assert!(refused(&|v| v["knee_form_mm"][0] = 190.0.into()).contains("knee-form"));
         assert!(refused(&|v| v["pitch_mm"] = 2.0.into()).contains("pitch"));
         assert!(refused(&|v| v["eps_mm"] = 0.01.into()).contains("eps_mm"));

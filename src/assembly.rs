@@ -1,0 +1,185 @@
+//! Assemblies: several part files analysed as one part (`analyze trim.stl
+//! bezel.stl switch.stl`), each colliding node attributed to the file whose
+//! surface set its height.
+//!
+//! The files' triangles are merged in the files' order into one
+//! [`Part`], so the height grid is exactly the grid of one file holding
+//! them all; the rasterizer ([`crate::grid::HeightGrid::sample_attributed`])
+//! carries each triangle's file index to the node it sets. Where two files
+//! set the same height at a node (a tie to the last bit), the node is the
+//! **lowest-indexed** file's: the rasterizer keeps the first of equal
+//! depths, and the lower index comes first.
+//!
+//! Files the regulation disregards (materials softer than 50 Shore A:
+//! `--ignore FILE`) are read and identified (path, SHA-256, triangles) but
+//! kept out of the height grid: the knee-form passes through them.
+
+use std::path::{Path, PathBuf};
+
+use crate::frame::Placement;
+use crate::mesh::{MeshError, Part, PartFile, read_part_placed};
+
+/// One file of an assembly.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AssemblyFile {
+    /// The file as given.
+    pub path: PathBuf,
+    /// SHA-256 of its bytes (lowercase hex).
+    pub sha256: String,
+    /// Triangles in the file.
+    pub triangles: usize,
+    /// Of those, skipped for zero area.
+    pub degenerate: usize,
+    /// Disregarded by the regulation (`--ignore`): not in the height grid.
+    pub ignored: bool,
+}
+
+/// The files of a part read from several, and where each triangle came
+/// from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Assembly {
+    /// Every file, in the order given: the analysed files, then the
+    /// `--ignore` files not among them.
+    pub files: Vec<AssemblyFile>,
+    /// Per triangle of the merged part, the index of its file in `files`.
+    pub file_of: Vec<u32>,
+}
+
+/// What to read: the files of a part, the ones to disregard, and how
+/// their coordinates map into the analysis frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PartSource {
+    /// The part's files, in order (one for a single part).
+    pub files: Vec<PathBuf>,
+    /// Files disregarded by the regulation: identified, not analysed. A
+    /// file both here and in `files` is disregarded.
+    pub ignored: Vec<PathBuf>,
+    /// Factor from the files' units to mm.
+    pub scale: f64,
+    /// The frame and side of every file.
+    pub placement: Placement,
+}
+
+/// Why the files of an assembly cannot be read as one part.
+#[derive(Debug, thiserror::Error)]
+pub enum AssemblyError {
+    /// No file to analyse.
+    #[error("no part file to analyse (every file given is --ignore'd)")]
+    NothingToAnalyse,
+    /// A file is given twice.
+    #[error("{} is given twice", path.display())]
+    Repeated {
+        /// The file.
+        path: PathBuf,
+    },
+    /// An assembly holds more files than a node's attribution can name.
+    #[error("{0} files: at most {max} can be analysed as one part", max = u32::MAX)]
+    TooMany(usize),
+}
+
+impl PartSource {
+    /// One file, no frame.
+    pub fn file(path: &Path, scale: f64, placement: Placement) -> PartSource {
+        PartSource {
+            files: vec![path.to_path_buf()],
+            ignored: Vec::new(),
+            scale,
+            placement,
+        }
+    }
+
+    /// Whether this is one file with nothing disregarded: read exactly as
+    /// [`read_part_placed`] reads it, with no [`Assembly`].
+    pub fn is_single(&self) -> bool {
+        self.files.len() == 1 && self.ignored.is_empty()
+    }
+
+    /// Reads the part: one file as [`read_part_placed`]; several (or any
+    /// `--ignore`) merged in order, with an [`Assembly`] saying which file
+    /// each triangle came from.
+    pub fn read(&self) -> Result<PartFile, MeshError> {
+        if self.is_single() {
+            return read_part_placed(&self.files[0], self.scale, &self.placement);
+        }
+        let order = self.order()?;
+        let mut merged: Option<PartFile> = None;
+        let mut files = Vec::with_capacity(order.len());
+        let mut file_of = Vec::new();
+        let mut triangles = Vec::new();
+        let (mut file_triangles, mut degenerate) = (0, 0);
+        for (index, (path, ignored)) in order.into_iter().enumerate() {
+            let read = read_part_placed(&path, self.scale, &self.placement)?;
+            files.push(AssemblyFile {
+                path: path.clone(),
+                sha256: read.sha256.clone(),
+                triangles: read.part.file_triangles,
+                degenerate: read.part.degenerate,
+                ignored,
+            });
+            if ignored {
+                continue;
+            }
+            file_triangles += read.part.file_triangles;
+            degenerate += read.part.degenerate;
+            file_of.extend(std::iter::repeat_n(index as u32, read.part.triangles.len()));
+            triangles.extend_from_slice(&read.part.triangles);
+            merged.get_or_insert(read);
+        }
+        let mut merged = merged.ok_or(AssemblyError::NothingToAnalyse)?;
+        merged.part = Part {
+            triangles,
+            file_triangles,
+            degenerate,
+        };
+        merged.sha256 = String::new();
+        merged.assembly = Some(Assembly { files, file_of });
+        Ok(merged)
+    }
+
+    /// The files in order with whether each is disregarded: `files` as
+    /// given (those also in `ignored` disregarded), then the rest of
+    /// `ignored`. Files are compared by their canonical path where it can
+    /// be had.
+    fn order(&self) -> Result<Vec<(PathBuf, bool)>, AssemblyError> {
+        let key = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+        let ignored_keys: Vec<PathBuf> = self.ignored.iter().map(|p| key(p)).collect();
+        let mut seen: Vec<PathBuf> = Vec::new();
+        let mut order = Vec::new();
+        for path in &self.files {
+            let k = key(path);
+            if seen.contains(&k) {
+                return Err(AssemblyError::Repeated { path: path.clone() });
+            }
+            order.push((path.clone(), ignored_keys.contains(&k)));
+            seen.push(k);
+        }
+        for (path, k) in self.ignored.iter().zip(ignored_keys) {
+            if !seen.contains(&k) {
+                order.push((path.clone(), true));
+                seen.push(k);
+            }
+        }
+        if order.iter().all(|(_, ignored)| *ignored) {
+            return Err(AssemblyError::NothingToAnalyse);
+        }
+        if order.len() > u32::MAX as usize {
+            return Err(AssemblyError::TooMany(order.len()));
+        }
+        Ok(order)
+    }
+}
+
+/// Per file of `assembly`, the composite's nodes whose height that file
+/// set: `node_file` is the grid's attribution, `composite` the count per
+/// node.
+pub fn colliding_nodes_per_file(
+    assembly: &Assembly,
+    node_file: &[u32],
+    composite: &[u16],
+) -> Vec<usize> {
+    let mut per_file = vec![0; assembly.files.len()];
+    for (&f, _) in node_file.iter().zip(composite).filter(|&(_, &c)| c > 0) {
+        per_file[f as usize] += 1;
+    }
+    per_file
+}
