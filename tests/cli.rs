@@ -10,7 +10,7 @@ use kneeform::scenario::{Extent, ScenarioFile, builtin, write_stl};
 
 use crate::util::scratch_dir;
 
-fn kneeform(args: &[&str]) -> Output {
+pub(crate) fn kneeform(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_kneeform"))
         .args(args)
         .output()
@@ -32,7 +32,7 @@ const OUTPUTS: [&str; 6] = [
 
 /// Asserts a run failed cleanly: exit 2, one line on stderr, no output
 /// directory and no staging directory left beside it.
-fn assert_clean_failure(out: &Output, dir: &Path, what: &str) {
+pub(crate) fn assert_clean_failure(out: &Output, dir: &Path, what: &str) {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{what}: {stderr}");
     assert_eq!(stderr.lines().count(), 1, "{what}: not one line: {stderr}");
@@ -175,7 +175,7 @@ fn bad_input_gets_one_line_and_exit_2() {
     std::fs::remove_dir_all(&scratch).unwrap();
 }
 
-fn analyse_to(part: &Path, dir: &Path, extra: &[&str]) -> Output {
+pub(crate) fn analyse_to(part: &Path, dir: &Path, extra: &[&str]) -> Output {
     let mut args = vec![
         "analyze",
         part.to_str().unwrap(),
@@ -219,7 +219,7 @@ fn thread_count_does_not_change_any_byte() {
 }
 
 /// Rows of a CSV file as text fields, header dropped.
-fn csv_rows(path: &Path) -> Vec<Vec<String>> {
+pub(crate) fn csv_rows(path: &Path) -> Vec<Vec<String>> {
     let mut reader = csv::Reader::from_path(path).unwrap();
     reader
         .records()
@@ -227,7 +227,7 @@ fn csv_rows(path: &Path) -> Vec<Vec<String>> {
         .collect()
 }
 
-fn mirrored(tris: &[Triangle], axis: usize) -> Vec<Triangle> {
+pub(crate) fn mirrored(tris: &[Triangle], axis: usize) -> Vec<Triangle> {
     tris.iter()
         .map(|t| {
             // Mirroring flips the winding; swap two vertices to keep it.
@@ -241,7 +241,7 @@ fn mirrored(tris: &[Triangle], axis: usize) -> Vec<Triangle> {
 }
 
 /// A part with features varying along z, so that the angle matters.
-fn asymmetric_part() -> Vec<Triangle> {
+pub(crate) fn asymmetric_part() -> Vec<Triangle> {
     let bump = ScenarioFile {
         extent: Extent {
             x: [-150.0, 150.0],
