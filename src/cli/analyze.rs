@@ -94,6 +94,20 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         setup.knee.radius,
         args.out.display()
     );
+    for (k, f) in summary.files.iter().enumerate() {
+        eprintln!(
+            "kneeform: file {k}, {}: {}",
+            f.path,
+            if f.ignored {
+                "ignored (--ignore)".to_string()
+            } else {
+                format!(
+                    "{} colliding nodes ({:.0} mm^2)",
+                    f.colliding_nodes, f.colliding_area_mm2
+                )
+            }
+        );
+    }
     if args.report {
         // From the committed run, so the analysis stands whatever the
         // report meets; report.html itself appears whole or not at all.
