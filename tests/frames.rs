@@ -101,6 +101,35 @@ fn door_panel(
         }
     }
     assert_eq!((sp.bbox_min, sp.bbox_max), (lo, hi));
+    // The report re-reads the file, finds every CSV node on the run's grid
+    // through the frame, and draws the part in vehicle coordinates: the
+    // same pictures as the vehicle file's.
+    let page = |run: &Path| {
+        let html = run.join("report.html");
+        let result = kneeform(&[
+            "report",
+            run.to_str().unwrap(),
+            "--out",
+            html.to_str().unwrap(),
+        ]);
+        assert!(
+            result.status.success(),
+            "{}",
+            String::from_utf8_lossy(&result.stderr)
+        );
+        std::fs::read_to_string(html).unwrap()
+    };
+    let (pv, pp) = (page(&v_run), page(&p_run));
+    assert!(pp.contains("Frame (--frame)") && !pv.contains("Frame (--frame)"));
+    let views = |page: &str| -> Vec<String> {
+        page.split("data:image/png;base64,")
+            .skip(1)
+            .take(2)
+            .map(|s| s.split('"').next().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(views(&pv).len(), 2);
+    assert!(views(&pv) == views(&pp), "the report's views differ");
     std::fs::remove_dir_all(&scratch).unwrap();
 }
 
