@@ -47,6 +47,11 @@ struct Map {
     /// The flag's value as given: `x,-z,y` or `@FILE`.
     given: String,
     rotation: Rotation3<f64>,
+    /// `R^-1`, computed rather than taken as `R^T`: for a matrix
+    /// orthonormal only within [`ROTATION_TOL`] the two differ by up to
+    /// that much, and results must go back exactly where they came from
+    /// (to rounding). For signed axes it is exact.
+    inverse: Matrix3<f64>,
     translation: Translation3<f64>,
 }
 
@@ -220,10 +225,14 @@ impl Frame {
         if (det - 1.0).abs() > ROTATION_TOL {
             return Err(refuse(format!("its determinant is {det}, not 1")));
         }
+        let inverse = m
+            .try_inverse()
+            .ok_or_else(|| refuse("it has no inverse".into()))?;
         Ok(Frame {
             map: Some(Map {
                 given: given.to_string(),
                 rotation: Rotation3::from_matrix_unchecked(m),
+                inverse,
                 translation: Translation3::new(t[0], t[1], t[2]),
             }),
         })
@@ -272,9 +281,10 @@ impl Frame {
         match &self.map {
             None => v,
             Some(m) => {
-                let p = m.rotation.inverse_transform_point(
-                    &m.translation.inverse_transform_point(&Point3::from(v)),
-                );
+                let p = m.inverse
+                    * m.translation
+                        .inverse_transform_point(&Point3::from(v))
+                        .coords;
                 [p.x, p.y, p.z]
             }
         }
@@ -396,6 +406,19 @@ mod tests {
             &format!("1,0,0,0\n0,{c},{},0\n0,{s},{c},0\n", -s),
         );
         assert!(Frame::parse(&turn).is_ok());
+        // Ten digits: orthonormal within 1e-9 only, yet a point goes back
+        // where it came from, to rounding.
+        let ten = file(
+            "ten.txt",
+            &format!("1 0 0 0\n0 {c:.10} {:.10} 100\n0 {s:.10} {c:.10} -40\n", -s),
+        );
+        let f = Frame::parse(&ten).unwrap();
+        let p = [350.0, -120.5, 980.25];
+        let back = f.to_part(f.to_vehicle(p));
+        assert!(
+            back.iter().zip(p).all(|(a, b)| (a - b).abs() < 1e-12),
+            "{back:?}"
+        );
         let refused = |text: &str| Frame::parse(&file("bad.txt", text)).unwrap_err();
         assert!(matches!(
             refused("1 0 0 0\n0 1 0 0\n"),

@@ -375,11 +375,24 @@ impl CsvRows {
         let x: f64 = self.parse(row, col("x"))?;
         let y: f64 = self.parse(row, col("y"))?;
         let z: f64 = self.parse(row, col("z"))?;
-        let [x, y, z] = frame.to_vehicle([x, y, z]);
+        let part_point = [x, y, z];
+        let [x, y, z] = frame.to_vehicle(part_point);
+        // Through a frame the point was mapped twice (to the part for the
+        // CSV, back here): a few units in the last place of its largest
+        // coordinate, in either frame, not of x or z alone.
+        let reach = if frame.is_none() {
+            0.0
+        } else {
+            part_point
+                .iter()
+                .chain(&[x, y, z])
+                .fold(spec.pitch, |m, c| m.max(c.abs()))
+        };
+        let scale = spec.pitch.max(reach);
         if i >= spec.nx
             || j >= spec.nz
-            || !same_coordinate(x, spec.x(i), spec.pitch)
-            || !same_coordinate(z, spec.z(j), spec.pitch)
+            || !same_coordinate(x, spec.x(i), scale)
+            || !same_coordinate(z, spec.z(j), scale)
         {
             return Err(self.bad(format!(
                 "node ({i}, {j}) at x = {x}, z = {z} is not a node of the run's {} x {} grid",
