@@ -156,3 +156,217 @@ pub struct Summary {
     #[serde(default)]
     pub warnings: Vec<String>,
 }
+
+/// Why a `summary.json` cannot be used: it does not parse as a summary, or
+/// a field is outside what any run writes (a tampered or corrupt file).
+#[derive(Debug, thiserror::Error)]
+pub enum SummaryError {
+    /// Not JSON, or not the summary's schema.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+    /// A field is out of bounds or contradicts another.
+    #[error("`{field}` {reason}")]
+    Field {
+        /// The key at fault.
+        field: &'static str,
+        /// What is wrong with it, in words.
+        reason: String,
+    },
+}
+
+impl Summary {
+    /// Parses a `summary.json` and checks every field a reader sizes or
+    /// indexes anything by against [`crate::limits`] and the other
+    /// fields, so that a tampered file is refused before any allocation it
+    /// would drive: the grid's size, pitch and origin, the angles and their
+    /// per-angle rows, the node counts, the part's identity and the
+    /// knee-form's dimensions.
+    pub fn from_json(text: &str) -> Result<Summary, SummaryError> {
+        let summary: Summary = serde_json::from_str(text)?;
+        summary.check()?;
+        Ok(summary)
+    }
+
+    fn check(&self) -> Result<(), SummaryError> {
+        use crate::limits::{self, short};
+        let bad = |field: &'static str, reason: String| Err(SummaryError::Field { field, reason });
+        let within = |field: &'static str, v: f64, lo: f64, hi: f64| {
+            if v.is_finite() && (lo..=hi).contains(&v) {
+                Ok(())
+            } else {
+                bad(
+                    field,
+                    format!("is {}, outside [{}, {}]", short(v), short(lo), short(hi)),
+                )
+            }
+        };
+        within(
+            "pitch_mm",
+            self.pitch_mm,
+            limits::MIN_PITCH_MM,
+            limits::MAX_PITCH_MM,
+        )?;
+        within(
+            "scale",
+            self.scale,
+            1.0 / limits::MAX_SCALE,
+            limits::MAX_SCALE,
+        )?;
+        for (field, v) in [
+            ("triangle_side_mm", self.triangle_side_mm),
+            ("radius_mm", self.radius_mm),
+            ("thickness_mm", self.thickness_mm),
+        ] {
+            within(field, v, f64::MIN_POSITIVE, limits::MAX_LENGTH_MM)?;
+        }
+        within(
+            "blind_depth_mm",
+            self.blind_depth_mm,
+            0.0,
+            limits::MAX_LENGTH_MM,
+        )?;
+        let m = limits::MAX_COORD_MM;
+        for c in self.grid_origin {
+            within("grid_origin", c, -m, m)?;
+        }
+        for (min, max) in self.bbox_min.iter().zip(&self.bbox_max) {
+            within("bbox_min", *min, -m, m)?;
+            within("bbox_max", *max, *min, m)?;
+        }
+        let [nx, nz] = self.grid_size;
+        let nodes = nx
+            .checked_mul(nz)
+            .filter(|n| (1..=limits::MAX_GRID_NODES).contains(n));
+        let Some(nodes) = nodes else {
+            return bad(
+                "grid_size",
+                format!(
+                    "is {nx} x {nz}, not between 1 and {} nodes",
+                    limits::MAX_GRID_NODES
+                ),
+            );
+        };
+        for (field, count) in [
+            ("sampled_nodes", self.sampled_nodes),
+            ("composite_nodes", self.composite_nodes),
+            ("blind_spots", self.blind_spots),
+        ] {
+            if count > nodes {
+                return bad(
+                    field,
+                    format!("is {count}, more than the grid's {nodes} nodes"),
+                );
+            }
+        }
+        let angles = self.angles_deg.len();
+        if !(1..=limits::MAX_ANGLES).contains(&angles) {
+            return bad(
+                "angles_deg",
+                format!("holds {angles} angles, not 1 to {}", limits::MAX_ANGLES),
+            );
+        }
+        for &a in &self.angles_deg {
+            within("angles_deg", a, -90.0, 90.0)?;
+        }
+        if self.per_angle.len() != angles {
+            return bad(
+                "per_angle",
+                format!("holds {} rows for {angles} angles", self.per_angle.len()),
+            );
+        }
+        for (row, &a) in self.per_angle.iter().zip(&self.angles_deg) {
+            if row.angle_deg.to_bits() != a.to_bits() || row.colliding_nodes > nodes {
+                return bad(
+                    "per_angle",
+                    format!(
+                        "row of angle {} does not match angle {} of a {nodes}-node grid",
+                        short(row.angle_deg),
+                        short(a)
+                    ),
+                );
+            }
+        }
+        let hex = |s: &str| s.len() == 64 && s.bytes().all(|b| b.is_ascii_hexdigit());
+        if !(self.sha256.is_empty() || hex(&self.sha256)) {
+            return bad("sha256", "is not a SHA-256 (64 hex digits)".into());
+        }
+        if self.threads == 0 || self.threads > limits::MAX_THREADS {
+            return bad(
+                "threads",
+                format!("is {}, not 1 to {}", self.threads, limits::MAX_THREADS),
+            );
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn valid() -> serde_json::Value {
+        serde_json::json!({
+            "kneeform_version": "0", "run_unix_time": 0, "input_file": "p.stl",
+            "sha256": "ab".repeat(32), "triangles": 1, "degenerate_triangles": 0,
+            "bbox_min": [0.0, 0.0, 0.0], "bbox_max": [1.0, 1.0, 1.0], "scale": 1.0,
+            "side": "left", "triangle_side_mm": 200.0, "triangle_side_assumed": true,
+            "radius_mm": 60.0, "thickness_mm": 120.0, "pitch_mm": 1.24,
+            "grid_origin": [-12.4, 2.48], "grid_size": [3, 4], "sampled_nodes": 12,
+            "angles_deg": [-1.0, 0.0], "deflection_deg": 0.5, "sigma": 0.0087,
+            "e0_mm": 1e-6, "rate": "x-slope", "algorithm": "fast", "threads": 2,
+            "per_angle": [
+                {"angle_deg": -1.0, "placed_starts": 1, "colliding_nodes": 2, "colliding_area_mm2": 3.0},
+                {"angle_deg": 0.0, "placed_starts": 1, "colliding_nodes": 12, "colliding_area_mm2": 3.0}
+            ],
+            "composite_nodes": 2, "composite_area_mm2": 3.0,
+            "timings": {"read_s": 0.0, "sample_s": 0.0, "push_slide_s": 0.0,
+                        "write_s": 0.0, "total_s": 0.0}
+        })
+    }
+
+    fn with(key: &str, value: serde_json::Value) -> Result<Summary, SummaryError> {
+        let mut v = valid();
+        v[key] = value;
+        Summary::from_json(&v.to_string())
+    }
+
+    #[test]
+    fn a_written_summary_reads_back() {
+        let s = Summary::from_json(&valid().to_string()).unwrap();
+        assert_eq!(s.grid_size, [3, 4]);
+    }
+
+    #[test]
+    fn every_field_a_reader_sizes_by_is_bounded() {
+        use serde_json::json;
+        let refused = [
+            ("grid_size", json!([4_000_000_000u64, 4_000_000_000u64])),
+            ("grid_size", json!([usize::MAX, 2])),
+            ("grid_size", json!([0, 4])),
+            ("pitch_mm", json!(1e300)),
+            ("pitch_mm", json!(-1.0)),
+            ("pitch_mm", json!(1e-300)),
+            ("grid_origin", json!([1e300, 0.0])),
+            ("angles_deg", json!([])),
+            ("angles_deg", json!([0.0, 91.0])),
+            ("per_angle", json!([])),
+            ("sampled_nodes", json!(13)),
+            ("composite_nodes", json!(1_000_000)),
+            ("sha256", json!("not a hash")),
+            ("threads", json!(0)),
+            ("scale", json!(0.0)),
+            ("radius_mm", json!(1e300)),
+            ("bbox_max", json!([-1.0, 1.0, 1.0])),
+        ];
+        for (key, value) in refused {
+            let err = with(key, value.clone()).expect_err(&format!("{key} = {value}"));
+            assert!(
+                matches!(err, SummaryError::Field { .. } | SummaryError::Json(_)),
+                "{key}: {err}"
+            );
+        }
+        // A message names the key, with short numbers.
+        let err = with("pitch_mm", json!(1e-300)).unwrap_err().to_string();
+        assert!(err.starts_with("`pitch_mm` is 1e-300, outside"), "{err}");
+    }
+}

@@ -57,6 +57,14 @@ pub enum ReportError {
         /// What serde said.
         source: serde_json::Error,
     },
+    /// A buffer the run's files call for cannot be allocated.
+    #[error("{what}: {source}")]
+    Memory {
+        /// What needed it.
+        what: String,
+        /// The refused allocation.
+        source: crate::limits::OutOfMemory,
+    },
     /// A run file contradicts the run's summary.
     #[error("{}: {reason}", path.display())]
     Inconsistent {
@@ -184,7 +192,7 @@ fn build_report(options: &ReportOptions) -> Result<(String, Report), ReportError
     let run_figures: Vec<(String, Vec<u8>)> = RUN_FIGURES
         .iter()
         .filter_map(|name| {
-            std::fs::read(run.dir.join(name))
+            crate::limits::read_bounded(&run.dir.join(name), crate::limits::MAX_RUN_TABLE_BYTES)
                 .ok()
                 .map(|b| (name.to_string(), b))
         })

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use crate::frame::Frame;
 use crate::grid::GridSpec;
 use crate::mesh::{Part, Side, read_part_bytes, sha256_hex};
-use crate::summary::Summary;
+use crate::summary::{Summary, SummaryError};
 
 use super::ReportError;
 
@@ -27,12 +27,16 @@ pub struct NodeCounts {
 }
 
 impl NodeCounts {
-    fn empty(spec: GridSpec) -> NodeCounts {
-        NodeCounts {
+    fn empty(spec: GridSpec) -> Result<NodeCounts, ReportError> {
+        let memory = |e: crate::limits::OutOfMemory| ReportError::Memory {
+            what: format!("a {} x {} grid", spec.nx, spec.nz),
+            source: e,
+        };
+        Ok(NodeCounts {
             spec,
-            count: vec![0; spec.len()],
-            y: vec![f64::NAN; spec.len()],
-        }
+            count: crate::limits::try_filled(spec.len(), 0).map_err(memory)?,
+            y: crate::limits::try_filled(spec.len(), f64::NAN).map_err(memory)?,
+        })
     }
 
     /// The largest count of the nodes whose cell holds `(x, z)` (mm): nodes
@@ -133,7 +137,13 @@ impl Run {
             source,
         };
         let summary_json: serde_json::Value = serde_json::from_str(&text).map_err(json)?;
-        let summary: Summary = serde_json::from_str(&text).map_err(json)?;
+        let summary = Summary::from_json(&text).map_err(|e| match e {
+            SummaryError::Json(source) => json(source),
+            e @ SummaryError::Field { .. } => ReportError::Inconsistent {
+                path: summary_path.clone(),
+                reason: e.to_string(),
+            },
+        })?;
         let spec = grid_spec(&summary).ok_or_else(|| ReportError::Inconsistent {
             path: summary_path.clone(),
             reason: format!(
@@ -176,8 +186,8 @@ impl Run {
         let path = self.dir.join("colliding_points.csv");
         let mut masks: BTreeMap<u64, NodeCounts> = angles
             .iter()
-            .map(|a| (a.to_bits(), NodeCounts::empty(self.spec)))
-            .collect();
+            .map(|a| Ok((a.to_bits(), NodeCounts::empty(self.spec)?)))
+            .collect::<Result<_, ReportError>>()?;
         let mut rows = CsvRows::open(&path, &["angle_deg", "i", "j", "x", "y", "z"])?;
         while let Some(row) = rows.next_row()? {
             let angle: f64 = rows.parse(&row, 0)?;
@@ -240,7 +250,7 @@ pub fn same_coordinate(v: f64, node: f64, pitch: f64) -> bool {
 }
 
 fn read_composite(path: &Path, spec: GridSpec, frame: &Frame) -> Result<NodeCounts, ReportError> {
-    let mut counts = NodeCounts::empty(spec);
+    let mut counts = NodeCounts::empty(spec)?;
     let mut rows = CsvRows::open(path, &["i", "j", "x", "y", "z", "angles"])?;
     while let Some(row) = rows.next_row()? {
         let (k, y) = rows.node(&row, spec, frame)?;
@@ -477,7 +487,8 @@ fn find_part(
     };
     let mut mismatched = Vec::new();
     for path in &candidates {
-        let Ok(bytes) = std::fs::read(path) else {
+        let Ok(bytes) = crate::limits::read_bounded(path, crate::limits::MAX_PART_FILE_BYTES)
+        else {
             continue;
         };
         let sha = sha256_hex(&bytes);
@@ -509,10 +520,13 @@ fn find_part(
 }
 
 fn read_text(path: &Path) -> Result<String, ReportError> {
-    std::fs::read_to_string(path).map_err(|source| ReportError::Io {
+    let io = |source| ReportError::Io {
         path: path.to_path_buf(),
         source,
-    })
+    };
+    let bytes = crate::limits::read_bounded(path, crate::limits::MAX_RUN_JSON_BYTES).map_err(io)?;
+    String::from_utf8(bytes)
+        .map_err(|e| io(std::io::Error::new(std::io::ErrorKind::InvalidData, e)))
 }
 
 #[cfg(test)]
@@ -527,7 +541,7 @@ mod tests {
             nx: 5,
             nz: 4,
         };
-        let mut c = NodeCounts::empty(spec);
+        let mut c = NodeCounts::empty(spec).unwrap();
         // Node (1, 2) at x = -4, z = 24, count 3; its neighbour (2, 2) at
         // x = -2, count 5.
         c.count[2 * 5 + 1] = 3;

@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use super::ReportError;
+use crate::limits::{MAX_RUN_JSON_BYTES, MAX_RUN_TABLE_BYTES};
 
 /// The figures a verification directory may hold, in the order shown.
 pub const VERIFY_FIGURES: [&str; 2] = ["error_vs_pitch.png", "time_vs_pitch.png"];
@@ -50,7 +51,7 @@ impl Verification {
     pub fn read(dir: &Path) -> Result<Verification, ReportError> {
         let json = |name: &str| -> Result<Option<Value>, ReportError> {
             let path = dir.join(name);
-            match optional_text(&path)? {
+            match optional_text(&path, MAX_RUN_JSON_BYTES)? {
                 None => Ok(None),
                 Some(text) => serde_json::from_str(&text)
                     .map(Some)
@@ -60,13 +61,13 @@ impl Verification {
         let v = Verification {
             dir: dir.to_path_buf(),
             verify: json("verify.json")?,
-            verify_csv: optional_text(&dir.join("verify.csv"))?,
+            verify_csv: optional_text(&dir.join("verify.csv"), MAX_RUN_TABLE_BYTES)?,
             converge: json("converge.json")?,
-            converge_csv: optional_text(&dir.join("converge.csv"))?,
+            converge_csv: optional_text(&dir.join("converge.csv"), MAX_RUN_TABLE_BYTES)?,
             figures: VERIFY_FIGURES
                 .iter()
                 .filter_map(|name| {
-                    std::fs::read(dir.join(name))
+                    crate::limits::read_bounded(&dir.join(name), MAX_RUN_TABLE_BYTES)
                         .ok()
                         .map(|bytes| (name.to_string(), bytes))
                 })
@@ -263,8 +264,12 @@ fn list(keys: &[&str]) -> String {
     }
 }
 
-fn optional_text(path: &Path) -> Result<Option<String>, ReportError> {
-    match std::fs::read_to_string(path) {
+fn optional_text(path: &Path, max_bytes: u64) -> Result<Option<String>, ReportError> {
+    let text = crate::limits::read_bounded(path, max_bytes).and_then(|bytes| {
+        String::from_utf8(bytes)
+            .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+    });
+    match text {
         Ok(text) => Ok(Some(text)),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
         Err(source) => Err(ReportError::Io {

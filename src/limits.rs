@@ -1,0 +1,152 @@
+//! The bounds every user-given number and every file is held to, in one
+//! place, so that no arithmetic on them can wrap, overflow to infinity or
+//! end in NaN, and no allocation is asked for that the machine cannot make.
+//!
+//! Each bound is far beyond any real knee-form inspection (a part is at most
+//! a few metres, a pitch at least a few micrometres) and close enough that
+//! every derived integer (node indices, grid sizes, byte counts) stays
+//! exact in an `f64` and well inside an `i64`/`usize`. A refused value is
+//! named with its bound in one line; the few bounds a user could need
+//! beyond are set by a flag (`--max-memory`), the others are documented
+//! here and in `--help`.
+
+/// The finest pitch (mm): 1 um, a hundredth of the finest pitch any study
+/// here needed (0.25 mm).
+pub const MIN_PITCH_MM: f64 = 1e-3;
+
+/// The coarsest pitch (mm): half a metre, coarser than the knee-form.
+pub const MAX_PITCH_MM: f64 = 500.0;
+
+/// The largest knee-form length (triangle side, radius, thickness) and
+/// blind-spot depth (mm): 10 m.
+pub const MAX_LENGTH_MM: f64 = 1e4;
+
+/// The largest coordinate a part or grid may have, in absolute value
+/// (mm): 1 km, so that a node index `x / pitch` stays below 1e12 at the
+/// finest pitch and is exact as an `f64` and an `i64`.
+pub const MAX_COORD_MM: f64 = 1e6;
+
+/// The largest file-units-to-mm factor (`--scale`), and the inverse of the
+/// smallest: 1e6 (from km to mm, from nm to mm).
+pub const MAX_SCALE: f64 = 1e6;
+
+/// The most knee-form angles in one run: every twentieth of a degree over
+/// +-90, far more than the regulation's 61 whole degrees.
+pub const MAX_ANGLES: usize = 3601;
+
+/// The most nodes a grid may have, whatever the memory allowed: 2^30, a
+/// 33 m x 33 m part at 1 mm or 1 m x 1 m at 0.03 mm. Beyond it, node
+/// counts times bytes per node no longer fit a machine of today.
+pub const MAX_GRID_NODES: usize = 1 << 30;
+
+/// The most worker threads (`--threads`): more than any machine of today
+/// has CPUs, and few enough to start in a blink.
+pub const MAX_THREADS: usize = 1024;
+
+/// The largest part file read (bytes): 8 GiB, a binary STL of 170 million
+/// triangles. Checked on the file's size before reading, and on the bytes
+/// read for what is not a regular file (a pipe, `/dev/zero`).
+pub const MAX_PART_FILE_BYTES: u64 = 8 << 30;
+
+/// The most triangles a part may have: 170 million, the binary STL that
+/// fills [`MAX_PART_FILE_BYTES`]; 460 times the paper's console.
+pub const MAX_PART_TRIANGLES: usize = 170_000_000;
+
+/// The largest `summary.json` (or other run JSON file) read: 64 MiB; the
+/// paper workload's is 12 KB.
+pub const MAX_RUN_JSON_BYTES: u64 = 64 << 20;
+
+/// The largest run table or figure read back by `report`
+/// (`verify.csv`, `converge.csv`, a PNG): 1 GiB.
+pub const MAX_RUN_TABLE_BYTES: u64 = 1 << 30;
+
+/// Reads the file at `path` whole, refusing one longer than `max_bytes`:
+/// a regular file by its size, before reading anything; anything else (a
+/// pipe, a device such as `/dev/zero`) once `max_bytes` have been read.
+pub fn read_bounded(path: &std::path::Path, max_bytes: u64) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let file = std::fs::File::open(path)?;
+    let meta = file.metadata()?;
+    let too_long = |what: String| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("{what}, more than the {max_bytes} bytes read at most"),
+        )
+    };
+    if meta.is_dir() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::IsADirectory,
+            "is a directory",
+        ));
+    }
+    if meta.is_file() && meta.len() > max_bytes {
+        return Err(too_long(format!("{} bytes", meta.len())));
+    }
+    let mut bytes = Vec::new();
+    file.take(max_bytes + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(too_long("not a regular file and longer".into()));
+    }
+    Ok(bytes)
+}
+
+/// `len` copies of `value`, or an error where the allocation fails,
+/// rather than the abort of `vec![value; len]`: for buffers sized by a
+/// file or a user's number.
+pub fn try_filled<T: Clone>(len: usize, value: T) -> Result<Vec<T>, OutOfMemory> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(len).map_err(|_| OutOfMemory {
+        bytes: len.saturating_mul(std::mem::size_of::<T>()),
+    })?;
+    v.resize(len, value);
+    Ok(v)
+}
+
+/// An allocation the machine refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("cannot allocate {:.2} GiB", *bytes as f64 / f64::from(1u32 << 30))]
+pub struct OutOfMemory {
+    /// The bytes asked for.
+    pub bytes: usize,
+}
+
+/// A number for a message: short, whatever its size (`1e-300`, not three
+/// hundred digits; `0.25`, not `2.5e-1`).
+pub fn short(value: f64) -> String {
+    let a = value.abs();
+    if value == 0.0 || !value.is_finite() || (1e-4..1e7).contains(&a) {
+        let s = format!("{value:.6}");
+        let s = s.trim_end_matches('0').trim_end_matches('.');
+        if s.is_empty() || s == "-" || s == "-0" {
+            "0".into()
+        } else {
+            s.into()
+        }
+    } else {
+        format!("{value:e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn short_numbers_stay_short() {
+        assert_eq!(short(1e-300), "1e-300");
+        assert_eq!(short(1e300), "1e300");
+        assert_eq!(short(0.25), "0.25");
+        assert_eq!(short(-3.0), "-3");
+        assert_eq!(short(0.0), "0");
+        assert_eq!(short(f64::NAN), "NaN");
+        assert_eq!(short(f64::NEG_INFINITY), "-inf");
+        assert_eq!(short(1.24), "1.24");
+    }
+
+    #[test]
+    fn the_finest_grid_indices_are_exact() {
+        let index = MAX_COORD_MM / MIN_PITCH_MM;
+        assert!(index < 2f64.powi(52));
+        assert!((MAX_GRID_NODES as f64) < 2f64.powi(52));
+    }
+}
