@@ -6,6 +6,7 @@ mod cli;
 mod engine;
 mod first_hour;
 mod harness;
+mod hostile;
 mod oracle;
 mod report;
 mod resolution;
