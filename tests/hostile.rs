@@ -453,3 +453,24 @@ fn the_memory_estimate_bounds_the_measured_peak() {
     }
     std::fs::remove_dir_all(&scratch).unwrap();
 }
+
+#[test]
+fn report_never_overwrites_a_part_or_a_run_file() {
+    // Minor finding: `--out` naming the input was refused only after the
+    // work, or not at all for `report`.
+    let scratch = scratch_dir("report-out");
+    let d = scratch.join("out");
+    small_run(&d, &[]);
+    let summary = d.join("summary.json");
+    let before = std::fs::read(&summary).unwrap();
+    let out = kneeform(&[
+        "report",
+        d.to_str().unwrap(),
+        "--out",
+        summary.to_str().unwrap(),
+    ]);
+    let line = assert_refused(&out, &scratch, "report --out summary.json");
+    assert!(line.contains("not an .html file"), "{line}");
+    assert_eq!(std::fs::read(&summary).unwrap(), before);
+    std::fs::remove_dir_all(&scratch).unwrap();
+}
