@@ -7,6 +7,7 @@ mod engine;
 mod first_hour;
 mod frames;
 mod harness;
+mod hostile;
 mod oracle;
 mod report;
 mod resolution;

@@ -69,6 +69,7 @@ pub fn write_analysis(out: &OutputDir, analysis: &Analysis) -> Result<Summary, W
     let t_ = &mut summary.timings;
     t_.write_s = t.elapsed().as_secs_f64();
     t_.total_s = t_.read_s + t_.sample_s + t_.push_slide_s + t_.write_s;
+    summary.peak_rss_mib = crate::memory::peak_rss_bytes().map(|b| b / (1024.0 * 1024.0));
     write_json(&out.path("summary.json"), &summary)?;
     Ok(summary)
 }
@@ -182,7 +183,7 @@ fn write_rows(path: &Path, rows: &[impl serde::Serialize]) -> Result<(), WriteEr
 }
 
 fn commit(out: OutputDir, dir: &Path) -> Result<(), WriteError> {
-    out.commit().map_err(|source| WriteError::Commit {
+    out.commit().map(drop).map_err(|source| WriteError::Commit {
         path: dir.to_path_buf(),
         source,
     })
