@@ -467,11 +467,12 @@ impl Analysis {
             progress.warn(w);
         }
         // Every file is sized up before any is read.
-        let (mut file_bytes, mut triangles) = (0u64, 0u64);
+        let (mut file_bytes, mut triangles, mut known) = (0u64, 0u64, true);
         for path in source.files.iter().chain(&source.ignored) {
             let size = crate::mesh::part_size(path)?;
             file_bytes = file_bytes.saturating_add(size.file_bytes);
             triangles = triangles.saturating_add(size.triangles);
+            known &= size.known;
         }
         let reading = MemoryEstimate::reading(file_bytes, triangles);
         let shown = source
@@ -496,7 +497,11 @@ impl Analysis {
         let input = source.read()?;
         let read_s = t.elapsed().as_secs_f64();
         // What reading held, now that the triangles are counted.
-        let read = MemoryEstimate::reading(file_bytes, input.part.file_triangles as u64);
+        // (A stream's bytes, unknown before, as those of the binary STL of
+        // the triangles read.)
+        let n = input.part.file_triangles as u64;
+        let read_bytes = if known { file_bytes } else { 84 + 50 * n };
+        let read = MemoryEstimate::reading(read_bytes, n);
         let mut analysis = Analysis::run_checked(input, setup, progress, angle_warnings)?;
         analysis.timings.read_s = read_s;
         if read.bytes() > analysis.memory.bytes() {

@@ -49,6 +49,11 @@ pub const MAX_THREADS: usize = 1024;
 /// read for what is not a regular file (a pipe, `/dev/zero`).
 pub const MAX_PART_FILE_BYTES: u64 = 8 << 30;
 
+/// The most bytes read from a part that is not a regular file (a pipe,
+/// `/dev/stdin`), whose size cannot be known before reading: 1 GiB, a
+/// binary STL of 21 million triangles. Save a larger part to a file.
+pub const MAX_STREAM_BYTES: u64 = 1 << 30;
+
 /// The most triangles a part may have: 170 million, the binary STL that
 /// fills [`MAX_PART_FILE_BYTES`]; 460 times the paper's console.
 pub const MAX_PART_TRIANGLES: usize = 170_000_000;

@@ -244,6 +244,23 @@ pub fn read_part_bytes_bounded(path: &Path) -> Result<Vec<u8>, MeshError> {
         }
         StlKind::Ascii => crate::limits::MAX_PART_FILE_BYTES,
     };
+    // A stream's size is unknown until read: at most MAX_STREAM_BYTES.
+    let limit = if size.is_none() {
+        if limit > crate::limits::MAX_STREAM_BYTES
+            && matches!(stl_kind(&head, size), Ok(StlKind::Binary { .. }))
+        {
+            return Err(io(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!(
+                    "not a regular file, and its binary header announces {limit} bytes, more than the {} read from a stream: save the part to a file",
+                    crate::limits::MAX_STREAM_BYTES
+                ),
+            )));
+        }
+        limit.min(crate::limits::MAX_STREAM_BYTES)
+    } else {
+        limit
+    };
     if let Some(size) = size
         && size > limit
     {
@@ -281,6 +298,8 @@ pub struct PartSize {
     pub file_bytes: u64,
     /// Its triangles, or the most it can hold.
     pub triangles: u64,
+    /// Whether `file_bytes` is the file's (a regular file), not a bound.
+    pub known: bool,
 }
 
 /// The size of the part file at `path`, for the memory reading it takes
@@ -302,24 +321,34 @@ pub fn part_size(path: &Path) -> Result<PartSize, MeshError> {
         return Ok(PartSize {
             file_bytes: bytes.len() as u64,
             triangles: file.triangle_count(None) as u64,
+            known: true,
         });
     }
     let file = std::fs::File::open(path).map_err(io)?;
     let meta = file.metadata().map_err(io)?;
-    let size = meta.is_file().then_some(meta.len());
+    if !meta.is_file() {
+        // A stream is not read twice: counted at the most read from one.
+        let file_bytes = crate::limits::MAX_STREAM_BYTES;
+        return Ok(PartSize {
+            file_bytes,
+            triangles: file_bytes / 50,
+            known: false,
+        });
+    }
+    let size = meta.len();
     let mut head = Vec::with_capacity(STL_HEADER);
     (&file)
         .take(STL_HEADER as u64)
         .read_to_end(&mut head)
         .map_err(io)?;
-    let file_bytes = size.unwrap_or(crate::limits::MAX_PART_FILE_BYTES);
-    let triangles = match stl_kind(&head, size) {
+    let triangles = match stl_kind(&head, Some(size)) {
         Ok(StlKind::Binary { triangles }) => triangles,
-        _ => file_bytes / MIN_ASCII_FACET_BYTES,
+        _ => size / MIN_ASCII_FACET_BYTES,
     };
     Ok(PartSize {
-        file_bytes,
+        file_bytes: size,
         triangles,
+        known: true,
     })
 }
 

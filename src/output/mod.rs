@@ -131,16 +131,22 @@ pub struct OutputDir {
 
 /// The advisory lock of a result directory: `<parent>/.<name>.lock`, held
 /// (an exclusive `flock`) from staging until the value is dropped, by one
-/// run at a time. The empty lock file stays: removing it would let two
-/// runs lock two different files of the same name.
+/// run at a time, and removed when released.
+///
+/// Removing a lock file is safe because a lock counts only while its file
+/// still has the lock's name: after locking, [`DirLock::take`] checks the
+/// name still refers to the file it locked (a run releasing the lock may
+/// have just removed it) and otherwise tries again, and a release removes
+/// the name before it unlocks.
 #[derive(Debug)]
 pub struct DirLock {
-    _file: std::fs::File,
+    file: std::fs::File,
+    path: PathBuf,
 }
 
 impl DirLock {
-    /// Takes the lock of `final_dir`, or says which run-shaped thing holds
-    /// it (`ErrorKind::ResourceBusy`).
+    /// Takes the lock of `final_dir`, or says that another run holds it
+    /// (`ErrorKind::ResourceBusy`).
     pub fn take(final_dir: &Path) -> io::Result<DirLock> {
         let (parent, name) = parent_and_name(final_dir)?;
         std::fs::create_dir_all(&parent)?;
@@ -148,22 +154,53 @@ impl DirLock {
         lock_name.push(name);
         lock_name.push(".lock");
         let path = parent.join(lock_name);
-        let file = std::fs::OpenOptions::new()
-            .create(true)
-            .truncate(false)
-            .write(true)
-            .open(&path)?;
-        match file.try_lock() {
-            Ok(()) => Ok(DirLock { _file: file }),
-            Err(std::fs::TryLockError::WouldBlock) => Err(io::Error::new(
-                io::ErrorKind::ResourceBusy,
-                format!(
-                    "another kneeform run is writing it (it holds {}): wait for it to end, or choose another directory",
-                    path.display()
-                ),
-            )),
-            Err(std::fs::TryLockError::Error(e)) => Err(e),
+        loop {
+            let file = std::fs::OpenOptions::new()
+                .create(true)
+                .truncate(false)
+                .write(true)
+                .open(&path)?;
+            match file.try_lock() {
+                Ok(()) => {}
+                Err(std::fs::TryLockError::WouldBlock) => {
+                    return Err(io::Error::new(
+                        io::ErrorKind::ResourceBusy,
+                        format!(
+                            "another kneeform run is writing it (it holds {}): wait for it to end, or choose another directory",
+                            path.display()
+                        ),
+                    ));
+                }
+                Err(std::fs::TryLockError::Error(e)) => return Err(e),
+            }
+            if still_named(&file, &path) {
+                return Ok(DirLock { file, path });
+            }
         }
+    }
+}
+
+/// Whether `path` still names the open `file` (same device and inode).
+#[cfg(unix)]
+fn still_named(file: &std::fs::File, path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), std::fs::metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+/// Elsewhere a lock file's name cannot be compared: it is trusted.
+#[cfg(not(unix))]
+fn still_named(_file: &std::fs::File, path: &Path) -> bool {
+    path.exists()
+}
+
+impl Drop for DirLock {
+    fn drop(&mut self) {
+        // The name first, then the lock (when `file` closes).
+        let _ = std::fs::remove_file(&self.path);
+        let _ = self.file.unlock();
     }
 }
 
@@ -424,8 +461,8 @@ mod tests {
             std::fs::read_to_string(final_dir.join("a.csv")).unwrap(),
             "angle_deg\n"
         );
-        // The staging directory is gone; the lock file stays.
-        assert_eq!(entries(&root), [".run.lock", "run"]);
+        // The staging directory is gone, the lock released.
+        assert_eq!(entries(&root), ["run"]);
         std::fs::remove_dir_all(root).unwrap();
     }
 
@@ -467,7 +504,7 @@ mod tests {
             std::fs::read_to_string(final_dir.join("a.csv")).unwrap(),
             "second"
         );
-        assert_eq!(entries(&root), [".run.lock", "run"]);
+        assert_eq!(entries(&root), ["run"]);
         std::fs::remove_dir_all(root).unwrap();
     }
 
@@ -515,7 +552,7 @@ mod tests {
             std::fs::write(out.path("half.csv"), "angle_deg,i").unwrap();
             assert!(out.path("half.csv").exists());
         }
-        assert_eq!(entries(&root), [".run.lock"]);
+        assert!(entries(&root).is_empty());
         std::fs::remove_dir_all(root).unwrap();
     }
 
