@@ -5,6 +5,7 @@ mod analytic;
 mod cli;
 mod engine;
 mod first_hour;
+mod fuzz_seeded;
 mod harness;
 mod oracle;
 mod report;

@@ -3,7 +3,9 @@
 //! test suite (`tests/fuzz_seeded.rs`) both call these, so CI exercises
 //! exactly the calls the fuzzer does. Each takes untrusted bytes and must
 //! return: an `Err` from the library is a fine answer; a panic, an abort, a
-//! hang or a memory blow-up is a bug.
+//! hang or a memory blow-up is a bug. Each says whether the library
+//! accepted the input, so the seeded run can show that it reaches past the
+//! parsers.
 
 use std::path::Path;
 
@@ -18,15 +20,15 @@ use kneeform::summary::Summary;
 /// input within milliseconds in a release build.
 pub const FUZZ_MAX_TRIANGLES: usize = 200_000;
 
-/// `data` read as an STL part (binary or ASCII).
-pub fn stl(data: &[u8]) {
-    let _ = read_part_bytes(Path::new("fuzz.stl"), data, 1.0, Side::Left);
+/// `data` read as an STL part (binary or ASCII); whether it was read.
+pub fn stl(data: &[u8]) -> bool {
+    read_part_bytes(Path::new("fuzz.stl"), data, 1.0, Side::Left).is_ok()
 }
 
 /// `data` parsed as a scenario file and, when it parses into at most
 /// `max_triangles` triangles, tessellated (checking the count it
-/// announced) and read as a `.toml` part.
-pub fn scenario(data: &[u8], max_triangles: usize) {
+/// announced) and read as a `.toml` part; whether it was read as a part.
+pub fn scenario(data: &[u8], max_triangles: usize) -> bool {
     let path = Path::new("fuzz.toml");
     let small = match std::str::from_utf8(data).map(|text| scenario::parse(text, path)) {
         Ok(Ok(file)) => {
@@ -47,27 +49,27 @@ pub fn scenario(data: &[u8], max_triangles: usize) {
     };
     // read_part_bytes tessellates whatever parses, so it only runs where
     // the tessellation above did.
-    if small {
-        let _ = read_part_bytes(path, data, 1.0, Side::Left);
-    }
+    small && read_part_bytes(path, data, 1.0, Side::Left).is_ok()
 }
 
 /// `data` read as a `summary.json` with the checks `kneeform report`
 /// relies on ([`Summary::from_json`]) and, when it is accepted, its grid
 /// placed the way the report places it; an accepted summary must also
 /// read back unchanged from what serde writes for it (the writer and the
-/// reader agree).
-pub fn summary(data: &[u8]) {
+/// reader agree). Whether it was accepted.
+pub fn summary(data: &[u8]) -> bool {
     let Ok(text) = std::str::from_utf8(data) else {
-        return;
+        return false;
     };
-    if let Ok(summary) = Summary::from_json(text) {
-        let _ = kneeform::report::grid_spec(&summary);
-        let written = serde_json::to_string(&summary).expect("an accepted summary serialises");
-        let reread = Summary::from_json(&written).expect("a written summary reads back");
-        assert_eq!(
-            reread, summary,
-            "a summary changed on writing and reading back"
-        );
-    }
+    let Ok(summary) = Summary::from_json(text) else {
+        return false;
+    };
+    let _ = kneeform::report::grid_spec(&summary);
+    let written = serde_json::to_string(&summary).expect("an accepted summary serialises");
+    let reread = Summary::from_json(&written).expect("a written summary reads back");
+    assert_eq!(
+        reread, summary,
+        "a summary changed on writing and reading back"
+    );
+    true
 }

@@ -8,4 +8,6 @@
 #[path = "../entry.rs"]
 mod entry;
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| entry::scenario(data, entry::FUZZ_MAX_TRIANGLES));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    entry::scenario(data, entry::FUZZ_MAX_TRIANGLES);
+});
