@@ -16,7 +16,9 @@ use crate::blind::{BlindSpot, blind_spots};
 use crate::engine::{Algorithm, AngleMask, EngineOptions, Probe, colliding_masks, composite};
 use crate::grid::{GridError, GridSpec, HeightGrid};
 use crate::kneeform::{Footprint, GridFootprint, KneeForm};
-use crate::mesh::{Bbox, MeshError, PartFile, read_part};
+use crate::limits::{self, short};
+use crate::memory::MemoryEstimate;
+use crate::mesh::{Bbox, MeshError, Part, PartFile, read_part};
 use crate::sanity::{self, Warning};
 use crate::strike::StrikeRule;
 use crate::summary::{AngleSummary, Summary, Timings};
@@ -85,34 +87,51 @@ impl Default for Setup {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SetupError {
     /// A length or limit that must be a finite positive number is not.
-    #[error("the {field} must be a finite number > 0, got {value}")]
+    #[error("the {field} must be a finite number > 0, got {}", short(*value))]
     NotPositive {
-        /// The field (`pitch`, `triangle_side`, `radius`, `thickness`,
-        /// `max_memory`, `blind_depth`, `scale`).
+        /// The field (`max_memory`).
         field: &'static str,
         /// The value given.
         value: f64,
     },
+    /// A number is outside the bounds of [`crate::limits`].
+    #[error("the {field} must be a number from {} to {}, got {}", short(*min), short(*max), short(*value))]
+    OutOfRange {
+        /// The field (`pitch`, `triangle_side`, `radius`, `thickness`,
+        /// `blind_depth`, `scale`).
+        field: &'static str,
+        /// The value given.
+        value: f64,
+        /// The smallest allowed.
+        min: f64,
+        /// The largest allowed.
+        max: f64,
+    },
+    /// More angles than [`crate::limits::MAX_ANGLES`].
+    #[error("{0} angles given, at most {max} are analysed in one run", max = crate::limits::MAX_ANGLES)]
+    TooManyAngles(usize),
     /// The angle list is empty.
     #[error("no angle given")]
     NoAngles,
     /// An angle is not finite or beyond +-90 degrees.
-    #[error("angle {0} is outside -90..90 degrees")]
+    #[error("angle {} is outside -90..90 degrees", short(*.0))]
     AngleOutOfRange(f64),
     /// An angle is given twice.
-    #[error("angle {0} is given twice")]
+    #[error("angle {} is given twice", short(*.0))]
     RepeatedAngle(f64),
     /// The deflection threshold is outside [0, 45) degrees.
-    #[error("the deflection threshold must be a number of degrees in [0, 45), got {0}")]
+    #[error("the deflection threshold must be a number of degrees in [0, 45), got {}", short(*.0))]
     Deflection(f64),
     /// The rounding tolerance is outside [0, 0.01] mm.
-    #[error("e0 must be a number of mm in [0, 0.01] (it only absorbs rounding), got {0}")]
+    #[error("e0 must be a number of mm in [0, 0.01] (it only absorbs rounding), got {}", short(*.0))]
     E0(f64),
-    /// The explicit grid's origin is not finite.
-    #[error("the grid origin must be finite, got {0:?}")]
+    /// The explicit grid's origin is not finite, or beyond
+    /// [`crate::limits::MAX_COORD_MM`].
+    #[error("the grid origin must be two numbers of mm within +-{}, got {},{}", short(crate::limits::MAX_COORD_MM), short(.0[0]), short(.0[1]))]
     GridOrigin([f64; 2]),
-    /// The explicit grid has no node.
-    #[error("the grid size must be at least 1,1, got {0:?}")]
+    /// The explicit grid has no node, or more than
+    /// [`crate::limits::MAX_GRID_NODES`].
+    #[error("the grid size must be from 1,1 to {} nodes in all, got {},{}", crate::limits::MAX_GRID_NODES, .0[0], .0[1])]
     GridSize([usize; 2]),
 }
 
@@ -121,8 +140,9 @@ impl SetupError {
     /// `deflection`, `e0`, `grid_origin`, ...).
     pub fn field(&self) -> &'static str {
         match self {
-            SetupError::NotPositive { field, .. } => field,
+            SetupError::NotPositive { field, .. } | SetupError::OutOfRange { field, .. } => field,
             SetupError::NoAngles
+            | SetupError::TooManyAngles(_)
             | SetupError::AngleOutOfRange(_)
             | SetupError::RepeatedAngle(_) => "angles",
             SetupError::Deflection(_) => "deflection",
@@ -141,21 +161,41 @@ impl Setup {
 
     /// Checks every field, before any work.
     pub fn validate(&self) -> Result<(), SetupError> {
-        let positive = |field: &'static str, value: f64| {
-            if value.is_finite() && value > 0.0 {
+        let within = |field: &'static str, value: f64, min: f64, max: f64| {
+            if value.is_finite() && (min..=max).contains(&value) && value > 0.0 {
                 Ok(())
             } else {
-                Err(SetupError::NotPositive { field, value })
+                Err(SetupError::OutOfRange {
+                    field,
+                    value,
+                    min,
+                    max,
+                })
             }
         };
-        positive("pitch", self.pitch)?;
-        positive("triangle_side", self.knee.triangle_side)?;
-        positive("radius", self.knee.radius)?;
-        positive("thickness", self.knee.thickness)?;
-        positive("max_memory", self.max_memory_bytes)?;
-        positive("blind_depth", self.blind_depth)?;
+        within(
+            "pitch",
+            self.pitch,
+            limits::MIN_PITCH_MM,
+            limits::MAX_PITCH_MM,
+        )?;
+        let length =
+            |field, value| within(field, value, limits::MIN_PITCH_MM, limits::MAX_LENGTH_MM);
+        length("triangle_side", self.knee.triangle_side)?;
+        length("radius", self.knee.radius)?;
+        length("thickness", self.knee.thickness)?;
+        length("blind_depth", self.blind_depth)?;
+        if !(self.max_memory_bytes.is_finite() && self.max_memory_bytes > 0.0) {
+            return Err(SetupError::NotPositive {
+                field: "max_memory",
+                value: self.max_memory_bytes,
+            });
+        }
         if self.angles.is_empty() {
             return Err(SetupError::NoAngles);
+        }
+        if self.angles.len() > limits::MAX_ANGLES {
+            return Err(SetupError::TooManyAngles(self.angles.len()));
         }
         if let Some(&a) = self
             .angles
@@ -177,21 +217,33 @@ impl Setup {
             return Err(SetupError::E0(self.rule.e0));
         }
         if let GridPlacement::Explicit { origin, size } = self.grid {
-            if !origin.iter().all(|c| c.is_finite()) {
+            if !origin
+                .iter()
+                .all(|c| c.is_finite() && c.abs() <= limits::MAX_COORD_MM)
+            {
                 return Err(SetupError::GridOrigin(origin));
             }
-            if size.contains(&0) {
+            let nodes = size[0].checked_mul(size[1]);
+            if !nodes.is_some_and(|n| (1..=limits::MAX_GRID_NODES).contains(&n)) {
                 return Err(SetupError::GridSize(size));
             }
         }
         Ok(())
     }
 
-    /// The grid for a part with bounding box `bbox` (analysis frame), at
-    /// this setup's pitch: SPEC's default extent covers every requested
-    /// angle and its mirror, so that a part mirrored in z gets the mirrored
-    /// grid. Checked to be non-empty and within the memory limit.
-    pub fn grid_spec(&self, bbox: &Bbox) -> Result<GridSpec, GridError> {
+    /// The grid for `part` (analysis frame), at this setup's pitch: SPEC's
+    /// default extent covers every requested angle and its mirror, so that
+    /// a part mirrored in z gets the mirrored grid. Checked to have a
+    /// bounded number of nodes and the analysis on it to fit the memory
+    /// allowed ([`Setup::check_memory`]).
+    pub fn grid_spec(&self, part: &Part) -> Result<GridSpec, GridError> {
+        let spec = self.grid_placed(&part.bbox())?;
+        self.check_memory(&spec, part.triangles.len())?;
+        Ok(spec)
+    }
+
+    /// The grid alone, its node count checked, not its memory.
+    fn grid_placed(&self, bbox: &Bbox) -> Result<GridSpec, GridError> {
         let spec = match self.grid {
             GridPlacement::AroundPart => {
                 let extents: Vec<Footprint> = self
@@ -210,8 +262,52 @@ impl Setup {
                 GridSpec::explicit(origin[0], origin[1], size[0], size[1], self.pitch)
             }
         };
-        spec.check_fits(self.max_memory_bytes)?;
+        spec.check_nodes()?;
         Ok(spec)
+    }
+
+    /// The working memory of analysing a part of `triangles` triangles on
+    /// `spec` with this setup, on the current thread pool.
+    pub fn memory_estimate(&self, spec: &GridSpec, triangles: usize) -> MemoryEstimate {
+        MemoryEstimate::analysis(
+            spec,
+            &self.footprints(spec),
+            triangles,
+            rayon::current_num_threads(),
+        )
+    }
+
+    /// The estimate of [`Setup::memory_estimate`], checked against the
+    /// memory allowed and the machine's physical memory before anything is
+    /// allocated.
+    pub fn check_memory(
+        &self,
+        spec: &GridSpec,
+        triangles: usize,
+    ) -> Result<MemoryEstimate, GridError> {
+        spec.check_nodes()?;
+        let estimate = self.memory_estimate(spec, triangles);
+        check_estimate(&estimate, self.max_memory_bytes).map_err(|limit| {
+            let (nx, nz, angles) = (spec.nx, spec.nz, self.angles.len());
+            let need_gib = estimate.bytes() / GIB;
+            match limit {
+                Limit::Allowed(limit) => GridError::TooLarge {
+                    nx,
+                    nz,
+                    angles,
+                    need_gib,
+                    limit_gib: limit / GIB,
+                },
+                Limit::Machine(machine) => GridError::BeyondMachine {
+                    nx,
+                    nz,
+                    angles,
+                    need_gib,
+                    machine_gib: machine / GIB,
+                },
+            }
+        })?;
+        Ok(estimate)
     }
 
     /// The knee-form's footprint at every angle, laid on `spec`.
@@ -223,6 +319,29 @@ impl Setup {
     }
 }
 
+const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+
+/// Which limit an estimate broke (bytes).
+enum Limit {
+    Allowed(f64),
+    Machine(f64),
+}
+
+/// Whether `estimate` fits `allowed` bytes and the machine's memory.
+fn check_estimate(estimate: &MemoryEstimate, allowed: f64) -> Result<(), Limit> {
+    let need = estimate.bytes();
+    if need > allowed {
+        return Err(Limit::Allowed(allowed));
+    }
+    match crate::memory::physical_bytes() {
+        Some(machine) if need > machine => Err(Limit::Machine(machine)),
+        _ => Ok(()),
+    }
+}
+
+/// Estimates above this (bytes) are said before the run: 256 MiB.
+const NOTE_MEMORY_BYTES: f64 = 256.0 * 1024.0 * 1024.0;
+
 /// Why an analysis could not run.
 #[derive(Debug, thiserror::Error)]
 pub enum AnalysisError {
@@ -232,6 +351,20 @@ pub enum AnalysisError {
     /// The part could not be read.
     #[error(transparent)]
     Part(#[from] MeshError),
+    /// Reading the part would take more memory than allowed.
+    #[error(
+        "reading {path} needs about {need_gib:.2} GiB, more than the {limit_gib:.2} GiB {what}"
+    )]
+    ReadTooLarge {
+        /// The part file.
+        path: String,
+        /// The estimate.
+        need_gib: f64,
+        /// The limit.
+        limit_gib: f64,
+        /// Which limit, in words.
+        what: &'static str,
+    },
     /// The grid cannot be laid (empty, or too large for the memory limit).
     #[error(transparent)]
     Grid(#[from] GridError),
@@ -244,6 +377,11 @@ pub trait Progress: Sync {
     /// concerns).
     fn warn(&self, warning: &Warning) {
         let _ = warning;
+    }
+    /// A fact worth a line before long work (the memory a large run will
+    /// take).
+    fn note(&self, line: &str) {
+        let _ = line;
     }
     /// A stage begins: `what` in words, `total` steps when known.
     fn begin(&self, what: &str, total: Option<u64>) {
@@ -292,6 +430,8 @@ pub struct Analysis {
     /// The pitch study that chose `setup.pitch`, when one did (set by the
     /// caller: [`crate::harness::choose_pitch`]).
     pub pitch_choice: Option<crate::harness::PitchChoice>,
+    /// The working memory estimated before the run.
+    pub memory: MemoryEstimate,
     /// Seconds per stage (`write_s` and `total_s` are the writer's).
     pub timings: Timings,
 }
@@ -306,22 +446,35 @@ impl Analysis {
         progress: &dyn Progress,
     ) -> Result<Analysis, AnalysisError> {
         setup.validate()?;
-        if !(scale.is_finite() && scale > 0.0) {
-            return Err(SetupError::NotPositive {
-                field: "scale",
-                value: scale,
-            }
-            .into());
-        }
+        crate::mesh::check_scale(scale)?;
         let angle_warnings = sanity::angle_warnings(&setup.angles);
         for w in &angle_warnings {
             progress.warn(w);
         }
+        let size = crate::mesh::part_size(path)?;
+        let reading = MemoryEstimate::reading(size.file_bytes, size.triangles);
+        check_estimate(&reading, setup.max_memory_bytes).map_err(|limit| {
+            let (limit_gib, what) = match limit {
+                Limit::Allowed(b) => (b / GIB, "allowed by --max-memory"),
+                Limit::Machine(b) => (b / GIB, "this machine has"),
+            };
+            AnalysisError::ReadTooLarge {
+                path: path.display().to_string(),
+                need_gib: reading.bytes() / GIB,
+                limit_gib,
+                what,
+            }
+        })?;
         let t = Instant::now();
         let input = read_part(path, scale, side)?;
         let read_s = t.elapsed().as_secs_f64();
+        // What reading held, now that the triangles are counted.
+        let read = MemoryEstimate::reading(size.file_bytes, input.part.file_triangles as u64);
         let mut analysis = Analysis::run_checked(input, setup, progress, angle_warnings)?;
         analysis.timings.read_s = read_s;
+        if read.bytes() > analysis.memory.bytes() {
+            analysis.memory = read;
+        }
         Ok(analysis)
     }
 
@@ -353,7 +506,18 @@ impl Analysis {
         warnings.extend(part_warnings);
 
         let t = Instant::now();
-        let spec = setup.grid_spec(&input.part.bbox())?;
+        let spec = setup.grid_spec(&input.part)?;
+        let memory = setup.memory_estimate(&spec, input.part.triangles.len());
+        if memory.bytes() > NOTE_MEMORY_BYTES {
+            progress.note(&format!(
+                "this run needs about {:.2} GiB of memory ({} x {} grid, {} angles; --max-memory {:.2} GiB)",
+                memory.bytes() / GIB,
+                spec.nx,
+                spec.nz,
+                setup.angles.len(),
+                setup.max_memory_bytes / GIB
+            ));
+        }
         let grid = HeightGrid::sample(&input.part.triangles, spec);
         let footprints = setup.footprints(&spec);
         let sample_s = t.elapsed().as_secs_f64();
@@ -403,6 +567,7 @@ impl Analysis {
             blind_spots: blind,
             warnings,
             pitch_choice: None,
+            memory,
             timings: Timings {
                 sample_s,
                 push_slide_s,
@@ -480,6 +645,8 @@ impl Analysis {
             composite_area_mm2: composite_nodes as f64 * area,
             blind_depth_mm: setup.blind_depth,
             pitch_study: self.pitch_choice.clone(),
+            memory_estimate_mib: self.memory.mib(),
+            peak_rss_mib: None,
             blind_spots: self.blind_spots.len(),
             blind_spots_met: self
                 .blind_spots

@@ -29,19 +29,48 @@ pub struct GridSpec {
 /// Why a grid cannot be laid out.
 #[derive(Debug, thiserror::Error)]
 pub enum GridError {
-    /// The grid would not fit in memory.
+    /// The run would need more memory than allowed.
     #[error(
-        "a {nx} x {nz} grid needs about {need_gib:.1} GiB, more than the {limit_gib:.1} GiB allowed; use a coarser --pitch or a smaller --grid-size"
+        "this run needs about {need_gib:.2} GiB ({nx} x {nz} grid, {angles} angles), more than the {limit_gib:.2} GiB allowed by --max-memory; use a coarser --pitch, fewer --angles or a smaller --grid-size, or raise --max-memory"
     )]
     TooLarge {
         /// Nodes along x.
         nx: usize,
         /// Nodes along z.
         nz: usize,
-        /// Estimated memory need.
+        /// Angles analysed.
+        angles: usize,
+        /// Estimated memory need ([`crate::memory::MemoryEstimate`]).
         need_gib: f64,
         /// The limit.
         limit_gib: f64,
+    },
+    /// The run would need more memory than the machine has.
+    #[error(
+        "this run needs about {need_gib:.2} GiB ({nx} x {nz} grid, {angles} angles), more than this machine's {machine_gib:.2} GiB of memory; use a coarser --pitch, fewer --angles or a smaller --grid-size"
+    )]
+    BeyondMachine {
+        /// Nodes along x.
+        nx: usize,
+        /// Nodes along z.
+        nz: usize,
+        /// Angles analysed.
+        angles: usize,
+        /// Estimated memory need.
+        need_gib: f64,
+        /// The machine's physical memory.
+        machine_gib: f64,
+    },
+    /// The grid has more nodes than [`crate::limits::MAX_GRID_NODES`].
+    #[error(
+        "a {nx} x {nz} grid has more than the {} nodes a grid may have; use a coarser --pitch or a smaller --grid-size",
+        crate::limits::MAX_GRID_NODES
+    )]
+    TooManyNodes {
+        /// Nodes along x.
+        nx: usize,
+        /// Nodes along z.
+        nz: usize,
     },
     /// The grid has no node.
     #[error("the grid is empty ({nx} x {nz} nodes)")]
@@ -52,12 +81,6 @@ pub enum GridError {
         nz: usize,
     },
 }
-
-/// Bytes of working memory per grid node in a full analysis: the heights,
-/// the push window-minimum table (about ten levels of f64), the face levels
-/// and one byte of mask per angle in flight, with padding. Measured peak RSS
-/// on the paper-sized benchmark divided by its node count, rounded up.
-pub const BYTES_PER_NODE: f64 = 160.0;
 
 impl GridSpec {
     /// The default extent of SPEC: every node whose footprint, at any of
@@ -116,27 +139,22 @@ impl GridSpec {
 
     /// Whether the grid has no node.
     pub fn is_empty(&self) -> bool {
-        self.len() == 0
+        self.nx == 0 || self.nz == 0
     }
 
-    /// Checks the grid is non-empty and its estimated working memory
-    /// ([`BYTES_PER_NODE`] per node) fits in `limit_bytes`, before anything
-    /// is allocated.
-    pub fn check_fits(&self, limit_bytes: f64) -> Result<(), GridError> {
+    /// Checks the grid has at least one node and at most
+    /// [`crate::limits::MAX_GRID_NODES`], before anything is allocated (the
+    /// memory a run needs is [`crate::memory::MemoryEstimate`]'s).
+    pub fn check_nodes(&self) -> Result<(), GridError> {
+        let (nx, nz) = (self.nx, self.nz);
         if self.is_empty() {
-            return Err(GridError::Empty {
-                nx: self.nx,
-                nz: self.nz,
-            });
+            return Err(GridError::Empty { nx, nz });
         }
-        let need = self.nx as f64 * self.nz as f64 * BYTES_PER_NODE;
-        if need > limit_bytes {
-            return Err(GridError::TooLarge {
-                nx: self.nx,
-                nz: self.nz,
-                need_gib: need / f64::from(1u32 << 30),
-                limit_gib: limit_bytes / f64::from(1u32 << 30),
-            });
+        if nx
+            .checked_mul(nz)
+            .is_none_or(|n| n > crate::limits::MAX_GRID_NODES)
+        {
+            return Err(GridError::TooManyNodes { nx, nz });
         }
         Ok(())
     }
@@ -285,10 +303,24 @@ mod tests {
         assert_eq!(coarse.x(0), fine.x((coarse.x(0) - fine.x(0)) as usize / 2));
         assert!(coarse.x(0) <= -10.0 - fp[0].x_range().1);
         assert!(coarse.x(coarse.nx - 1) >= 30.0 - fp[0].x_range().0);
-        assert!(coarse.check_fits(1e12).is_ok());
+        assert!(coarse.check_nodes().is_ok());
+        let huge = GridSpec {
+            nx: 1 << 20,
+            nz: 1 << 20,
+            ..coarse
+        };
         assert!(matches!(
-            coarse.check_fits(10.0),
-            Err(GridError::TooLarge { .. })
+            huge.check_nodes(),
+            Err(GridError::TooManyNodes { .. })
+        ));
+        let wrapping = GridSpec {
+            nx: usize::MAX,
+            nz: 2,
+            ..coarse
+        };
+        assert!(matches!(
+            wrapping.check_nodes(),
+            Err(GridError::TooManyNodes { .. })
         ));
     }
 }

@@ -45,6 +45,7 @@ pub mod grid;
 pub mod harness;
 pub mod kneeform;
 pub mod limits;
+pub mod memory;
 pub mod mesh;
 pub mod output;
 pub mod padded;

@@ -22,9 +22,10 @@ pub const MAX_PITCH_MM: f64 = 500.0;
 pub const MAX_LENGTH_MM: f64 = 1e4;
 
 /// The largest coordinate a part or grid may have, in absolute value
-/// (mm): 1 km, so that a node index `x / pitch` stays below 1e12 at the
-/// finest pitch and is exact as an `f64` and an `i64`.
-pub const MAX_COORD_MM: f64 = 1e6;
+/// (mm): 10 km (a 2 m part read in micrometres still reads, to be warned
+/// of), so that a node index `x / pitch` stays below 1e10 at the finest
+/// pitch and is exact as an `f64` and an `i64`.
+pub const MAX_COORD_MM: f64 = 1e7;
 
 /// The largest file-units-to-mm factor (`--scale`), and the inverse of the
 /// smallest: 1e6 (from km to mm, from nm to mm).

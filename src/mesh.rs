@@ -68,6 +68,27 @@ pub enum MeshError {
         /// The triangle's index in the file.
         index: usize,
     },
+    /// A vertex lies beyond [`crate::limits::MAX_COORD_MM`] once scaled.
+    #[error("{path}: triangle {index} lies {} mm from the origin, beyond the {} mm a part may span (wrong --scale?)", crate::limits::short(*distance), crate::limits::short(crate::limits::MAX_COORD_MM))]
+    TooFar {
+        /// The file.
+        path: String,
+        /// The triangle's index in the file.
+        index: usize,
+        /// Its largest coordinate (mm, absolute).
+        distance: f64,
+    },
+    /// The file holds more triangles than [`crate::limits::MAX_PART_TRIANGLES`].
+    #[error(
+        "{path} holds {count} triangles, more than the {} a part may have",
+        crate::limits::MAX_PART_TRIANGLES
+    )]
+    TooManyTriangles {
+        /// The file.
+        path: String,
+        /// How many it holds (or declares).
+        count: u64,
+    },
     /// A scenario file could not be read or tessellated.
     #[error(transparent)]
     Scenario(#[from] crate::scenario::ScenarioError),
@@ -125,16 +146,199 @@ impl PartFile {
     }
 }
 
+/// Checks a file-units-to-mm factor: finite, within
+/// [`crate::limits::MAX_SCALE`] of 1 either way.
+pub fn check_scale(scale: f64) -> Result<(), crate::SetupError> {
+    let max = crate::limits::MAX_SCALE;
+    if scale.is_finite() && (1.0 / max..=max).contains(&scale) {
+        Ok(())
+    } else {
+        Err(crate::SetupError::OutOfRange {
+            field: "scale",
+            value: scale,
+            min: 1.0 / max,
+            max,
+        })
+    }
+}
+
 /// Reads a part from an STL file (binary or ASCII) or a scenario file
 /// (`.toml`, tessellated at its own step), scales it by `scale` (to mm)
 /// and maps `side` into the analysis frame; the file's SHA-256 is taken
-/// from the same bytes.
+/// from the same bytes. The file is sized up before it is read
+/// ([`read_part_bytes_bounded`]).
 pub fn read_part(path: &Path, scale: f64, side: Side) -> Result<PartFile, MeshError> {
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
-        path: path.display().to_string(),
-        source,
-    })?;
+    let bytes = read_part_bytes_bounded(path)?;
     read_part_bytes(path, &bytes, scale, side)
+}
+
+/// The bytes of the part file at `path`, read only once they are known to
+/// be a part of bounded size: a regular file by its size
+/// ([`crate::limits::MAX_PART_FILE_BYTES`]; a scenario file
+/// [`crate::limits::MAX_RUN_JSON_BYTES`]) and, for STL, by its first bytes
+/// (a binary header whose triangle count gives the file's size, or ASCII's
+/// `solid`), so that a large file of something else is refused without
+/// being read. A stream (a pipe, a device) is read up to the size its
+/// binary header gives, or the bound.
+pub fn read_part_bytes_bounded(path: &Path) -> Result<Vec<u8>, MeshError> {
+    use std::io::Read;
+    let name = path.display().to_string();
+    let io = |source| MeshError::Io {
+        path: name.clone(),
+        source,
+    };
+    if crate::scenario::is_scenario_file(path) {
+        return crate::limits::read_bounded(path, crate::limits::MAX_RUN_JSON_BYTES).map_err(io);
+    }
+    let file = std::fs::File::open(path).map_err(io)?;
+    let meta = file.metadata().map_err(io)?;
+    if meta.is_dir() {
+        return Err(io(std::io::Error::new(
+            std::io::ErrorKind::IsADirectory,
+            "is a directory",
+        )));
+    }
+    let size = meta.is_file().then_some(meta.len());
+    let mut head = Vec::with_capacity(STL_HEADER);
+    (&file)
+        .take(STL_HEADER as u64)
+        .read_to_end(&mut head)
+        .map_err(io)?;
+    let limit = match stl_kind(&head, size).map_err(|reason| MeshError::Format {
+        path: name.clone(),
+        reason,
+    })? {
+        StlKind::Binary { triangles } => {
+            if triangles > crate::limits::MAX_PART_TRIANGLES as u64 {
+                return Err(MeshError::TooManyTriangles {
+                    path: name,
+                    count: triangles,
+                });
+            }
+            binary_stl_len(triangles)
+        }
+        StlKind::Ascii => crate::limits::MAX_PART_FILE_BYTES,
+    };
+    if let Some(size) = size
+        && size > limit
+    {
+        return Err(io(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("{size} bytes, more than the {limit} bytes read at most"),
+        )));
+    }
+    let mut bytes = head;
+    bytes
+        .try_reserve_exact(size.unwrap_or(0).saturating_sub(bytes.len() as u64) as usize)
+        .map_err(|_| {
+            io(std::io::Error::new(
+                std::io::ErrorKind::OutOfMemory,
+                "cannot allocate memory for the file",
+            ))
+        })?;
+    (&file)
+        .take(limit + 1 - bytes.len() as u64)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > limit {
+        return Err(MeshError::Format {
+            path: name,
+            reason: format!("longer than the {limit} bytes its binary header announces"),
+        });
+    }
+    Ok(bytes)
+}
+
+/// A part file's size, known before reading it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PartSize {
+    /// Its bytes (a stream: the most read, [`crate::limits::MAX_PART_FILE_BYTES`]).
+    pub file_bytes: u64,
+    /// Its triangles, or the most it can hold.
+    pub triangles: u64,
+}
+
+/// The size of the part file at `path`, for the memory reading it takes
+/// ([`crate::memory::MemoryEstimate::reading`]), known before reading it:
+/// from its size and, for STL, its header's triangle count (binary) or the
+/// most triangles its size can hold (ASCII, [`MIN_ASCII_FACET_BYTES`]
+/// each); a scenario file is parsed for its count.
+pub fn part_size(path: &Path) -> Result<PartSize, MeshError> {
+    use std::io::Read;
+    let name = path.display().to_string();
+    let io = |source| MeshError::Io {
+        path: name.clone(),
+        source,
+    };
+    if crate::scenario::is_scenario_file(path) {
+        let bytes = read_part_bytes_bounded(path)?;
+        let text = String::from_utf8_lossy(&bytes);
+        let file = crate::scenario::parse(&text, path)?;
+        return Ok(PartSize {
+            file_bytes: bytes.len() as u64,
+            triangles: file.triangle_count(None) as u64,
+        });
+    }
+    let file = std::fs::File::open(path).map_err(io)?;
+    let meta = file.metadata().map_err(io)?;
+    let size = meta.is_file().then_some(meta.len());
+    let mut head = Vec::with_capacity(STL_HEADER);
+    (&file)
+        .take(STL_HEADER as u64)
+        .read_to_end(&mut head)
+        .map_err(io)?;
+    let file_bytes = size.unwrap_or(crate::limits::MAX_PART_FILE_BYTES);
+    let triangles = match stl_kind(&head, size) {
+        Ok(StlKind::Binary { triangles }) => triangles,
+        _ => file_bytes / MIN_ASCII_FACET_BYTES,
+    };
+    Ok(PartSize {
+        file_bytes,
+        triangles,
+    })
+}
+
+/// The fewest bytes an ASCII STL facet takes (`facet normal 0 0 0`,
+/// `outer loop`, three `vertex 0 0 0`, `endloop`, `endfacet`, one space
+/// each between words and lines).
+pub const MIN_ASCII_FACET_BYTES: u64 = 80;
+
+/// The bytes of a binary STL's header: 80 of text, a 4-byte count.
+const STL_HEADER: usize = 84;
+
+/// The length of a binary STL of `triangles` triangles (50 bytes each).
+fn binary_stl_len(triangles: u64) -> u64 {
+    STL_HEADER as u64 + 50 * triangles
+}
+
+/// How an STL file is written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum StlKind {
+    /// Binary, with the triangle count of its header.
+    Binary { triangles: u64 },
+    /// ASCII (`solid ...`).
+    Ascii,
+}
+
+/// An STL file's kind from its first [`STL_HEADER`] bytes and, for a
+/// regular file, its size. Binary files may start with `solid` too, so a
+/// file is binary when its size matches the triangle count in its header
+/// (a stream, whose size is unknown, when it does not start with `solid`),
+/// and ASCII when it starts with `solid`.
+fn stl_kind(head: &[u8], size: Option<u64>) -> Result<StlKind, String> {
+    let count = (head.len() >= STL_HEADER)
+        .then(|| u64::from(u32::from_le_bytes([head[80], head[81], head[82], head[83]])));
+    let ascii = head.trim_ascii_start().starts_with(b"solid");
+    match (count, size) {
+        (Some(n), Some(size)) if binary_stl_len(n) == size => Ok(StlKind::Binary { triangles: n }),
+        (Some(n), None) if !ascii => Ok(StlKind::Binary { triangles: n }),
+        _ if ascii => Ok(StlKind::Ascii),
+        (None, _) => Err(format!(
+            "{} bytes, too short for a binary STL header",
+            head.len()
+        )),
+        _ => Err("neither ASCII (`solid ...`) nor binary: the binary triangle count does not match the file size (truncated?)".into()),
+    }
 }
 
 /// The SHA-256 of `bytes`, lowercase hex: a part file's identity.
@@ -217,6 +421,23 @@ impl Part {
                 index,
             });
         }
+        if triangles.len() > crate::limits::MAX_PART_TRIANGLES {
+            return Err(MeshError::TooManyTriangles {
+                path: name.into(),
+                count: triangles.len() as u64,
+            });
+        }
+        let reach = |t: &Triangle| t.iter().flatten().fold(0.0f64, |m, c| m.max(c.abs())) * scale;
+        if let Some(index) = triangles
+            .iter()
+            .position(|t| reach(t) > crate::limits::MAX_COORD_MM)
+        {
+            return Err(MeshError::TooFar {
+                path: name.into(),
+                index,
+                distance: reach(&triangles[index]),
+            });
+        }
         let file_triangles = triangles.len();
         let kept: Vec<Triangle> = triangles
             .into_iter()
@@ -269,31 +490,29 @@ fn is_degenerate(t: &Triangle) -> bool {
 /// a file is taken as binary when its size matches the triangle count in
 /// its header, and as ASCII otherwise.
 fn parse_stl(bytes: &[u8]) -> Result<Vec<Triangle>, String> {
-    let looks_binary = bytes.len() >= 84 && {
-        let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
-        84 + 50 * n == bytes.len() as u64
-    };
+    let kind = stl_kind(
+        &bytes[..bytes.len().min(STL_HEADER)],
+        Some(bytes.len() as u64),
+    )?;
     let text = bytes.trim_ascii_start();
-    let looks_ascii = text.starts_with(b"solid");
-    let normalised: Vec<u8> = if looks_binary {
+    let normalised: Vec<u8> = if let StlKind::Binary { triangles } = kind {
+        if triangles > crate::limits::MAX_PART_TRIANGLES as u64 {
+            return Err(format!(
+                "{triangles} triangles, more than the {} a part may have",
+                crate::limits::MAX_PART_TRIANGLES
+            ));
+        }
         // stl_io takes any file whose first line starts with "solid " as
         // ASCII; the binary header is free text, so blank it.
         let mut copy = bytes.to_vec();
         copy[..80].fill(0);
         copy
-    } else if looks_ascii {
+    } else {
         // stl_io wants "solid " with a space; exporters also write a bare
         // "solid" line.
         let mut copy = b"solid ".to_vec();
         copy.extend_from_slice(&text[5..]);
         copy
-    } else if bytes.len() < 84 {
-        return Err(format!(
-            "{} bytes, too short for a binary STL header",
-            bytes.len()
-        ));
-    } else {
-        return Err("binary triangle count does not match the file size (truncated?)".into());
     };
     let mut cursor = std::io::Cursor::new(normalised);
     let stl = stl_io::create_stl_reader(&mut cursor)

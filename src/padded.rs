@@ -37,10 +37,22 @@ pub fn start_lanes(fp: &GridFootprint, nx: usize) -> std::ops::Range<i64> {
     (-i64::from(kf_max)).min(0)..nx as i64
 }
 
-impl PaddedGrid {
-    /// Pads `grid` for all of `footprints`.
-    pub fn new(grid: &HeightGrid, footprints: &[GridFootprint]) -> PaddedGrid {
-        let GridSpec { nx, nz, .. } = grid.spec;
+/// The padding [`PaddedGrid::new`] gives a grid for some footprints,
+/// known before anything is allocated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Padding {
+    /// Padding columns before column 0.
+    pub pad_lo: usize,
+    /// Padding rows before row 0 (and after the last).
+    pub pad_rows: usize,
+    /// Length of a padded row.
+    pub stride: usize,
+}
+
+impl Padding {
+    /// The padding of `spec` for all of `footprints`.
+    pub fn of(spec: &GridSpec, footprints: &[GridFootprint]) -> Padding {
+        let nx = spec.nx;
         let (mut lo, mut hi, mut dj_max) = (0i64, 0i64, 0i64);
         for fp in footprints {
             let (k_lo, k_hi) = fp.k_range();
@@ -53,8 +65,28 @@ impl PaddedGrid {
                 .max(i64::from(dj_hi).abs());
         }
         let pad_lo = (-lo) as usize + LANE_SLACK;
-        let stride = pad_lo + nx + hi as usize + 1 + LANE_SLACK;
-        let pad_rows = dj_max as usize;
+        Padding {
+            pad_lo,
+            pad_rows: dj_max as usize,
+            stride: pad_lo + nx + hi as usize + 1 + LANE_SLACK,
+        }
+    }
+
+    /// Nodes of the padded grid of `spec`.
+    pub fn nodes(&self, spec: &GridSpec) -> usize {
+        self.stride * (spec.nz + 2 * self.pad_rows)
+    }
+}
+
+impl PaddedGrid {
+    /// Pads `grid` for all of `footprints`.
+    pub fn new(grid: &HeightGrid, footprints: &[GridFootprint]) -> PaddedGrid {
+        let GridSpec { nx, nz, .. } = grid.spec;
+        let Padding {
+            pad_lo,
+            pad_rows,
+            stride,
+        } = Padding::of(&grid.spec, footprints);
         let mut h = vec![f64::INFINITY; stride * (nz + 2 * pad_rows)];
         for (dst, src) in h[pad_rows * stride..]
             .chunks_exact_mut(stride)

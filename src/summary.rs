@@ -115,6 +115,16 @@ pub struct Summary {
     /// chose `pitch_mm`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pitch_study: Option<crate::harness::PitchChoice>,
+    /// The working memory estimated before the run (MiB,
+    /// [`crate::memory::MemoryEstimate`]). Absent in runs of earlier
+    /// versions.
+    #[serde(default)]
+    pub memory_estimate_mib: f64,
+    /// The process's peak resident memory when the summary was written
+    /// (MiB), where the system says: what the estimate is held to. A
+    /// measurement, like `timings`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_rss_mib: Option<f64>,
     /// Time per stage.
     pub timings: Timings,
     /// The sanity checks' warnings (one line each), as printed on stderr:

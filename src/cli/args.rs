@@ -366,7 +366,7 @@ impl SetupArgs {
     /// the flag at fault; also returns `--threads`.
     pub fn validate(&self) -> anyhow::Result<(Setup, Option<usize>)> {
         if let Some(n) = self.threads {
-            ensure!(n >= 1, "--threads must be at least 1");
+            check_threads(n)?;
         }
         let grid = match (&self.grid_origin, &self.grid_size) {
             (Some(origin), Some(size)) => GridPlacement::Explicit {
@@ -409,13 +409,18 @@ pub fn with_flag(err: SetupError) -> anyhow::Error {
 impl PartArgs {
     /// Validates the flags.
     pub fn validate(&self) -> anyhow::Result<()> {
-        ensure!(
-            self.scale.is_finite() && self.scale > 0.0,
-            "--scale must be a finite number > 0, got {}",
-            self.scale
-        );
-        Ok(())
+        kneeform::mesh::check_scale(self.scale).context("--scale")
     }
+}
+
+/// `--threads`: at least 1, at most [`kneeform::limits::MAX_THREADS`].
+pub fn check_threads(n: usize) -> anyhow::Result<()> {
+    ensure!(
+        (1..=kneeform::limits::MAX_THREADS).contains(&n),
+        "--threads must be between 1 and {}, got {n}",
+        kneeform::limits::MAX_THREADS
+    );
+    Ok(())
 }
 
 fn pair<T: std::str::FromStr>(s: &str) -> anyhow::Result<[T; 2]>
@@ -444,12 +449,27 @@ pub fn parse_angles(s: &str) -> anyhow::Result<Vec<f64>> {
         );
         ensure!(step > 0.0, "--angles {s:?}: STEP must be > 0");
         ensure!(to >= from, "--angles {s:?}: TO must be >= FROM");
-        let n = ((to - from) / step + 1e-9).floor() as usize + 1;
+        // Counted before any angle is made: `-90:90:1e-9` is refused, not
+        // allocated.
+        let count = ((to - from) / step + 1e-9).floor() + 1.0;
+        ensure!(
+            count <= kneeform::limits::MAX_ANGLES as f64,
+            "--angles {s:?}: {} angles, more than the {} a run takes (use a larger STEP)",
+            kneeform::limits::short(count),
+            kneeform::limits::MAX_ANGLES
+        );
+        let n = count as usize;
         // Rounded to 1e-9 degree so that 0.1-degree steps print cleanly.
         (0..n)
             .map(|k| ((from + k as f64 * step) * 1e9).round() / 1e9)
             .collect()
     } else {
+        let count = s.split(',').count();
+        ensure!(
+            count <= kneeform::limits::MAX_ANGLES,
+            "--angles: {count} angles, more than the {} a run takes",
+            kneeform::limits::MAX_ANGLES
+        );
         s.split(',')
             .map(number)
             .collect::<anyhow::Result<Vec<f64>>>()?

@@ -98,7 +98,7 @@ pub fn one_line(err: &anyhow::Error) -> String {
 /// Sizes rayon's global pool (default: one thread per CPU).
 pub fn set_threads(threads: Option<usize>) -> anyhow::Result<()> {
     if let Some(n) = threads {
-        anyhow::ensure!(n >= 1, "--threads must be at least 1");
+        args::check_threads(n)?;
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build_global()?;

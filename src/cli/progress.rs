@@ -22,13 +22,23 @@ impl Bars {
     }
 }
 
-impl Progress for Bars {
-    fn warn(&self, warning: &Warning) {
-        let line = format!("kneeform: warning: {warning}");
+impl Bars {
+    /// A line on stderr, above the bar if one is shown.
+    fn say(&self, line: &str) {
         match self.current().as_ref() {
             Some(bar) => bar.suspend(|| eprintln!("{line}")),
             None => eprintln!("{line}"),
         }
+    }
+}
+
+impl Progress for Bars {
+    fn warn(&self, warning: &Warning) {
+        self.say(&format!("kneeform: warning: {warning}"));
+    }
+
+    fn note(&self, line: &str) {
+        self.say(&format!("kneeform: {line}"));
     }
 
     fn begin(&self, what: &str, total: Option<u64>) {

@@ -35,7 +35,7 @@ use super::nearest::PointSet;
 use super::{HarnessError, TieBand};
 use crate::analysis::{Progress, Setup};
 use crate::engine::AngleMask;
-use crate::grid::{BYTES_PER_NODE, GridSpec, HeightGrid};
+use crate::grid::{GridSpec, HeightGrid};
 use crate::mesh::PartFile;
 
 /// How to choose the pitch.
@@ -138,7 +138,11 @@ pub fn choose_pitch(
         progress,
     )?;
     let scale = setup.angles.len() as f64 / angles.len() as f64;
-    let memory = |spec: &GridSpec| spec.nx as f64 * spec.nz as f64 * BYTES_PER_NODE;
+    let memory = |spec: &GridSpec| {
+        setup
+            .memory_estimate(spec, input.part.triangles.len())
+            .bytes()
+    };
 
     let mut rows: Vec<PitchStudyRow> = Vec::new();
     // The struck points per angle at the previous (coarser) pitch.

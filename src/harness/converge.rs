@@ -178,7 +178,7 @@ impl<'a> Ladder<'a> {
     ) -> Result<Ladder<'a>, HarnessError> {
         setup.validate()?;
         let triangles = &input.part.triangles;
-        let coarse = setup.grid_spec(&input.part.bbox())?;
+        let coarse = setup.grid_spec(&input.part)?;
         let coarse_grid = HeightGrid::sample(triangles, coarse);
         let starts = start_positions(&coarse_grid, &setup.footprints(&coarse), selection)?;
         drop(coarse_grid);
@@ -345,7 +345,7 @@ pub fn converge(
         progress,
     )?;
     for &p in pitches {
-        ladder.spec_at(p).check_fits(setup.max_memory_bytes)?;
+        setup.check_memory(&ladder.spec_at(p), input.part.triangles.len())?;
     }
     let mut results = Vec::new();
     for &pitch in pitches {

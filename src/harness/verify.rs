@@ -167,7 +167,7 @@ pub(crate) fn verify_with(
     options.validate()?;
     let t = Instant::now();
     let triangles = &input.part.triangles;
-    let spec = setup.grid_spec(&input.part.bbox())?;
+    let spec = setup.grid_spec(&input.part)?;
     let grid = HeightGrid::sample(triangles, spec);
     let footprints = setup.footprints(&spec);
     let sample_s = t.elapsed().as_secs_f64();
