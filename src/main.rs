@@ -9,8 +9,24 @@ use clap::Parser;
 
 use cli::args::{Cli, Command};
 
+/// Exit code after SIGINT or SIGTERM (128 + SIGINT's number, as shells
+/// report an interrupted command).
+const INTERRUPTED: i32 = 130;
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // An interrupted run leaves nothing behind: its staged results and
+    // temporary files are removed (a commit in progress finishes first).
+    let handler = ctrlc::set_handler(|| {
+        kneeform::output::remove_staged();
+        eprintln!("kneeform: interrupted; partial results removed");
+        std::process::exit(INTERRUPTED);
+    });
+    if let Err(err) = handler {
+        eprintln!(
+            "kneeform: warning: cannot catch interrupts ({err}); an interrupted run may leave a hidden .partial directory"
+        );
+    }
     match run(&cli) {
         Ok(code) => code,
         Err(err) => {

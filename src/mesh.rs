@@ -298,6 +298,49 @@ pub fn part_size(path: &Path) -> Result<PartSize, MeshError> {
     })
 }
 
+/// Checks triangles read from the file `name` (scaled by `scale` to mm)
+/// can be a part: some triangles, at most
+/// [`crate::limits::MAX_PART_TRIANGLES`], every coordinate finite and
+/// within [`crate::limits::MAX_COORD_MM`], and not all of zero area.
+pub fn check_triangles(name: &str, triangles: &[Triangle], scale: f64) -> Result<(), MeshError> {
+    if triangles.is_empty() {
+        return Err(MeshError::Empty { path: name.into() });
+    }
+    if let Some(index) = triangles
+        .iter()
+        .position(|t| t.iter().flatten().any(|c| !c.is_finite()))
+    {
+        return Err(MeshError::NonFinite {
+            path: name.into(),
+            index,
+        });
+    }
+    if triangles.len() > crate::limits::MAX_PART_TRIANGLES {
+        return Err(MeshError::TooManyTriangles {
+            path: name.into(),
+            count: triangles.len() as u64,
+        });
+    }
+    let reach = |t: &Triangle| t.iter().flatten().fold(0.0f64, |m, c| m.max(c.abs())) * scale;
+    if let Some(index) = triangles
+        .iter()
+        .position(|t| reach(t) > crate::limits::MAX_COORD_MM)
+    {
+        return Err(MeshError::TooFar {
+            path: name.into(),
+            index,
+            distance: reach(&triangles[index]),
+        });
+    }
+    if triangles.iter().all(is_degenerate) {
+        return Err(MeshError::AllDegenerate {
+            path: name.into(),
+            count: triangles.len(),
+        });
+    }
+    Ok(())
+}
+
 /// The fewest bytes an ASCII STL facet takes (`facet normal 0 0 0`,
 /// `outer loop`, three `vertex 0 0 0`, `endloop`, `endfacet`, one space
 /// each between words and lines).
@@ -409,35 +452,7 @@ impl Part {
         scale: f64,
         side: Side,
     ) -> Result<Part, MeshError> {
-        if triangles.is_empty() {
-            return Err(MeshError::Empty { path: name.into() });
-        }
-        if let Some(index) = triangles
-            .iter()
-            .position(|t| t.iter().flatten().any(|c| !c.is_finite()))
-        {
-            return Err(MeshError::NonFinite {
-                path: name.into(),
-                index,
-            });
-        }
-        if triangles.len() > crate::limits::MAX_PART_TRIANGLES {
-            return Err(MeshError::TooManyTriangles {
-                path: name.into(),
-                count: triangles.len() as u64,
-            });
-        }
-        let reach = |t: &Triangle| t.iter().flatten().fold(0.0f64, |m, c| m.max(c.abs())) * scale;
-        if let Some(index) = triangles
-            .iter()
-            .position(|t| reach(t) > crate::limits::MAX_COORD_MM)
-        {
-            return Err(MeshError::TooFar {
-                path: name.into(),
-                index,
-                distance: reach(&triangles[index]),
-            });
-        }
+        check_triangles(name, &triangles, scale)?;
         let file_triangles = triangles.len();
         let kept: Vec<Triangle> = triangles
             .into_iter()

@@ -189,17 +189,32 @@ pub fn part_warnings(part: &Part, side: Side, knee: &KneeForm) -> Vec<Warning> {
 /// The angles (degrees) beyond the regulation's range, as one warning.
 pub fn angle_warnings(angles_deg: &[f64]) -> Vec<Warning> {
     // Within rounding of a range's step arithmetic, 30 is 30.
-    let outside: Vec<String> = angles_deg
+    let mut outside: Vec<f64> = angles_deg
         .iter()
+        .copied()
         .filter(|a| a.abs() > REGULATION_ANGLE_DEG + 1e-9)
-        .map(|a| a.to_string())
         .collect();
     if outside.is_empty() {
         return Vec::new();
     }
-    vec![Warning::AnglesOutsideRegulation {
-        angles: outside.join(", "),
-    }]
+    outside.sort_by(f64::total_cmp);
+    // A warning is one line: a long list is said by its count and ends.
+    let angles = if outside.len() > 8 {
+        format!(
+            "{}, {}, ..., {} ({} in all)",
+            outside[0],
+            outside[1],
+            outside[outside.len() - 1],
+            outside.len()
+        )
+    } else {
+        outside
+            .iter()
+            .map(f64::to_string)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    vec![Warning::AnglesOutsideRegulation { angles }]
 }
 
 /// The blind spots the knee-form meets (contacts the grid cannot see), as
@@ -359,6 +374,12 @@ mod tests {
         let w = angle_warnings(&[-45.0, 0.0, 30.5]);
         assert_eq!(w.len(), 1);
         assert!(w[0].to_string().contains("-45, 30.5"), "{}", w[0]);
+        let many: Vec<f64> = (-900..=900).map(|a| f64::from(a) / 10.0).collect();
+        let w = angle_warnings(&many)[0].to_string();
+        assert!(
+            w.contains("angles -90, -89.9, ..., 90 (1200 in all) degrees"),
+            "{w}"
+        );
         assert_eq!(result_warnings(0), [Warning::NothingStruck]);
         assert!(result_warnings(1).is_empty());
     }

@@ -145,7 +145,7 @@ fn bad_input_gets_one_line_and_exit_2() {
         ("zero pitch", vec!["analyze", p, "--out", d, "--pitch", "0"]),
         (
             "grid too large",
-            vec!["analyze", p, "--out", d, "--pitch", "0.001"],
+            vec!["analyze", p, "--out", d, "--pitch", "0.05"],
         ),
         (
             "bad angles",
@@ -170,7 +170,7 @@ fn bad_input_gets_one_line_and_exit_2() {
         assert_clean_failure(&out, &dir, what);
     }
     // The memory refusal names what it would need.
-    let out = kneeform(&["analyze", p, "--out", d, "--pitch", "0.001"]);
+    let out = kneeform(&["analyze", p, "--out", d, "--pitch", "0.05"]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("GiB"));
     std::fs::remove_dir_all(&scratch).unwrap();
 }

@@ -7,6 +7,7 @@ mod engine;
 mod first_hour;
 mod fuzz_seeded;
 mod harness;
+mod hostile;
 mod oracle;
 mod report;
 mod resolution;

@@ -75,7 +75,10 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
     )?;
     analysis.pitch_choice = choice;
     let summary = output::write_analysis(&out, &analysis)?;
-    out.commit()
+    // Held until the report is written: no other run replaces the
+    // directory under it.
+    let _lock = out
+        .commit()
         .with_context(|| format!("cannot move results into {}", args.out.display()))?;
     if let Some(chosen) = &analysis.pitch_choice {
         let t = &analysis.timings;

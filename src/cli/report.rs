@@ -6,6 +6,17 @@ use kneeform::report::ReportOptions;
 use super::args::ReportArgs;
 
 pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
+    // A report replaces an earlier report, never a part or a run file
+    // (`--out part.stl`, `--out run/summary.json`).
+    let is_html = args
+        .out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("html") || e.eq_ignore_ascii_case("htm"));
+    anyhow::ensure!(
+        is_html || !args.out.exists(),
+        "--out {} exists and is not an .html file: it will not be overwritten; name the report something.html",
+        args.out.display()
+    );
     let options = ReportOptions {
         verify_dirs: args.verify_dirs.clone(),
         part: args.part.clone(),

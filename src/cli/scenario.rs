@@ -35,6 +35,10 @@ pub fn run(args: &ScenarioArgs) -> anyhow::Result<()> {
     let file = resolve(&args.part)?;
     let step = file.step_for(args.triangles);
     let triangles = file.triangulate(args.triangles);
+    // What `analyze` would refuse is not written: no triangles (an extent
+    // too small for one), non-finite or out-of-range heights.
+    kneeform::mesh::check_triangles(&args.part, &triangles, 1.0)
+        .context("the scenario makes no usable part")?;
     scenario::write_stl(&args.out, &triangles)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
     eprintln!(

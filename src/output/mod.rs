@@ -95,6 +95,7 @@ pub fn write_file_atomically(
         NEXT.fetch_add(1, Ordering::Relaxed)
     ));
     let tmp = path.with_file_name(tmp_name);
+    staged_paths().push(tmp.clone());
     let written = (|| {
         let mut file = io::BufWriter::new(std::fs::File::create(&tmp)?);
         write(&mut file)?;
@@ -105,43 +106,158 @@ pub fn write_file_atomically(
     if written.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
+    forget_staged(&tmp);
     written
 }
 
 /// A result directory written atomically: files go into a hidden sibling
 /// staging directory (`<parent>/.<name>.partial-<pid>-<n>`) and are renamed
 /// into the final directory by [`OutputDir::commit`]. Dropped without a
-/// commit, the staging directory and everything in it are removed.
+/// commit, the staging directory and everything in it are removed; a
+/// signal handler can remove it too ([`remove_staged`]).
 ///
 /// Renames within one file system are atomic, and the staging directory is
 /// a sibling of the final one, so each file appears complete or not at all.
+/// One run at a time writes a final directory: staging takes an advisory
+/// lock ([`DirLock`]) that a second run finds held and is refused.
 #[derive(Debug)]
 pub struct OutputDir {
     final_dir: PathBuf,
     staging: PathBuf,
     committed: bool,
     replace: bool,
+    lock: Option<DirLock>,
+}
+
+/// The advisory lock of a result directory: `<parent>/.<name>.lock`, held
+/// (an exclusive `flock`) from staging until the value is dropped, by one
+/// run at a time. The empty lock file stays: removing it would let two
+/// runs lock two different files of the same name.
+#[derive(Debug)]
+pub struct DirLock {
+    _file: std::fs::File,
+}
+
+impl DirLock {
+    /// Takes the lock of `final_dir`, or says which run-shaped thing holds
+    /// it (`ErrorKind::ResourceBusy`).
+    pub fn take(final_dir: &Path) -> io::Result<DirLock> {
+        let (parent, name) = parent_and_name(final_dir)?;
+        std::fs::create_dir_all(&parent)?;
+        let mut lock_name = std::ffi::OsString::from(".");
+        lock_name.push(name);
+        lock_name.push(".lock");
+        let path = parent.join(lock_name);
+        let file = std::fs::OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&path)?;
+        match file.try_lock() {
+            Ok(()) => Ok(DirLock { _file: file }),
+            Err(std::fs::TryLockError::WouldBlock) => Err(io::Error::new(
+                io::ErrorKind::ResourceBusy,
+                format!(
+                    "another kneeform run is writing it (it holds {}): wait for it to end, or choose another directory",
+                    path.display()
+                ),
+            )),
+            Err(std::fs::TryLockError::Error(e)) => Err(e),
+        }
+    }
+}
+
+/// The directory holding `dir` (`.` for a bare name) and `dir`'s name.
+fn parent_and_name(dir: &Path) -> io::Result<(PathBuf, std::ffi::OsString)> {
+    let name = dir.file_name().ok_or_else(|| {
+        io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!("{} does not name a directory", dir.display()),
+        )
+    })?;
+    let parent = match dir.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    Ok((parent, name.to_os_string()))
+}
+
+/// Staging directories and temporary files of this process not yet
+/// committed: what [`remove_staged`] removes.
+static STAGED_PATHS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn staged_paths() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    STAGED_PATHS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+fn forget_staged(path: &Path) {
+    staged_paths().retain(|p| p != path);
+}
+
+/// Removes every staging directory and temporary file this process has
+/// not committed: for a signal handler (SIGINT, SIGTERM) before it exits,
+/// so that an interrupted run leaves nothing behind. A commit in progress
+/// finishes first (it holds the same lock), so a directory is either
+/// committed whole or removed.
+pub fn remove_staged() {
+    let mut paths = staged_paths();
+    for path in paths.drain(..) {
+        let _ = if path.is_dir() {
+            std::fs::remove_dir_all(&path)
+        } else {
+            std::fs::remove_file(&path)
+        };
+    }
+    // Held until the process exits: no commit may start after this.
+    std::mem::forget(paths);
+}
+
+/// Removes the stagings of `name` in `parent` left by processes that no
+/// longer run (killed with SIGKILL, or by a power cut): entries
+/// `.<name>.partial-<pid>-<n>` (and their `.old` asides) whose `<pid>` is
+/// not a running process. Where the system cannot say (no `/proc`),
+/// nothing is removed.
+fn clear_stale_stagings(parent: &Path, name: &std::ffi::OsStr) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let prefix = format!(".{}.partial-", name.to_string_lossy());
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file_name = entry.file_name();
+        let Some(rest) = file_name.to_str().and_then(|n| n.strip_prefix(&prefix)) else {
+            continue;
+        };
+        let Some(pid) = rest.split('-').next().and_then(|p| p.parse::<u32>().ok()) else {
+            continue;
+        };
+        let alive = Path::new("/proc").join(pid.to_string()).exists();
+        if !alive {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
+}
+
+/// Syncs the file or directory at `path` to disk.
+fn sync_path(path: &Path) -> io::Result<()> {
+    std::fs::File::open(path)?.sync_all()
 }
 
 impl OutputDir {
     /// Creates the staging directory next to `final_dir` (which need not
-    /// exist yet). `<n>` counts the stagings of this process, so two of them
-    /// never share a staging directory; a stale one of the same name, left
-    /// by a crashed process that had the same id, is cleared first.
+    /// exist yet), after taking `final_dir`'s lock ([`DirLock`]) and
+    /// removing stagings of it left by dead processes. `<n>` counts the
+    /// stagings of this process.
     pub fn stage(final_dir: &Path) -> io::Result<OutputDir> {
-        let name = final_dir.file_name().ok_or_else(|| {
-            io::Error::new(
-                io::ErrorKind::InvalidInput,
-                format!("{} does not name a directory", final_dir.display()),
-            )
-        })?;
-        let parent = match final_dir.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        std::fs::create_dir_all(&parent)?;
+        let lock = DirLock::take(final_dir)?;
+        let (parent, name) = parent_and_name(final_dir)?;
+        clear_stale_stagings(&parent, &name);
         let mut staged_name = std::ffi::OsString::from(".");
-        staged_name.push(name);
+        staged_name.push(&name);
         static STAGED: AtomicUsize = AtomicUsize::new(0);
         let n = STAGED.fetch_add(1, Ordering::Relaxed);
         staged_name.push(format!(".partial-{}-{n}", std::process::id()));
@@ -149,12 +265,17 @@ impl OutputDir {
         if staging.exists() {
             std::fs::remove_dir_all(&staging)?;
         }
-        std::fs::create_dir(&staging)?;
+        staged_paths().push(staging.clone());
+        if let Err(e) = std::fs::create_dir(&staging) {
+            forget_staged(&staging);
+            return Err(e);
+        }
         Ok(OutputDir {
             final_dir: final_dir.to_path_buf(),
             staging,
             committed: false,
             replace: false,
+            lock: Some(lock),
         })
     }
 
@@ -180,27 +301,43 @@ impl OutputDir {
         &self.final_dir
     }
 
-    /// Moves every staged entry into the final directory (created if
-    /// missing; files of the same name are replaced), then removes the
-    /// staging directory. Entries are moved in name order, so a failure
-    /// part way leaves a predictable prefix.
-    pub fn commit(mut self) -> io::Result<()> {
-        if self.replace {
-            self.replace_final()?;
-            self.committed = true;
-            return Ok(());
-        }
-        std::fs::create_dir_all(&self.final_dir)?;
+    /// Syncs every staged file and the staging directory to disk, then
+    /// moves every staged entry into the final directory (created if
+    /// missing; files of the same name are replaced), removes the staging
+    /// directory and syncs the final directory and its parent. Entries are
+    /// moved in name order, so a failure part way leaves a predictable
+    /// prefix. Returns the directory's lock, for a caller that writes more
+    /// into it (a report) before another run may.
+    pub fn commit(mut self) -> io::Result<DirLock> {
+        // Held through the renames: a signal handler waits for them.
+        let mut staged = staged_paths();
         let mut names: Vec<_> = std::fs::read_dir(&self.staging)?
             .map(|entry| entry.map(|e| e.file_name()))
             .collect::<io::Result<_>>()?;
         names.sort();
-        for name in names {
-            std::fs::rename(self.staging.join(&name), self.final_dir.join(&name))?;
+        for name in &names {
+            let path = self.staging.join(name);
+            if path.is_file() {
+                sync_path(&path)?;
+            }
         }
-        std::fs::remove_dir(&self.staging)?;
+        sync_path(&self.staging)?;
+        if self.replace {
+            self.replace_final()?;
+        } else {
+            std::fs::create_dir_all(&self.final_dir)?;
+            for name in names {
+                std::fs::rename(self.staging.join(&name), self.final_dir.join(&name))?;
+            }
+            std::fs::remove_dir(&self.staging)?;
+        }
         self.committed = true;
-        Ok(())
+        staged.retain(|p| p != &self.staging);
+        drop(staged);
+        sync_path(&self.final_dir)?;
+        let (parent, _) = parent_and_name(&self.final_dir)?;
+        sync_path(&parent)?;
+        Ok(self.lock.take().expect("a staged directory holds its lock"))
     }
 }
 
@@ -235,6 +372,7 @@ impl Drop for OutputDir {
             // Best effort: a failure to clean up must not hide the error
             // that caused the drop.
             let _ = std::fs::remove_dir_all(&self.staging);
+            forget_staged(&self.staging);
         }
     }
 }
@@ -277,7 +415,7 @@ mod tests {
         let staged = entries(&root);
         let prefix = format!(".run.partial-{}-", std::process::id());
         assert!(
-            staged.len() == 1 && staged[0].starts_with(&prefix),
+            staged.len() == 2 && staged[0] == ".run.lock" && staged[1].starts_with(&prefix),
             "{staged:?}"
         );
         out.commit().unwrap();
@@ -286,8 +424,8 @@ mod tests {
             std::fs::read_to_string(final_dir.join("a.csv")).unwrap(),
             "angle_deg\n"
         );
-        // The staging directory is gone.
-        assert_eq!(entries(&root), ["run"]);
+        // The staging directory is gone; the lock file stays.
+        assert_eq!(entries(&root), [".run.lock", "run"]);
         std::fs::remove_dir_all(root).unwrap();
     }
 
@@ -329,21 +467,42 @@ mod tests {
             std::fs::read_to_string(final_dir.join("a.csv")).unwrap(),
             "second"
         );
-        assert_eq!(entries(&root), ["run"]);
+        assert_eq!(entries(&root), [".run.lock", "run"]);
         std::fs::remove_dir_all(root).unwrap();
     }
 
     #[test]
-    fn two_stagings_of_one_directory_do_not_collide() {
+    fn one_run_at_a_time_writes_a_directory() {
         let root = temp_dir("twice");
         let final_dir = root.join("run");
         let first = OutputDir::stage(&final_dir).unwrap();
-        let second = OutputDir::stage(&final_dir).unwrap();
+        let err = OutputDir::stage(&final_dir).unwrap_err();
+        assert_eq!(err.kind(), io::ErrorKind::ResourceBusy, "{err}");
+        assert!(err.to_string().contains("another kneeform run"), "{err}");
         std::fs::write(first.path("a.csv"), "first").unwrap();
+        let lock = first.commit().unwrap();
+        // Still held after the commit, until the lock is dropped.
+        assert!(OutputDir::stage(&final_dir).is_err());
+        drop(lock);
+        let second = OutputDir::stage(&final_dir).unwrap();
         std::fs::write(second.path("b.csv"), "second").unwrap();
-        first.commit().unwrap();
         second.commit().unwrap();
         assert_eq!(entries(&final_dir), ["a.csv", "b.csv"]);
+        std::fs::remove_dir_all(root).unwrap();
+    }
+
+    #[test]
+    fn stagings_of_dead_processes_are_cleared() {
+        let root = temp_dir("stale");
+        // No process has pid 4294967295.
+        let stale = root.join(".run.partial-4294967295-0");
+        std::fs::create_dir(&stale).unwrap();
+        std::fs::write(stale.join("half.csv"), "x").unwrap();
+        let ours = OutputDir::stage(&root.join("run")).unwrap();
+        if Path::new("/proc/self").exists() {
+            assert!(!stale.exists());
+        }
+        drop(ours);
         std::fs::remove_dir_all(root).unwrap();
     }
 
@@ -356,7 +515,7 @@ mod tests {
             std::fs::write(out.path("half.csv"), "angle_deg,i").unwrap();
             assert!(out.path("half.csv").exists());
         }
-        assert!(entries(&root).is_empty());
+        assert_eq!(entries(&root), [".run.lock"]);
         std::fs::remove_dir_all(root).unwrap();
     }
 

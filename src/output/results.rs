@@ -178,7 +178,7 @@ fn write_rows(path: &Path, rows: &[impl serde::Serialize]) -> Result<(), WriteEr
 }
 
 fn commit(out: OutputDir, dir: &Path) -> Result<(), WriteError> {
-    out.commit().map_err(|source| WriteError::Commit {
+    out.commit().map(drop).map_err(|source| WriteError::Commit {
         path: dir.to_path_buf(),
         source,
     })
