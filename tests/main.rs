@@ -6,6 +6,7 @@ mod cli;
 mod engine;
 mod first_hour;
 mod frames;
+mod fuzz_seeded;
 mod harness;
 mod hostile;
 mod oracle;

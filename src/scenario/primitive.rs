@@ -525,7 +525,11 @@ impl Wave {
             let last = ((hi / self.wavelength + shift) * 2.0).ceil() as i64;
             // More zeros than a lattice within `MAX_TRIANGLES` could hold
             // lines for would only exhaust memory: such a wave is sampled.
-            if last - first <= MAX_CREASES {
+            // A wavelength tiny against the extent saturates the casts to
+            // i64::MIN and i64::MAX, whose difference overflows: checked,
+            // so that too is "more zeros" (found by the fuzzer's seeded
+            // run, tests/fuzz/regressions/scenario).
+            if last.checked_sub(first).is_some_and(|n| n <= MAX_CREASES) {
                 out.extend((first..=last).map(|k| (k as f64 * 0.5 - shift) * self.wavelength));
             }
         }

@@ -1,0 +1,75 @@
+//! The fuzz targets' bodies, one function per target: the libFuzzer
+//! targets (`fuzz_targets/*.rs`, nightly) and the seeded stable run in the
+//! test suite (`tests/fuzz_seeded.rs`) both call these, so CI exercises
+//! exactly the calls the fuzzer does. Each takes untrusted bytes and must
+//! return: an `Err` from the library is a fine answer; a panic, an abort, a
+//! hang or a memory blow-up is a bug. Each says whether the library
+//! accepted the input, so the seeded run can show that it reaches past the
+//! parsers.
+
+use std::path::Path;
+
+use kneeform::Side;
+use kneeform::mesh::read_part_bytes;
+use kneeform::scenario;
+use kneeform::summary::Summary;
+
+/// The most triangles the fuzzer tessellates per input: a scenario may
+/// legitimately ask for up to `scenario::MAX_TRIANGLES` (20 million,
+/// gigabytes), which would only measure the allocator; 200 000 keeps each
+/// input within milliseconds in a release build.
+pub const FUZZ_MAX_TRIANGLES: usize = 200_000;
+
+/// `data` read as an STL part (binary or ASCII); whether it was read.
+pub fn stl(data: &[u8]) -> bool {
+    read_part_bytes(Path::new("fuzz.stl"), data, 1.0, Side::Left).is_ok()
+}
+
+/// `data` parsed as a scenario file and, when it parses into at most
+/// `max_triangles` triangles, tessellated (checking the count it
+/// announced) and read as a `.toml` part; whether it was read as a part.
+pub fn scenario(data: &[u8], max_triangles: usize) -> bool {
+    let path = Path::new("fuzz.toml");
+    let small = match std::str::from_utf8(data).map(|text| scenario::parse(text, path)) {
+        Ok(Ok(file)) => {
+            let count = file.triangle_count(None);
+            let small = count <= max_triangles;
+            if small {
+                let triangles = file.triangulate(None);
+                assert_eq!(
+                    triangles.len(),
+                    count,
+                    "triangle_count disagrees with triangulate"
+                );
+            }
+            small
+        }
+        // Not UTF-8, or refused: read_part_bytes must refuse it as well.
+        Ok(Err(_)) | Err(_) => true,
+    };
+    // read_part_bytes tessellates whatever parses, so it only runs where
+    // the tessellation above did.
+    small && read_part_bytes(path, data, 1.0, Side::Left).is_ok()
+}
+
+/// `data` read as a `summary.json` with the checks `kneeform report`
+/// relies on ([`Summary::from_json`]) and, when it is accepted, its grid
+/// placed the way the report places it; an accepted summary must also
+/// read back unchanged from what serde writes for it (the writer and the
+/// reader agree). Whether it was accepted.
+pub fn summary(data: &[u8]) -> bool {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return false;
+    };
+    let Ok(summary) = Summary::from_json(text) else {
+        return false;
+    };
+    let _ = kneeform::report::grid_spec(&summary);
+    let written = serde_json::to_string(&summary).expect("an accepted summary serialises");
+    let reread = Summary::from_json(&written).expect("a written summary reads back");
+    assert_eq!(
+        reread, summary,
+        "a summary changed on writing and reading back"
+    );
+    true
+}
