@@ -163,7 +163,7 @@ impl Setup {
     /// Checks every field, before any work.
     pub fn validate(&self) -> Result<(), SetupError> {
         let within = |field: &'static str, value: f64, min: f64, max: f64| {
-            if value.is_finite() && (min..=max).contains(&value) && value > 0.0 {
+            if value.is_finite() && (min..=max).contains(&value) {
                 Ok(())
             } else {
                 Err(SetupError::OutOfRange {
@@ -500,7 +500,11 @@ impl Analysis {
         // (A stream's bytes, unknown before, as those of the binary STL of
         // the triangles read.)
         let n = input.part.file_triangles as u64;
-        let read_bytes = if known { file_bytes } else { 84 + 50 * n };
+        let read_bytes = if known {
+            file_bytes
+        } else {
+            crate::mesh::binary_stl_len(n)
+        };
         let read = MemoryEstimate::reading(read_bytes, n);
         let mut analysis = Analysis::run_checked(input, setup, progress, angle_warnings)?;
         analysis.timings.read_s = read_s;
@@ -538,8 +542,8 @@ impl Analysis {
         warnings.extend(part_warnings);
 
         let t = Instant::now();
-        let spec = setup.grid_spec(&input.part)?;
-        let memory = setup.memory_estimate(&spec, input.part.triangles.len());
+        let spec = setup.grid_placed(&input.part.bbox())?;
+        let memory = setup.check_memory(&spec, input.part.triangles.len())?;
         if memory.bytes() > NOTE_MEMORY_BYTES {
             progress.note(&format!(
                 "this run needs about {:.2} GiB of memory ({} x {} grid, {} angles; --max-memory {:.2} GiB)",

@@ -111,14 +111,7 @@ pub fn colliding_masks(
     assert_same_pitch(grid, footprints);
     let padded = PaddedGrid::new(grid, footprints);
     let table = match options.algorithm {
-        Algorithm::Fast => {
-            let max_width = footprints
-                .iter()
-                .flat_map(|fp| fp.rows.iter().map(|r| (r.khi - r.klo + 1).max(1) as usize))
-                .max()
-                .unwrap_or(1);
-            Some(WindowMin::new(&padded, max_width))
-        }
+        Algorithm::Fast => Some(WindowMin::new(&padded, WindowMin::max_width(footprints))),
         Algorithm::Paper => None,
     };
     let rows: Vec<usize> = match &options.start_rows {
@@ -322,13 +315,7 @@ fn paper_band(
 pub fn push_levels(grid: &HeightGrid, fp: &GridFootprint) -> Vec<f64> {
     assert_same_pitch(grid, std::slice::from_ref(fp));
     let padded = PaddedGrid::new(grid, std::slice::from_ref(fp));
-    let max_width = fp
-        .rows
-        .iter()
-        .map(|r| (r.khi - r.klo + 1).max(1) as usize)
-        .max()
-        .unwrap_or(1);
-    let table = WindowMin::new(&padded, max_width);
+    let table = WindowMin::new(&padded, WindowMin::max_width(std::slice::from_ref(fp)));
     let rows = PushRows::new(&padded, fp);
     let nx = grid.spec.nx;
     let mut yr = vec![f64::INFINITY; grid.spec.len()];

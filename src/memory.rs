@@ -23,6 +23,7 @@
 use crate::grid::GridSpec;
 use crate::kneeform::GridFootprint;
 use crate::padded::Padding;
+use crate::push::WindowMin;
 
 /// The program before any part is read: code, the font, the thread pool.
 pub const BASE_BYTES: f64 = 10.0 * MIB;
@@ -61,12 +62,7 @@ impl MemoryEstimate {
     ) -> MemoryEstimate {
         let n = spec.nx as f64 * spec.nz as f64;
         let padded = Padding::of(spec, footprints).nodes(spec) as f64;
-        let max_width = footprints
-            .iter()
-            .flat_map(|fp| fp.rows.iter().map(|r| (r.khi - r.klo + 1).max(1) as usize))
-            .max()
-            .unwrap_or(1);
-        let levels = f64::from(max_width.max(1).ilog2() + 1);
+        let levels = WindowMin::levels(WindowMin::max_width(footprints)) as f64;
         let angles = footprints.len() as f64;
         let in_flight = threads.clamp(1, footprints.len().max(1)) as f64;
         MemoryEstimate {

@@ -224,15 +224,12 @@ pub fn read_part_bytes_bounded(path: &Path) -> Result<Vec<u8>, MeshError> {
         )));
     }
     let size = meta.is_file().then_some(meta.len());
-    let mut head = Vec::with_capacity(STL_HEADER);
-    (&file)
-        .take(STL_HEADER as u64)
-        .read_to_end(&mut head)
-        .map_err(io)?;
-    let limit = match stl_kind(&head, size).map_err(|reason| MeshError::Format {
+    let head = read_head(&file).map_err(io)?;
+    let kind = stl_kind(&head, size).map_err(|reason| MeshError::Format {
         path: name.clone(),
         reason,
-    })? {
+    })?;
+    let limit = match kind {
         StlKind::Binary { triangles } => {
             if triangles > crate::limits::MAX_PART_TRIANGLES as u64 {
                 return Err(MeshError::TooManyTriangles {
@@ -246,9 +243,7 @@ pub fn read_part_bytes_bounded(path: &Path) -> Result<Vec<u8>, MeshError> {
     };
     // A stream's size is unknown until read: at most MAX_STREAM_BYTES.
     let limit = if size.is_none() {
-        if limit > crate::limits::MAX_STREAM_BYTES
-            && matches!(stl_kind(&head, size), Ok(StlKind::Binary { .. }))
-        {
+        if limit > crate::limits::MAX_STREAM_BYTES && matches!(kind, StlKind::Binary { .. }) {
             return Err(io(std::io::Error::new(
                 std::io::ErrorKind::InvalidData,
                 format!(
@@ -294,7 +289,8 @@ pub fn read_part_bytes_bounded(path: &Path) -> Result<Vec<u8>, MeshError> {
 /// A part file's size, known before reading it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PartSize {
-    /// Its bytes (a stream: the most read, [`crate::limits::MAX_PART_FILE_BYTES`]).
+    /// Its bytes (a stream: the most read from one,
+    /// [`crate::limits::MAX_STREAM_BYTES`]).
     pub file_bytes: u64,
     /// Its triangles, or the most it can hold.
     pub triangles: u64,
@@ -308,7 +304,6 @@ pub struct PartSize {
 /// most triangles its size can hold (ASCII, [`MIN_ASCII_FACET_BYTES`]
 /// each); a scenario file is parsed for its count.
 pub fn part_size(path: &Path) -> Result<PartSize, MeshError> {
-    use std::io::Read;
     let name = path.display().to_string();
     let io = |source| MeshError::Io {
         path: name.clone(),
@@ -331,16 +326,12 @@ pub fn part_size(path: &Path) -> Result<PartSize, MeshError> {
         let file_bytes = crate::limits::MAX_STREAM_BYTES;
         return Ok(PartSize {
             file_bytes,
-            triangles: file_bytes / 50,
+            triangles: file_bytes / STL_RECORD,
             known: false,
         });
     }
     let size = meta.len();
-    let mut head = Vec::with_capacity(STL_HEADER);
-    (&file)
-        .take(STL_HEADER as u64)
-        .read_to_end(&mut head)
-        .map_err(io)?;
+    let head = read_head(&file).map_err(io)?;
     let triangles = match stl_kind(&head, Some(size)) {
         Ok(StlKind::Binary { triangles }) => triangles,
         _ => size / MIN_ASCII_FACET_BYTES,
@@ -403,9 +394,21 @@ pub const MIN_ASCII_FACET_BYTES: u64 = 80;
 /// The bytes of a binary STL's header: 80 of text, a 4-byte count.
 const STL_HEADER: usize = 84;
 
-/// The length of a binary STL of `triangles` triangles (50 bytes each).
-fn binary_stl_len(triangles: u64) -> u64 {
-    STL_HEADER as u64 + 50 * triangles
+/// The bytes of a binary STL's triangle record: normal, three vertices
+/// (f32) and a 2-byte attribute.
+pub(crate) const STL_RECORD: u64 = 50;
+
+/// The length of a binary STL of `triangles` triangles.
+pub(crate) fn binary_stl_len(triangles: u64) -> u64 {
+    STL_HEADER as u64 + STL_RECORD * triangles
+}
+
+/// The first [`STL_HEADER`] bytes of `file` (fewer if it is shorter).
+fn read_head(file: &std::fs::File) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut head = Vec::with_capacity(STL_HEADER);
+    file.take(STL_HEADER as u64).read_to_end(&mut head)?;
+    Ok(head)
 }
 
 /// How an STL file is written.

@@ -21,12 +21,28 @@ pub struct WindowMin {
 }
 
 impl WindowMin {
+    /// The widest push window of `footprints` (nodes, at least 1): the
+    /// width the table must cover.
+    pub fn max_width(footprints: &[GridFootprint]) -> usize {
+        footprints
+            .iter()
+            .flat_map(|fp| fp.rows.iter().map(|r| (r.khi - r.klo + 1).max(1) as usize))
+            .max()
+            .unwrap_or(1)
+    }
+
+    /// The levels a table for windows up to `max_width` nodes holds, each
+    /// a copy of the padded grid: widths 1, 2, 4, ... up to `max_width`.
+    pub fn levels(max_width: usize) -> usize {
+        max_width.max(1).ilog2() as usize + 1
+    }
+
     /// Builds the table for windows up to `max_width` nodes.
     pub fn new(grid: &PaddedGrid, max_width: usize) -> WindowMin {
         let mut levels = vec![grid.h.clone()];
         let stride = grid.stride;
         let mut width = 1;
-        while width * 2 <= max_width.max(1) {
+        for _ in 1..WindowMin::levels(max_width) {
             let prev = levels.last().expect("level 0 exists");
             let mut next = vec![f64::INFINITY; prev.len()];
             for (dst, src) in next.chunks_exact_mut(stride).zip(prev.chunks_exact(stride)) {

@@ -10,9 +10,12 @@ use kneeform::scenario::{Extent, ScenarioFile, builtin, write_stl};
 
 use crate::util::scratch_dir;
 
+/// Runs the binary with `args`, without the caller's RUST_BACKTRACE (its
+/// errors must be one line whatever the environment).
 pub(crate) fn kneeform(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_kneeform"))
         .args(args)
+        .env_remove("RUST_BACKTRACE")
         .output()
         .expect("the binary runs")
 }

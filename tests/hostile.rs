@@ -9,15 +9,8 @@ use std::process::{Command, Output};
 
 use kneeform::output::DirLock;
 
+use crate::cli::kneeform;
 use crate::util::scratch_dir;
-
-fn kneeform(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kneeform"))
-        .args(args)
-        .env_remove("RUST_BACKTRACE")
-        .output()
-        .expect("the binary runs")
-}
 
 fn scenario(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -70,7 +63,12 @@ fn small_run(dir: &Path, extra: &[&str]) {
     ];
     args.extend(extra.iter().map(|s| s.to_string()));
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let out = kneeform(&args);
+    run_ok(&args);
+}
+
+/// Runs the binary, asserting it succeeds.
+fn run_ok(args: &[&str]) {
+    let out = kneeform(args);
     assert!(
         out.status.success(),
         "{}",
@@ -220,7 +218,7 @@ fn a_result_directory_is_replaced_whole() {
     let d = scratch.join("out");
     small_run(&d, &["--report"]);
     assert!(d.join("report.html").is_file());
-    let out = kneeform(&[
+    run_ok(&[
         "analyze",
         &scenario("wave"),
         "--out",
@@ -230,7 +228,6 @@ fn a_result_directory_is_replaced_whole() {
         "--angles=0",
         "--force",
     ]);
-    assert!(out.status.success());
     assert!(!d.join("report.html").exists(), "the old report survived");
     let summary = std::fs::read_to_string(d.join("summary.json")).unwrap();
     assert!(summary.contains("wave.toml"), "{summary}");
@@ -261,7 +258,7 @@ fn a_second_run_on_one_out_is_refused_while_the_first_holds_it() {
     assert_eq!(snapshot(&d), before, "the held directory changed");
     // Released, the same command runs, and every file is its own.
     drop(lock);
-    let out = kneeform(&[
+    run_ok(&[
         "analyze",
         &scenario("wave"),
         "--out",
@@ -271,7 +268,6 @@ fn a_second_run_on_one_out_is_refused_while_the_first_holds_it() {
         "--angles=0",
         "--force",
     ]);
-    assert!(out.status.success());
     let summary = std::fs::read_to_string(d.join("summary.json")).unwrap();
     assert!(summary.contains("wave.toml") && summary.contains("\"pitch_mm\": 8.0"));
     std::fs::remove_dir_all(&scratch).unwrap();
@@ -406,12 +402,7 @@ fn estimate_and_peak(dir: &Path, part: &str, extra: &[&str]) -> (f64, f64) {
         "2",
     ];
     args.extend_from_slice(extra);
-    let out = kneeform(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    run_ok(&args);
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
     let estimate = summary["memory_estimate_mib"].as_f64().unwrap();

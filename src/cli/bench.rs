@@ -31,14 +31,6 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// Peak resident memory of this process (MiB), from /proc.
-fn peak_rss_mib() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib / 1024.0)
-}
-
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     ensure!(args.runs >= 1, "--runs must be at least 1");
     ensure!(
@@ -195,7 +187,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         footprints.len()
     )?;
     writeln!(md, "| composite colliding nodes | {composite_nodes} |")?;
-    if let Some(mib) = peak_rss_mib() {
+    if let Some(mib) = kneeform::memory::peak_rss_bytes().map(|b| b / (1024.0 * 1024.0)) {
         writeln!(md, "| peak memory (RSS) | {mib:.0} MiB |")?;
     }
     writeln!(

@@ -150,10 +150,7 @@ impl DirLock {
     pub fn take(final_dir: &Path) -> io::Result<DirLock> {
         let (parent, name) = parent_and_name(final_dir)?;
         std::fs::create_dir_all(&parent)?;
-        let mut lock_name = std::ffi::OsString::from(".");
-        lock_name.push(name);
-        lock_name.push(".lock");
-        let path = parent.join(lock_name);
+        let path = parent.join(hidden_name(&name, ".lock"));
         loop {
             let file = std::fs::OpenOptions::new()
                 .create(true)
@@ -202,6 +199,14 @@ impl Drop for DirLock {
         let _ = std::fs::remove_file(&self.path);
         let _ = self.file.unlock();
     }
+}
+
+/// The hidden sibling name `.<name><suffix>` (a lock, a staging).
+fn hidden_name(name: &std::ffi::OsStr, suffix: &str) -> std::ffi::OsString {
+    let mut hidden = std::ffi::OsString::from(".");
+    hidden.push(name);
+    hidden.push(suffix);
+    hidden
 }
 
 /// The directory holding `dir` (`.` for a bare name) and `dir`'s name.
@@ -293,12 +298,12 @@ impl OutputDir {
         let lock = DirLock::take(final_dir)?;
         let (parent, name) = parent_and_name(final_dir)?;
         clear_stale_stagings(&parent, &name);
-        let mut staged_name = std::ffi::OsString::from(".");
-        staged_name.push(&name);
         static STAGED: AtomicUsize = AtomicUsize::new(0);
         let n = STAGED.fetch_add(1, Ordering::Relaxed);
-        staged_name.push(format!(".partial-{}-{n}", std::process::id()));
-        let staging = parent.join(staged_name);
+        let staging = parent.join(hidden_name(
+            &name,
+            &format!(".partial-{}-{n}", std::process::id()),
+        ));
         if staging.exists() {
             std::fs::remove_dir_all(&staging)?;
         }
