@@ -1,16 +1,17 @@
 //! The grid engine's driver: for every angle, push and slide every start
 //! and collect the colliding mask `C_theta`; then the composite count.
 //!
-//! Work is split across angles and, within an angle, across bands of start
-//! rows, each band ORing into its own mask. OR is order-independent, so the
-//! masks are identical whatever the thread count.
+//! Work is split across angles and, within an angle, across bands of
+//! [`BAND_ROWS`] start rows, each band deciding the strikes in the window of
+//! rows its slides reach and ORing them into the angle's mask. OR is
+//! order-independent, so the masks are identical whatever the thread count.
 //!
 //! **Invariant:** the engine does no I/O and reads no clock; progress is
 //! reported through a callback.
 
 use rayon::prelude::*;
 
-use crate::grid::HeightGrid;
+use crate::grid::{GridSpec, HeightGrid};
 use crate::kneeform::GridFootprint;
 use crate::padded::PaddedGrid;
 use crate::paper::{PaperCounts, PaperScratch, paper_row};
@@ -94,8 +95,22 @@ pub struct AngleMask {
 /// 9.4 s at 16 against 10.7 s at 32 (register spills).
 const LANES: usize = 16;
 
+/// Start rows per band: the unit of work within an angle. A band's slides
+/// record their reach in a window of the rows the band's footprints span
+/// (the band and the footprint's height), not in a whole grid, so that an
+/// angle in flight holds a few MiB whatever the grid, and memory stays
+/// flat in the thread count. Deciding strikes per window costs one pass
+/// over `(BAND_ROWS + footprint rows) / BAND_ROWS` times the grid per
+/// angle, a few percent of the slides on the paper workload.
+pub const BAND_ROWS: usize = 64;
+
 /// Runs push and slide for every footprint (one per angle) on `grid`.
 /// `on_angle` is called once per finished angle (for a progress bar).
+///
+/// Angles run in parallel; when there are fewer angles than threads, the
+/// bands of start rows within an angle do too. At most one task per
+/// thread holds a reach window ([`BAND_ROWS`]), and at most
+/// `min(threads, angles)` angles hold an unfinished mask.
 ///
 /// # Panics
 ///
@@ -118,43 +133,44 @@ pub fn colliding_masks(
         Some(rows) => rows.iter().copied().filter(|&j| j < grid.spec.nz).collect(),
         None => (0..grid.spec.nz).collect(),
     };
-    // Enough independent tasks to keep every thread busy: whole angles when
-    // there are many, bands of start rows when there are few. Start rows
-    // are independent, so any split gives the same masks.
-    let bands = rayon::current_num_threads()
-        .div_ceil(footprints.len().max(1))
-        .max(1)
-        * 2
-        - 1;
-    let band_len = rows.len().div_ceil(bands).max(1);
+    // Bands within an angle run in parallel only when the angles alone
+    // cannot keep every thread busy; otherwise an angle's task would steal
+    // other angles while it waits for its bands, and hold their masks too.
+    let nested = footprints.len() < rayon::current_num_threads();
     footprints
         .par_iter()
         .map(|fp| {
-            let no_levels = || vec![f64::NEG_INFINITY; options.probes.len()];
-            let (padded_mask, placed, probe_levels) = rows
-                .par_chunks(band_len)
-                .map(|band| match &table {
-                    Some(table) => {
-                        let mut reach = vec![f64::NEG_INFINITY; padded.h.len()];
-                        let placed = fast_band(&padded, table, fp, band, &mut reach);
-                        let mask = strike_mask(&padded, &reach, &options.rule);
-                        (mask, placed, probe_levels(&padded, &reach, &options.probes))
+            let run = |band: &[usize]| match &table {
+                Some(table) => fast_window(&padded, table, fp, band, options),
+                None => {
+                    let mut mask = vec![0u8; padded.h.len()];
+                    let placed = paper_band(&padded, fp, band, &options.rule, &mut mask);
+                    BandResult {
+                        first_row: 0,
+                        strikes: mask,
+                        placed,
+                        probe_levels: vec![f64::NEG_INFINITY; options.probes.len()],
                     }
-                    None => {
-                        let mut mask = vec![0u8; padded.h.len()];
-                        let placed = paper_band(&padded, fp, band, &options.rule, &mut mask);
-                        (mask, placed, no_levels())
-                    }
-                })
-                .reduce(
-                    || (vec![0u8; padded.h.len()], 0, no_levels()),
-                    |(mut a, pa, mut la), (b, pb, lb)| {
-                        a.iter_mut().zip(&b).for_each(|(x, y)| *x |= y);
-                        la.iter_mut().zip(&lb).for_each(|(x, y)| *x = x.max(*y));
-                        (a, pa + pb, la)
-                    },
-                );
-            let mask = padded.unpad(&padded_mask);
+                }
+            };
+            let mut acc = std::sync::Mutex::new(AngleAcc::new(&padded, options.probes.len()));
+            if nested {
+                rows.par_chunks(BAND_ROWS).for_each(|band| {
+                    let result = run(band);
+                    acc.lock().expect("no band panics").add(&padded, result);
+                });
+            } else {
+                for band in rows.chunks(BAND_ROWS) {
+                    acc.get_mut()
+                        .expect("no band panics")
+                        .add(&padded, run(band));
+                }
+            }
+            let AngleAcc {
+                mask,
+                placed,
+                probe_levels,
+            } = acc.into_inner().expect("no band panics");
             on_angle();
             AngleMask {
                 angle_deg: fp.angle_deg,
@@ -172,9 +188,95 @@ pub fn colliding_masks(
         .collect()
 }
 
+/// What a band of start rows found: the strikes in a window of padded
+/// rows, the starts it placed and the face level that met each probe.
+struct BandResult {
+    /// The window's first padded row.
+    first_row: usize,
+    /// Per node of the window, 1 where it is struck.
+    strikes: Vec<u8>,
+    placed: usize,
+    probe_levels: Vec<f64>,
+}
+
+/// An angle's result so far: the union of its bands'.
+struct AngleAcc {
+    /// The (unpadded) mask.
+    mask: Vec<u8>,
+    placed: usize,
+    probe_levels: Vec<f64>,
+}
+
+impl AngleAcc {
+    fn new(padded: &PaddedGrid, probes: usize) -> AngleAcc {
+        AngleAcc {
+            mask: vec![0u8; padded.spec.len()],
+            placed: 0,
+            probe_levels: vec![f64::NEG_INFINITY; probes],
+        }
+    }
+
+    /// ORs a band's strikes in. OR, sum and max are order-independent, so
+    /// the result does not depend on the order bands finish in.
+    fn add(&mut self, padded: &PaddedGrid, band: BandResult) {
+        let GridSpec { nx, nz, .. } = padded.spec;
+        let rows = band.strikes.chunks_exact(padded.stride);
+        for (r, strikes) in (band.first_row..).zip(rows) {
+            let Some(j) = r.checked_sub(padded.pad_rows).filter(|&j| j < nz) else {
+                continue;
+            };
+            let strikes = &strikes[padded.pad_lo..padded.pad_lo + nx];
+            for (m, &s) in self.mask[j * nx..(j + 1) * nx].iter_mut().zip(strikes) {
+                *m |= s;
+            }
+        }
+        self.placed += band.placed;
+        for (l, b) in self.probe_levels.iter_mut().zip(band.probe_levels) {
+            *l = l.max(b);
+        }
+    }
+}
+
+/// The fast path over one band: push and slide every start of the band,
+/// recording reach in the window of padded rows its footprints span, then
+/// SPEC's strike rule over that window.
+fn fast_window(
+    padded: &PaddedGrid,
+    table: &WindowMin,
+    fp: &GridFootprint,
+    band: &[usize],
+    options: &EngineOptions,
+) -> BandResult {
+    let (dj_lo, dj_hi) = fp.dj_range();
+    let (j_first, j_last) = (band[0], band[band.len() - 1]);
+    // Padded rows j + dj + pad_rows, for every start row j of the band and
+    // every footprint row dj: never negative, never past the padding.
+    let first_row = (j_first as i64 + i64::from(dj_lo) + padded.pad_rows as i64) as usize;
+    let last_row = (j_last as i64 + i64::from(dj_hi) + padded.pad_rows as i64) as usize;
+    let start = first_row * padded.stride;
+    let end = (last_row + 1) * padded.stride;
+    let mut reach = vec![f64::NEG_INFINITY; end - start];
+    let placed = fast_band(padded, table, fp, band, start, &mut reach);
+    // The node behind the window's last is the next row's padding: `+inf`.
+    let strikes = strike_mask(
+        &padded.h[start..end],
+        &reach,
+        padded.spec.pitch,
+        &options.rule,
+    );
+    let probe_levels = probe_levels(padded, start, &reach, &options.probes);
+    BandResult {
+        first_row,
+        strikes,
+        placed,
+        probe_levels,
+    }
+}
+
 /// Per probe, the highest face level that met one of its cell's corners
-/// in this band (`-inf` where none did).
-fn probe_levels(padded: &PaddedGrid, reach: &[f64], probes: &[Probe]) -> Vec<f64> {
+/// in a band whose reach window begins at padded index `start` (`-inf`
+/// where none did).
+fn probe_levels(padded: &PaddedGrid, start: usize, reach: &[f64], probes: &[Probe]) -> Vec<f64> {
     let nz = padded.spec.nz as i64;
     probes
         .iter()
@@ -183,7 +285,10 @@ fn probe_levels(padded: &PaddedGrid, reach: &[f64], probes: &[Probe]) -> Vec<f64
             [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]
                 .into_iter()
                 .filter(|&(_, jj)| jj < nz)
-                .map(|(ii, jj)| reach[padded.index(jj, ii as i32)])
+                .filter_map(|(ii, jj)| {
+                    let n = padded.index(jj, ii as i32).checked_sub(start)?;
+                    reach.get(n).copied()
+                })
                 .fold(f64::NEG_INFINITY, f64::max)
         })
         .collect()
@@ -205,9 +310,10 @@ dispatch! {
     /// The fast path over a band of start rows: blocks of starts (32 with
     /// AVX-512, else [`LANES`]) from +x to -x, each swept over every start row of the band, carrying
     /// each row's slide level from one block into the next. Records each
-    /// node's reach (see [`crate::slide`]) and returns the number of placed
+    /// node's reach (see [`crate::slide`]) in `reach`, whose first element
+    /// is the padded node `window`, and returns the number of placed
     /// starts.
-    fn fast_band(padded: &PaddedGrid, table: &WindowMin, fp: &GridFootprint, band: &[usize], reach: &mut [f64]) -> usize => fast_band_impl::<32, 16, 16>
+    fn fast_band(padded: &PaddedGrid, table: &WindowMin, fp: &GridFootprint, band: &[usize], window: usize, reach: &mut [f64]) -> usize => fast_band_impl::<32, 16, 16>
 }
 
 #[inline(always)]
@@ -216,9 +322,12 @@ fn fast_band_impl<const W: usize>(
     table: &WindowMin,
     fp: &GridFootprint,
     band: &[usize],
+    window: usize,
     reach: &mut [f64],
 ) -> usize {
     let push_rows = PushRows::new(padded, fp);
+    let h = &padded.h[window..];
+    let nz = padded.spec.nz;
     let layer = LayerRows::new(padded, fp);
     let active: Vec<std::ops::Range<i64>> = band
         .iter()
@@ -248,7 +357,8 @@ fn fast_band_impl<const W: usize>(
             let base = padded
                 .index(j0 as i64, 0)
                 .wrapping_add_signed(block as isize);
-            let yr: [f64; W] = push_block(table, &push_rows, base);
+            let yr: [f64; W] = push_block(table, push_rows.within(j0, nz), base);
+            let base = base - window;
             // Only real starts are placed.
             let mut level = [f64::NEG_INFINITY; W];
             for w in 0..W {
@@ -258,7 +368,7 @@ fn fast_band_impl<const W: usize>(
                     placed += 1;
                 }
             }
-            let (after, layer_min) = slide_block(&padded.h, reach, &layer, base, level);
+            let (after, layer_min) = slide_block(h, reach, &layer, base, level);
             // Starts that are not placed continue the slide of the start on
             // their +x side, from +x to -x.
             let mut c = carry[k];
@@ -266,7 +376,7 @@ fn fast_band_impl<const W: usize>(
                 if level[w] != f64::NEG_INFINITY {
                     c = after[w];
                 } else if c != f64::NEG_INFINITY && layer_min[w] != f64::INFINITY {
-                    c = slide_carried(&padded.h, reach, &layer, base + w, c);
+                    c = slide_carried(h, reach, &layer, base + w, c);
                 }
             }
             carry[k] = c;
@@ -277,19 +387,18 @@ fn fast_band_impl<const W: usize>(
 }
 
 /// SPEC's strike rule applied once per node to its reach, the highest face
-/// level that met it (`-inf`: never met). The rule is monotone in the
-/// level, so this is the union of the strikes of every slide that met the
-/// node. The node behind `n` is `n + 1` (the next column; the padding's
-/// `+inf` past the grid's +x edge).
-fn strike_mask(padded: &PaddedGrid, reach: &[f64], rule: &StrikeRule) -> Vec<u8> {
-    let p = padded.spec.pitch;
-    let h = &padded.h;
+/// level that met it (`-inf`: never met), over a window of whole padded
+/// rows (`h` its heights, `reach` its reaches). The rule is monotone in
+/// the level, so this is the union of the strikes of every slide that met
+/// the node. The node behind `n` is `n + 1`: the next column, or past a
+/// row's last real column the padding's `+inf`.
+fn strike_mask(h: &[f64], reach: &[f64], pitch: f64, rule: &StrikeRule) -> Vec<u8> {
     let mut mask: Vec<u8> = h
         .windows(2)
         .zip(reach)
-        .map(|(w, &r)| u8::from(rule.strikes(w[0], w[1], r, p)))
+        .map(|(w, &r)| u8::from(rule.strikes(w[0], w[1], r, pitch)))
         .collect();
-    // The last padded node is padding (`+inf`), never struck.
+    // The window's last node is padding (`+inf`), never struck.
     mask.push(0);
     mask
 }
@@ -322,8 +431,11 @@ pub fn push_levels(grid: &HeightGrid, fp: &GridFootprint) -> Vec<f64> {
     for (j0, out) in yr.chunks_exact_mut(nx).enumerate() {
         for (block, out) in out.chunks_mut(LANES).enumerate() {
             // The padding's slack covers the lanes past the last column.
-            let levels: [f64; LANES] =
-                push_block(&table, &rows, padded.index(j0 as i64, 0) + block * LANES);
+            let levels: [f64; LANES] = push_block(
+                &table,
+                rows.within(j0, grid.spec.nz),
+                padded.index(j0 as i64, 0) + block * LANES,
+            );
             out.copy_from_slice(&levels[..out.len()]);
         }
     }
@@ -347,6 +459,9 @@ mod tests {
     use super::*;
     use crate::grid::GridSpec;
     use crate::kneeform::KneeForm;
+
+    /// [`fast_band`]'s signature.
+    type BandFn = fn(&PaddedGrid, &WindowMin, &GridFootprint, &[usize], usize, &mut [f64]) -> usize;
 
     /// The block width is a tuning knob per instruction set: every width
     /// gives the same reach and placed count (the tests elsewhere run only
@@ -382,16 +497,109 @@ mod tests {
             let fp = GridFootprint::new(&knee, angle, &spec);
             let padded = PaddedGrid::new(&grid, std::slice::from_ref(&fp));
             let table = WindowMin::new(&padded, 512);
-            let run =
-                |f: fn(&PaddedGrid, &WindowMin, &GridFootprint, &[usize], &mut [f64]) -> usize| {
-                    let mut reach = vec![f64::NEG_INFINITY; padded.h.len()];
-                    let placed = f(&padded, &table, &fp, &rows, &mut reach);
-                    (reach, placed)
-                };
+            let run = |f: BandFn| {
+                let mut reach = vec![f64::NEG_INFINITY; padded.h.len()];
+                let placed = f(&padded, &table, &fp, &rows, 0, &mut reach);
+                (reach, placed)
+            };
             let w16 = run(fast_band_impl::<16>);
             assert!(w16.1 > 0);
             assert!(run(fast_band_impl::<8>) == w16, "angle {angle}: 8 lanes");
             assert!(run(fast_band_impl::<32>) == w16, "angle {angle}: 32 lanes");
+        }
+    }
+
+    /// Bands of start rows, their reach windows and the thread count are
+    /// how the work is split, not what is computed: on a grid of several
+    /// bands, every split gives the masks and probe answers of one slide
+    /// over the whole grid with a whole-grid reach, and the paper path's.
+    #[test]
+    fn bands_windows_and_threads_do_not_change_the_result() {
+        let spec = GridSpec {
+            pitch: 2.0,
+            i_origin: -30,
+            j_origin: -100,
+            nx: 90,
+            nz: 3 * BAND_ROWS + 11,
+        };
+        let h: Vec<f64> = (0..spec.len())
+            .map(|n| {
+                let (x, z) = (spec.x(n % spec.nx), spec.z(n / spec.nx));
+                if (x - 40.0).hypot(z - 30.0) < 12.0 {
+                    f64::INFINITY
+                } else {
+                    (0.5 * (0.9 * x).sin() * (0.13 * z).cos() + 0.02 * x).round() * 0.5
+                }
+            })
+            .collect();
+        let grid = HeightGrid { spec, h };
+        let knee = KneeForm {
+            triangle_side: 60.0,
+            radius: 15.0,
+            thickness: 100.0,
+        };
+        // Probes in cells on both sides of every band boundary.
+        let probes: Vec<Probe> = [0, BAND_ROWS - 1, BAND_ROWS, 2 * BAND_ROWS - 1, spec.nz - 2]
+            .into_iter()
+            .flat_map(|j| [(5, j), (45, j), (80, j)])
+            .map(|cell| Probe { cell, y: 0.2 })
+            .collect();
+        let angles = [-30.0, -7.0, 0.0, 12.0, 30.0];
+        let footprints: Vec<GridFootprint> = angles
+            .iter()
+            .map(|&a| GridFootprint::new(&knee, a, &spec))
+            .collect();
+        let options = |algorithm| EngineOptions {
+            algorithm,
+            probes: probes.clone(),
+            ..EngineOptions::default()
+        };
+        // The reference: one band of every start row, one whole-grid reach.
+        let padded = PaddedGrid::new(&grid, &footprints);
+        let table = WindowMin::new(&padded, WindowMin::max_width(&footprints));
+        let rows: Vec<usize> = (0..spec.nz).collect();
+        let rule = StrikeRule::default();
+        let expected: Vec<(Vec<u8>, usize, Vec<bool>)> = footprints
+            .iter()
+            .map(|fp| {
+                let mut reach = vec![f64::NEG_INFINITY; padded.h.len()];
+                let placed = fast_band(&padded, &table, fp, &rows, 0, &mut reach);
+                let mask = padded.unpad(&strike_mask(&padded.h, &reach, spec.pitch, &rule));
+                let met = probe_levels(&padded, 0, &reach, &probes)
+                    .iter()
+                    .zip(&probes)
+                    .map(|(&level, probe)| probe.y < level - rule.e0)
+                    .collect();
+                (mask, placed, met)
+            })
+            .collect();
+        assert!(expected.iter().all(|(m, _, _)| m.contains(&1)));
+        assert!(expected.iter().any(|(_, _, met)| met.contains(&true)));
+        assert!(expected.iter().any(|(_, _, met)| met.contains(&false)));
+        for threads in [1, 3, 8] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            // Five angles on 8 threads: bands in parallel within an angle.
+            let got = pool
+                .install(|| colliding_masks(&grid, &footprints, &options(Algorithm::Fast), &|| ()));
+            for (m, (mask, placed, met)) in got.iter().zip(&expected) {
+                assert!(&m.mask == mask, "{threads} threads, angle {}", m.angle_deg);
+                assert_eq!(m.placed, *placed);
+                assert_eq!(&m.probes_met, met);
+            }
+            let paper = pool.install(|| {
+                colliding_masks(&grid, &footprints, &options(Algorithm::Paper), &|| ())
+            });
+            for (p, (mask, placed, _)) in paper.iter().zip(&expected) {
+                assert!(
+                    &p.mask == mask,
+                    "paper, {threads} threads, angle {}",
+                    p.angle_deg
+                );
+                assert_eq!(p.placed, *placed);
+            }
         }
     }
 }

@@ -3,14 +3,17 @@
 //! measured after, so that the estimate can be held to account.
 //!
 //! At its peak an analysis holds, in bytes (`N` grid nodes, `Np` nodes of
-//! the padded grid, `L` levels of the push's window-minimum table, `A`
-//! angles, `T` angles in flight at once, `n` triangles):
+//! the padded grid, `Nr` nodes of its real rows, `L` levels of the push's
+//! window-minimum table, `A` angles, `T` threads, `Nw` nodes of a band's
+//! reach window, `n` triangles):
 //!
 //! * the part: `72 n` (three f64 vertices per triangle);
 //! * the height grid `8 N`, its padded copy `8 Np` and the window-minimum
-//!   table `8 L Np`;
-//! * per angle in flight: the face levels (`8 Np`), the strike mask (`Np`),
-//!   the band reduction's mask (`Np`) and the unpadded mask (`N`);
+//!   table `8 (L - 1) Nr` (level 0 is the padded grid itself);
+//! * per band task running (at most `T`, and at most the bands there
+//!   are): its reach window and strikes (`9 Nw`; the paper path's band mask
+//!   `Np` where that is larger);
+//! * per angle in flight (at most `min(T, A)`): its mask (`N`);
 //! * every finished angle's mask (`A N`, with the allocator's holes
 //!   between them: [`MASK_BYTES_PER_NODE`]) and the composite (`2 N`);
 //! * the writers' buffers (the colliding-area surface, the images), at most
@@ -20,6 +23,7 @@
 //! The figures were checked against the measured peak (`VmHWM`) on runs
 //! from 40 MiB to 1.3 GiB (`tests/hostile.rs` holds the bound test).
 
+use crate::engine::BAND_ROWS;
 use crate::grid::GridSpec;
 use crate::kneeform::GridFootprint;
 use crate::padded::Padding;
@@ -61,17 +65,33 @@ impl MemoryEstimate {
         threads: usize,
     ) -> MemoryEstimate {
         let n = spec.nx as f64 * spec.nz as f64;
-        let padded = Padding::of(spec, footprints).nodes(spec) as f64;
+        let padding = Padding::of(spec, footprints);
+        let padded = padding.nodes(spec) as f64;
+        let real_rows = padding.stride as f64 * spec.nz as f64;
         let levels = WindowMin::levels(WindowMin::max_width(footprints)) as f64;
         let angles = footprints.len() as f64;
-        let in_flight = threads.clamp(1, footprints.len().max(1)) as f64;
+        let threads = threads.max(1);
+        let angles_in_flight = threads.min(footprints.len().max(1)) as f64;
+        let span = footprints
+            .iter()
+            .map(|fp| {
+                let (lo, hi) = fp.dj_range();
+                (hi - lo) as usize + 1
+            })
+            .max()
+            .unwrap_or(1);
+        let band = BAND_ROWS.min(spec.nz.max(1));
+        let window = (padding.stride * (band - 1 + span)) as f64;
+        let bands = footprints.len().max(1) * spec.nz.div_ceil(band).max(1);
+        let tasks = threads.min(bands) as f64;
         MemoryEstimate {
             items: vec![
                 ("program", BASE_BYTES),
                 ("part", BYTES_PER_TRIANGLE * triangles as f64),
                 ("height grid", 8.0 * n + 8.0 * padded),
-                ("push table", 8.0 * levels * padded),
-                ("angles in flight", in_flight * (10.0 * padded + n)),
+                ("push table", 8.0 * (levels - 1.0) * real_rows),
+                ("bands running", tasks * (9.0 * window).max(padded)),
+                ("angles in flight", angles_in_flight * n),
                 ("masks", MASK_BYTES_PER_NODE * angles * n + 2.0 * n),
                 ("writers", WRITE_BYTES_PER_NODE * n),
             ],

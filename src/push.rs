@@ -12,15 +12,26 @@
 use crate::kneeform::GridFootprint;
 use crate::padded::{PaddedGrid, fmin};
 
-/// Row window minima of a padded height grid, for every power-of-two width.
+/// Row window minima of a padded height grid's real rows, for every
+/// power-of-two width.
+///
+/// Level 0 is the grid's own heights (borrowed, not copied), and the
+/// padding rows above and below the grid are left out: they hold only
+/// `+inf`, which never lowers a minimum, so [`PushRows::within`] skips the
+/// footprint rows that fall on them. That keeps the table at `levels - 1`
+/// copies of the real rows, the largest item of an analysis's memory.
 #[derive(Debug)]
-pub struct WindowMin {
-    /// `levels[l][row * stride + x]` = min of `h` over `x .. x + 2^l` in the
-    /// padded row (`+inf` past its end).
+pub struct WindowMin<'a> {
+    /// The padded grid's real rows: level 0.
+    heights: &'a [f64],
+    /// `levels[l - 1][row * stride + x]` = min of `h` over `x .. x + 2^l`
+    /// in the real row `row` (`+inf` past its end).
     levels: Vec<Vec<f64>>,
+    /// Padded index of the first real row's first node.
+    first: usize,
 }
 
-impl WindowMin {
+impl<'a> WindowMin<'a> {
     /// The widest push window of `footprints` (nodes, at least 1): the
     /// width the table must cover.
     pub fn max_width(footprints: &[GridFootprint]) -> usize {
@@ -31,19 +42,22 @@ impl WindowMin {
             .unwrap_or(1)
     }
 
-    /// The levels a table for windows up to `max_width` nodes holds, each
-    /// a copy of the padded grid: widths 1, 2, 4, ... up to `max_width`.
+    /// The levels a table for windows up to `max_width` nodes holds: widths
+    /// 1, 2, 4, ... up to `max_width`. All but the first are a copy of the
+    /// grid's real rows.
     pub fn levels(max_width: usize) -> usize {
         max_width.max(1).ilog2() as usize + 1
     }
 
     /// Builds the table for windows up to `max_width` nodes.
-    pub fn new(grid: &PaddedGrid, max_width: usize) -> WindowMin {
-        let mut levels = vec![grid.h.clone()];
+    pub fn new(grid: &'a PaddedGrid, max_width: usize) -> WindowMin<'a> {
         let stride = grid.stride;
+        let first = grid.pad_rows * stride;
+        let heights = &grid.h[first..first + grid.spec.nz * stride];
+        let mut levels: Vec<Vec<f64>> = Vec::new();
         let mut width = 1;
         for _ in 1..WindowMin::levels(max_width) {
-            let prev = levels.last().expect("level 0 exists");
+            let prev = levels.last().map_or(heights, Vec::as_slice);
             let mut next = vec![f64::INFINITY; prev.len()];
             for (dst, src) in next.chunks_exact_mut(stride).zip(prev.chunks_exact(stride)) {
                 let n = stride - width;
@@ -55,48 +69,84 @@ impl WindowMin {
             levels.push(next);
             width *= 2;
         }
-        WindowMin { levels }
+        WindowMin {
+            heights,
+            levels,
+            first,
+        }
     }
 
-    /// Memory held (bytes).
+    /// Level `l`: minima over `2^l` nodes, indexed from the first real row.
+    #[inline(always)]
+    fn level(&self, l: usize) -> &[f64] {
+        if l == 0 {
+            self.heights
+        } else {
+            &self.levels[l - 1]
+        }
+    }
+
+    /// Memory held (bytes), level 0 aside (it is the grid's).
     pub fn bytes(&self) -> usize {
         self.levels.iter().map(|l| l.len() * 8).sum()
     }
 }
 
-/// The push rows of one footprint, ready for [`push_block`]: for each row
-/// with nodes inside, the offset from a start to its first inside node,
-/// and the table level and second-window shift covering its width.
+/// One footprint row of a push: the offset from a start to its first
+/// inside node, the table level and the second window's shift covering
+/// its width.
+type PushRow = (isize, u32, u32);
+
+/// The push rows of one footprint, ready for [`push_block`]: each row
+/// with nodes inside, in `dj` order.
 #[derive(Debug, Clone)]
 pub struct PushRows {
-    rows: Vec<(isize, u32, u32)>,
+    rows: Vec<PushRow>,
+    /// Each row's `dj`, ascending.
+    dj: Vec<i32>,
 }
 
 impl PushRows {
     /// Lays out `fp`'s rows on `grid`.
     pub fn new(grid: &PaddedGrid, fp: &GridFootprint) -> PushRows {
-        let rows = fp
-            .rows
+        let inside: Vec<_> = fp.rows.iter().filter(|r| r.khi >= r.klo).collect();
+        debug_assert!(inside.is_sorted_by_key(|r| r.dj));
+        let rows = inside
             .iter()
-            .filter(|r| r.khi >= r.klo)
             .map(|r| {
                 let width = (r.khi - r.klo + 1) as u32;
                 let level = width.ilog2();
                 (grid.offset(r.dj, r.klo), level, width - (1 << level))
             })
             .collect();
-        PushRows { rows }
+        PushRows {
+            rows,
+            dj: inside.iter().map(|r| r.dj).collect(),
+        }
+    }
+
+    /// The rows that fall on the grid's real rows for a start in row `j0`
+    /// of a grid of `nz` rows (the others lie on `+inf` padding).
+    pub fn within(&self, j0: usize, nz: usize) -> &[PushRow] {
+        let j0 = j0 as i64;
+        let lo = self.dj.partition_point(|&dj| j0 + i64::from(dj) < 0);
+        let hi = self
+            .dj
+            .partition_point(|&dj| j0 + i64::from(dj) < nz as i64);
+        &self.rows[lo..hi.max(lo)]
     }
 }
 
 /// Face levels of `W` consecutive starts whose node index (in the padded
 /// grid) begins at `base`: the minimum height over the nodes inside each
-/// footprint, `+inf` where none is finite.
+/// footprint, `+inf` where none is finite. `rows` are the footprint's
+/// rows [`PushRows::within`] the grid for the starts' row.
 #[inline(always)]
-pub fn push_block<const W: usize>(table: &WindowMin, rows: &PushRows, base: usize) -> [f64; W] {
+pub fn push_block<const W: usize>(table: &WindowMin, rows: &[PushRow], base: usize) -> [f64; W] {
     let mut yr = [f64::INFINITY; W];
-    for &(offset, level, second) in &rows.rows {
-        let t = &table.levels[level as usize];
+    let base = base - table.first;
+    for &(offset, level, second) in rows {
+        let t = table.level(level as usize);
         let a = base.wrapping_add_signed(offset);
         let first: &[f64; W] = t[a..a + W].try_into().expect("W values");
         let b = a + second as usize;
