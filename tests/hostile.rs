@@ -393,14 +393,7 @@ fn scenario_refuses_a_part_analyze_would_refuse() {
 
 /// The estimate and the measured peak (MiB) of one run.
 fn estimate_and_peak(dir: &Path, part: &str, extra: &[&str]) -> (f64, f64) {
-    let mut args = vec![
-        "analyze",
-        part,
-        "--out",
-        dir.to_str().unwrap(),
-        "--threads",
-        "2",
-    ];
+    let mut args = vec!["analyze", part, "--out", dir.to_str().unwrap()];
     args.extend_from_slice(extra);
     run_ok(&args);
     let summary: serde_json::Value =
@@ -415,24 +408,39 @@ fn estimate_and_peak(dir: &Path, part: &str, extra: &[&str]) -> (f64, f64) {
 fn the_memory_estimate_bounds_the_measured_peak() {
     // A test of a bound, not of time: peak RSS <= estimate <= 1.3 x peak,
     // on three sizes (about 75, 100 and 200 MiB) that stress the grid,
-    // the angles and the push table in turn.
+    // the angles and the push table in turn, and with 1 and 16 threads
+    // (bands running at once, each with its reach window).
     if !Path::new("/proc/self/status").exists() {
         eprintln!("skipped: no /proc to measure the peak");
         return;
     }
     let scratch = scratch_dir("estimate");
     let d: PathBuf = scratch.join("out");
-    let runs: [(&str, String, &[&str]); 3] = [
-        ("wave, 2 mm, 61 angles", scenario("wave"), &["--pitch", "2"]),
+    let runs: [(&str, String, &[&str]); 5] = [
+        (
+            "wave, 2 mm, 61 angles",
+            scenario("wave"),
+            &["--pitch", "2", "--threads", "2"],
+        ),
         (
             "console, 2 mm, 3 angles",
             scenario("console"),
-            &["--pitch", "2", "--angles=-30,0,30"],
+            &["--pitch", "2", "--angles=-30,0,30", "--threads", "2"],
         ),
         (
             "wave, 1 mm, 3 angles",
             scenario("wave"),
-            &["--pitch", "1", "--angles=-30,0,30"],
+            &["--pitch", "1", "--angles=-30,0,30", "--threads", "2"],
+        ),
+        (
+            "wave, 1 mm, 3 angles, 1 thread",
+            scenario("wave"),
+            &["--pitch", "1", "--angles=-30,0,30", "--threads", "1"],
+        ),
+        (
+            "console, 2 mm, 31 angles, 16 threads",
+            scenario("console"),
+            &["--pitch", "2", "--angles=-30:30:2", "--threads", "16"],
         ),
     ];
     for (what, part, extra) in runs {
