@@ -6,6 +6,8 @@
 #     bash results/regenerate.sh            # everything (about 10-20 minutes)
 #     bash results/regenerate.sh converge   # the convergence studies only
 #     bash results/regenerate.sh bench      # the benchmark only
+#     bash results/regenerate.sh ab REV     # results/ab.md: this tree against
+#                                           # the commit REV, end to end, in one run
 #
 # Every study uses the same settings so they can be compared: pitches 4, 2,
 # 1 and 0.5 mm (0.25 mm too on the wave and the depression), angles -30, 0
@@ -32,4 +34,48 @@ fi
 
 if [[ "$what" == all || "$what" == bench ]]; then
   "$bin" bench --runs 5 --markdown results/bench.md
+fi
+
+# The before/after of a change, end to end and measured in one run (the
+# machine is shared: the two binaries alternate, so both see the same load):
+# the README's command on the bundled console side, its wall time at 2
+# threads (median of 3) and its peak RSS at 1, 2 and 16 threads.
+if [[ "$what" == ab ]]; then
+  rev="${2:?usage: regenerate.sh ab REV}"
+  work=$(mktemp -d)
+  trap 'git worktree remove --force "$work/base" >/dev/null 2>&1 || true; rm -rf "$work"' EXIT
+  git worktree add --detach -q "$work/base" "$rev"
+  (cd "$work/base" && CARGO_TARGET_DIR="$OLDPWD/target/ab-base" cargo build --release --quiet --bin kneeform)
+  cp target/ab-base/release/kneeform "$work/before"
+  cp "$bin" "$work/after"
+  part=scenarios/console_side.stl
+  # One run: prints "wall_s peak_mib write_s output_mib".
+  measure() {
+    rm -rf "$work/out"
+    "$work/$1" analyze "$part" --out "$work/out" --threads "$2" >/dev/null 2>&1
+    python3 - "$work/out" <<'PY'
+import json, os, sys
+d = sys.argv[1]
+s = json.load(open(os.path.join(d, "summary.json")))
+size = sum(os.path.getsize(os.path.join(d, f)) for f in os.listdir(d))
+print(f"{s['timings']['total_s']:.2f} {s['peak_rss_mib']:.0f} {s['timings']['write_s']:.2f} {size / 2**20:.1f}")
+PY
+  }
+  {
+    echo "# Before and after, measured in one run"
+    echo
+    echo "\`bash results/regenerate.sh ab $rev\` on $(date -u +%Y-%m-%d), $(nproc) CPUs"
+    echo "($(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)), load average at the start"
+    echo "$(cut -d' ' -f1-3 /proc/loadavg). Before: $(git rev-parse --short "$rev"); after: this tree"
+    echo "($(git rev-parse --short HEAD)$(git diff --quiet || echo ', with changes')). Part: \`$part\`, the README's"
+    echo "command at default settings (1.24 mm, 61 angles). The binaries alternate."
+    echo
+    echo "| threads | before: total s | after: total s | before: peak MiB | after: peak MiB | before: write s | after: write s | before: outputs MiB | after: outputs MiB |"
+    echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+    for t in 2 2 2 1 16; do
+      b=($(measure before "$t")); a=($(measure after "$t"))
+      echo "| $t | ${b[0]} | ${a[0]} | ${b[1]} | ${a[1]} | ${b[2]} | ${a[2]} | ${b[3]} | ${a[3]} |"
+    done
+  } > results/ab.md
+  cat results/ab.md
 fi
