@@ -66,7 +66,9 @@ pub mod strike;
 pub mod summary;
 mod zbuffer;
 
-pub use analysis::{Analysis, AnalysisError, GridPlacement, Progress, Setup, SetupError, Status};
+pub use analysis::{
+    Analysis, AnalysisError, Approach, GridPlacement, Progress, Setup, SetupError, Status,
+};
 pub use assembly::PartSource;
 pub use engine::{Algorithm, AngleMask, EngineOptions, colliding_masks, composite, push_levels};
 pub use frame::{Frame, Placement};

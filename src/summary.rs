@@ -124,6 +124,13 @@ pub struct Summary {
     pub rate: String,
     /// `fast` or `paper`.
     pub algorithm: crate::Algorithm,
+    /// `slide` (push-and-slide, SPEC) or `direct` (the direct approach,
+    /// [`crate::direct`]: the grid, its origin and the heights are then in
+    /// the direct frame, and the deflection threshold, `sigma` and `rate`
+    /// are recorded but not used). Absent in runs of earlier versions
+    /// (slide).
+    #[serde(default)]
+    pub approach: crate::analysis::Approach,
     /// Worker threads.
     pub threads: usize,
     /// Per angle, in the order of `angles_deg`.
