@@ -640,9 +640,7 @@ impl Analysis {
                     .iter()
                     .map(|&a| DirectFootprint::new(&setup.knee, a, spec.pitch))
                     .collect();
-                direct_masks(&grid, &fronts, setup.rule.e0, &probes, &|| {
-                    progress.step()
-                })
+                direct_masks(&grid, &fronts, setup.rule.e0, &probes, &|| progress.step())
             }
         };
         progress.end();

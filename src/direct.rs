@@ -329,7 +329,19 @@ mod tests {
 
     #[test]
     fn window_extremes_match_a_scan() {
-        let row = [3.0, 1.0, f64::INFINITY, 4.0, 1.0, 5.0, 9.0, 2.0, 6.0, 5.0, 3.0];
+        let row = [
+            3.0,
+            1.0,
+            f64::INFINITY,
+            4.0,
+            1.0,
+            5.0,
+            9.0,
+            2.0,
+            6.0,
+            5.0,
+            3.0,
+        ];
         for half in 0..6 {
             let mut got = vec![0.0; row.len()];
             window_extreme(&row, half, f64::INFINITY, f64::min, &mut got);

@@ -7,8 +7,8 @@ use anyhow::{Context, ensure};
 use clap::{Args, Parser, Subcommand};
 use kneeform::strike::RateEstimate;
 use kneeform::{
-    Algorithm, Approach, Frame, GridPlacement, KneeForm, PartSource, Placement, Setup, SetupError, Side,
-    StrikeRule,
+    Algorithm, Approach, Frame, GridPlacement, KneeForm, PartSource, Placement, Setup, SetupError,
+    Side, StrikeRule,
 };
 
 /// UN Regulation No. 21 knee-form inspection: which areas of an interior
@@ -256,6 +256,13 @@ pub struct ReportArgs {
     /// (its SHA-256 must still be the run's).
     #[arg(long, value_name = "FILE")]
     pub part: Option<PathBuf>,
+    /// Another `analyze` run of the same part with the other --approach
+    /// (slide against direct): both areas painted on the same rendered
+    /// part, with the area only push-and-slide strikes (what the direct
+    /// approach cannot reach) and the area only the direct approach
+    /// touches.
+    #[arg(long, value_name = "RUN_DIR")]
+    pub compare: Option<PathBuf>,
 }
 
 /// Which starts a comparison uses.
