@@ -179,3 +179,88 @@ fn the_direct_approach_cannot_reach_the_pocket_behind_the_ridge() {
         assert!(front >= rows, "{name}: {front} nodes on the front flank");
     }
 }
+
+fn kneeform_cli(dir: &Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_kneeform"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn ok(out: std::process::Output, what: &str) -> std::process::Output {
+    assert!(
+        out.status.success(),
+        "{what}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+#[test]
+fn the_report_compares_a_direct_run_with_a_slide_run_of_the_same_part() {
+    let dir = crate::util::scratch_dir("direct-compare");
+    let scenario = scenario("pocket-behind-ridge");
+    let part = scenario.to_str().unwrap();
+    let common = ["--pitch", "8", "--angles=-30,0,30"];
+    for (approach, out) in [("slide", "slide"), ("direct", "direct")] {
+        let mut args = vec!["analyze", part, "--approach", approach, "--out", out];
+        args.extend(common);
+        ok(kneeform_cli(&dir, &args), approach);
+        let summary: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.join(out).join("summary.json")).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(summary["approach"], approach);
+    }
+    // A direct run reports on its own, and beside the slide run.
+    ok(
+        kneeform_cli(&dir, &["report", "direct", "--out", "direct.html"]),
+        "report direct",
+    );
+    let html = std::fs::read_to_string(dir.join("direct.html")).unwrap();
+    assert!(html.contains("direct approach (the knee-form moved in -x"));
+    ok(
+        kneeform_cli(
+            &dir,
+            &[
+                "report",
+                "slide",
+                "--compare",
+                "direct",
+                "--out",
+                "both.html",
+            ],
+        ),
+        "report --compare",
+    );
+    let html = std::fs::read_to_string(dir.join("both.html")).unwrap();
+    assert!(html.contains("<section id=\"compare\">"));
+    assert!(html.contains("id=\"compare-view-0\"") && html.contains("id=\"compare-view-1\""));
+    assert!(html.contains("data-src=\"compare/summary.json#/composite_area_mm2\""));
+    // The far wall (x in [-430, -420], every row of z in [-200, 200]: 51
+    // rows at 8 mm) is struck by the slide only: at least one node per
+    // row is what the direct approach misses.
+    let row = &html[html
+        .find("<tr id=\"slide-only\">")
+        .expect("the slide-only row")..];
+    let cells: Vec<&str> = row
+        .split("<td class=\"num\">")
+        .skip(1)
+        .take(2)
+        .map(|c| &c[..c.find('<').unwrap()])
+        .collect();
+    let nodes: usize = cells[0].parse().unwrap();
+    let area: f64 = cells[1].parse().unwrap();
+    assert!(nodes >= 51, "{nodes} nodes only push-and-slide strikes");
+    assert_eq!(area, nodes as f64 * 64.0);
+    // Two runs of one approach are not a comparison: one line, exit 2.
+    let out = kneeform_cli(
+        &dir,
+        &["report", "slide", "--compare", "slide", "--out", "x.html"],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("the run's approach"), "{err}");
+}
