@@ -264,3 +264,64 @@ fn the_report_compares_a_direct_run_with_a_slide_run_of_the_same_part() {
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("the run's approach"), "{err}");
 }
+
+#[test]
+fn the_right_side_of_a_mirrored_part_gives_the_mirrored_direct_result() {
+    // The pocket behind the ridge, and the same part mirrored in y read for
+    // the right side: the same analysis, so the same contacts with y
+    // negated, in the part's own coordinates.
+    use kneeform::{Part, PartFile};
+    let file = kneeform::scenario::load(&scenario("pocket-behind-ridge")).unwrap();
+    let left = file.triangulate(None);
+    // (The winding kept: read for the right side, these are the left
+    // part's triangles to the bit, so any difference is the mapping back.)
+    let right: Vec<_> = left.iter().map(|t| t.map(|[x, y, z]| [x, -y, z])).collect();
+    let setup = Setup {
+        pitch: 8.0,
+        angles: vec![-30.0, 0.0, 30.0],
+        approach: Approach::Direct,
+        ..Setup::default()
+    };
+    let run = |tris: Vec<_>, side| {
+        let part = Part::from_triangles("pocket", tris, 1.0, side).unwrap();
+        let mut input = PartFile::in_memory("pocket", part);
+        input.side = side;
+        let analysis = Analysis::run(input, &setup, &()).unwrap();
+        let mut points: Vec<[i64; 3]> = composite_points(&analysis)
+            .iter()
+            .map(|p| p.map(|c| (c * 1e6).round() as i64))
+            .collect();
+        points.sort_unstable();
+        points
+    };
+    let l = run(left, Side::Left);
+    let mut r: Vec<[i64; 3]> = run(right, Side::Right)
+        .into_iter()
+        .map(|[x, y, z]| [x, -y, z])
+        .collect();
+    r.sort_unstable();
+    assert!(l.len() > 100, "{} contacts", l.len());
+    assert_eq!(l, r);
+}
+
+#[test]
+fn the_harness_refuses_the_direct_approach_in_one_line() {
+    let dir = crate::util::scratch_dir("direct-verify");
+    let part = scenario("pocket-behind-ridge");
+    let args = [
+        "verify",
+        part.to_str().unwrap(),
+        "--pitch",
+        "8",
+        "--approach",
+        "direct",
+        "--out",
+        "v",
+    ];
+    let out = kneeform_cli(&dir, &args);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.starts_with("kneeform: error: --approach: "), "{err}");
+    assert!(!dir.join("v").exists());
+}
