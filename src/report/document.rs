@@ -326,7 +326,7 @@ fn result_section(inputs: &Inputs) -> Markup {
                 figcaption {
                     "The analysed side seen along the push, " (side_word)
                     ", z up. Colour: the number of knee-form angles (of " (n)
-                    ") " (strikes) "; grey: never struck. A point is coloured when it lies within half a pitch, across the grid, of a colliding grid node of "
+                    ") " (strikes) "; grey: never struck. A point is coloured when it lies within half a pitch, in " (if direct { "y" } else { "x" }) " and z, of a colliding grid node of "
                     code { "composite.csv" } "."
                     @if !run.blind_spots.is_empty() {
                         " Magenta: blind spots, grid cells where the part sticks out between the nodes unseen ("
