@@ -351,6 +351,11 @@ mod tests {
     fn a_written_summary_reads_back() {
         let s = Summary::from_json(&valid().to_string()).unwrap();
         assert_eq!(s.grid_size, [3, 4]);
+        // Runs of earlier versions were push-and-slide.
+        assert_eq!(s.approach, crate::Approach::Slide);
+        let s = with("approach", serde_json::json!("direct")).unwrap();
+        assert_eq!(s.approach, crate::Approach::Direct);
+        assert!(with("approach", serde_json::json!("sideways")).is_err());
     }
 
     #[test]
