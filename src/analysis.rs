@@ -452,7 +452,8 @@ pub struct Analysis {
     pub setup: Setup,
     /// The height grid.
     pub grid: HeightGrid,
-    /// The footprints, laid on `grid`, in the order of `setup.angles`.
+    /// The footprints, laid on `grid`, in the order of `setup.angles`;
+    /// empty for the direct approach ([`crate::direct::DirectFootprint`]).
     pub footprints: Vec<GridFootprint>,
     /// For an assembly ([`crate::assembly`]): per grid node, the index
     /// (into the assembly's files) of the file whose surface set its
@@ -606,7 +607,11 @@ impl Analysis {
                 (grid, Some(files))
             }
         };
-        let footprints = setup.footprints(&spec);
+        // The slide's footprints; the direct approach lays its own fronts.
+        let footprints = match setup.approach {
+            Approach::Slide => setup.footprints(&spec),
+            Approach::Direct => Vec::new(),
+        };
         let sample_s = t.elapsed().as_secs_f64();
 
         let t = Instant::now();
