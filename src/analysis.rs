@@ -263,7 +263,8 @@ impl Setup {
         Ok(())
     }
 
-    /// The grid for `part` (analysis frame), at this setup's pitch: SPEC's
+    /// The grid for `part` (analysis frame; the direct frame for
+    /// [`Approach::Direct`]), at this setup's pitch: SPEC's
     /// default extent covers every requested angle and its mirror, so that
     /// a part mirrored in z gets the mirrored grid. Checked to have a
     /// bounded number of nodes and the analysis on it to fit the memory
@@ -446,7 +447,9 @@ pub enum Status {
 /// angle, their composite and what was found on the way.
 #[derive(Debug, Clone)]
 pub struct Analysis {
-    /// The part and its file's identity.
+    /// The part and its file's identity. For the direct approach its
+    /// triangles are in the direct frame, as its grid ([`Analysis::placement`]
+    /// maps both back).
     pub input: PartFile,
     /// The setup it ran with.
     pub setup: Setup,
