@@ -25,6 +25,7 @@
 pub mod auto;
 pub mod compare;
 pub mod converge;
+pub mod direct;
 pub mod metrics;
 pub mod nearest;
 pub mod trace;
@@ -39,6 +40,10 @@ pub use compare::{
     exact_traces, select_starts,
 };
 pub use converge::{ConvergeOptions, ConvergeSummary, Convergence, PitchResult, converge};
+pub use direct::{
+    DIRECT_METRICS, DirectComparison, DirectConvergence, DirectRow, DirectStats,
+    DirectVerification, converge_direct, verify_direct,
+};
 pub use metrics::{DECIDED_METRICS, METRICS, Stats, TieBand};
 pub use trace::{GridContact, GridTrace};
 pub use verify::{
