@@ -14,6 +14,7 @@ use std::time::Instant;
 
 use crate::assembly::{PartSource, colliding_nodes_per_file};
 use crate::blind::{BlindSpot, blind_spots};
+use crate::direct::{DirectFootprint, direct_masks};
 use crate::engine::{Algorithm, AngleMask, EngineOptions, Probe, colliding_masks, composite};
 use crate::grid::{GridError, GridSpec, HeightGrid};
 use crate::kneeform::{Footprint, GridFootprint, KneeForm};
@@ -40,6 +41,33 @@ pub enum GridPlacement {
     },
 }
 
+/// Which knee motion an analysis follows. See README's "Two approaches".
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "snake_case")]
+pub enum Approach {
+    /// SPEC's push-and-slide (the paper's method): the knee-form pushed in
+    /// +y against a surface facing -y, then slid in -x; strikes by the
+    /// deflection threshold.
+    #[default]
+    Slide,
+    /// The direct approach (its predecessor, [`crate::direct`]): the
+    /// knee-form moved in -x until it first touches the part; the
+    /// first-contact points are the area. The deflection threshold and
+    /// rate rule are recorded but not used.
+    Direct,
+}
+
+impl Approach {
+    /// The name as the flag and `summary.json` write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Approach::Slide => "slide",
+            Approach::Direct => "direct",
+        }
+    }
+}
+
 /// What an analysis computes: the knee-form, the grid, the angles and the
 /// strike rule. Lengths in mm, angles in degrees. [`Setup::validate`]
 /// checks it; [`Analysis::run`] does so before any work.
@@ -63,6 +91,8 @@ pub struct Setup {
     /// How far the part must stick out between nodes (mm) for a grid cell
     /// to be a blind spot ([`crate::blind`]).
     pub blind_depth: f64,
+    /// Push-and-slide (the default) or the direct approach.
+    pub approach: Approach,
 }
 
 impl Default for Setup {
@@ -79,6 +109,7 @@ impl Default for Setup {
             algorithm: Algorithm::Fast,
             max_memory_bytes: 16.0 * f64::from(1u32 << 30),
             blind_depth: Setup::DEFAULT_BLIND_DEPTH,
+            approach: Approach::Slide,
         }
     }
 }
@@ -243,9 +274,13 @@ impl Setup {
         Ok(spec)
     }
 
-    /// The grid alone, its node count checked, not its memory.
+    /// The grid alone, its node count checked, not its memory. For the
+    /// direct approach `bbox` is the part's in the direct frame.
     fn grid_placed(&self, bbox: &Bbox) -> Result<GridSpec, GridError> {
         let spec = match self.grid {
+            GridPlacement::AroundPart if self.approach == Approach::Direct => {
+                crate::direct::grid_around(bbox, &self.knee, &self.angles, self.pitch)
+            }
             GridPlacement::AroundPart => {
                 let extents: Vec<Footprint> = self
                     .angles
@@ -530,7 +565,7 @@ impl Analysis {
     }
 
     fn run_checked(
-        input: PartFile,
+        mut input: PartFile,
         setup: &Setup,
         progress: &dyn Progress,
         mut warnings: Vec<Warning>,
@@ -541,6 +576,13 @@ impl Analysis {
         }
         warnings.extend(part_warnings);
 
+        // The direct approach samples the part turned into the direct
+        // frame, where SPEC's z-buffer from -y is its depth grid along x.
+        if setup.approach == Approach::Direct {
+            for v in input.part.triangles.iter_mut().flatten() {
+                *v = crate::direct::to_direct(*v);
+            }
+        }
         let t = Instant::now();
         let spec = setup.grid_placed(&input.part.bbox())?;
         let memory = setup.check_memory(&spec, input.part.triangles.len())?;
@@ -573,20 +615,34 @@ impl Analysis {
         let blind_s = t.elapsed().as_secs_f64();
 
         let t = Instant::now();
-        progress.begin("push and slide", Some(footprints.len() as u64));
-        let options = EngineOptions {
-            rule: setup.rule,
-            algorithm: setup.algorithm,
-            start_rows: None,
-            probes: blind
-                .iter()
-                .map(|b| Probe {
-                    cell: (b.i, b.j),
-                    y: b.y,
-                })
-                .collect(),
+        let probes: Vec<Probe> = blind
+            .iter()
+            .map(|b| Probe {
+                cell: (b.i, b.j),
+                y: b.y,
+            })
+            .collect();
+        let masks = match setup.approach {
+            Approach::Slide => {
+                progress.begin("push and slide", Some(footprints.len() as u64));
+                let options = EngineOptions {
+                    rule: setup.rule,
+                    algorithm: setup.algorithm,
+                    start_rows: None,
+                    probes,
+                };
+                colliding_masks(&grid, &footprints, &options, &|| progress.step())
+            }
+            Approach::Direct => {
+                progress.begin("direct approach", Some(setup.angles.len() as u64));
+                let fronts: Vec<DirectFootprint> = setup
+                    .angles
+                    .iter()
+                    .map(|&a| DirectFootprint::new(&setup.knee, a, spec.pitch))
+                    .collect();
+                direct_masks(&grid, &fronts, setup.rule.e0, &probes, &|| progress.step())
+            }
         };
-        let masks = colliding_masks(&grid, &footprints, &options, &|| progress.step());
         progress.end();
         let push_slide_s = t.elapsed().as_secs_f64();
 
@@ -621,6 +677,17 @@ impl Analysis {
                 ..Timings::default()
             },
         })
+    }
+
+    /// How the part file's coordinates map to this analysis's grid: the
+    /// file's frame and side, then, for the direct approach, the turn into
+    /// the direct frame ([`crate::direct`]). The writers map results back
+    /// by it.
+    pub fn placement(&self) -> crate::frame::Placement {
+        crate::frame::Placement {
+            approach: self.setup.approach,
+            ..self.input.placement()
+        }
     }
 
     /// Nodes colliding at some angle.
@@ -702,6 +769,7 @@ impl Analysis {
             e0_mm: setup.rule.e0,
             rate: setup.rule.rate.name().into(),
             algorithm: setup.algorithm,
+            approach: setup.approach,
             threads: rayon::current_num_threads(),
             per_angle: self
                 .masks
@@ -736,7 +804,7 @@ impl Analysis {
     /// corner.
     fn part_bbox(&self) -> ([f64; 3], [f64; 3]) {
         let part = &self.input.part;
-        if self.input.frame.is_none() {
+        if self.input.frame.is_none() && self.setup.approach == Approach::Slide {
             // A mirrored side only swaps the y bounds.
             let bbox = part.bbox();
             let side = self.input.side;
@@ -747,7 +815,7 @@ impl Analysis {
             );
         }
         // A rotation does not map boxes to boxes: map every vertex back.
-        let placement = self.input.placement();
+        let placement = self.placement();
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for &v in part.triangles.iter().flatten() {
             for (k, c) in placement.to_part(v).into_iter().enumerate() {

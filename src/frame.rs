@@ -27,6 +27,7 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Matrix3, Point3, Rotation3, Translation3};
 
+use crate::analysis::Approach;
 use crate::mesh::Side;
 
 /// How far from orthonormal with determinant +1 a frame's 3 x 3 part may
@@ -300,6 +301,10 @@ pub struct Placement {
     pub side: Side,
     /// Where the part sits in the vehicle.
     pub frame: Frame,
+    /// For [`Approach::Direct`], the analysis frame is turned into the
+    /// direct frame last ([`crate::direct::to_direct`]); the slide's is
+    /// SPEC's.
+    pub approach: Approach,
 }
 
 impl From<Side> for Placement {
@@ -308,21 +313,31 @@ impl From<Side> for Placement {
         Placement {
             side,
             frame: Frame::none(),
+            approach: Approach::Slide,
         }
     }
 }
 
 impl Placement {
-    /// A point of the part (mm) in the analysis frame.
+    /// A point of the part (mm) in the analysis frame (the direct frame
+    /// for the direct approach).
     pub fn to_analysis(&self, p: [f64; 3]) -> [f64; 3] {
         let [x, y, z] = self.frame.to_vehicle(p);
-        [x, self.side.to_part(y), z]
+        let a = [x, self.side.to_part(y), z];
+        match self.approach {
+            Approach::Slide => a,
+            Approach::Direct => crate::direct::to_direct(a),
+        }
     }
 
     /// A point of the analysis frame in the part's coordinates (mm): the
     /// inverse of [`Placement::to_analysis`]. Without a frame only y is
     /// touched (mirrored for the right side), exactly as before frames.
-    pub fn to_part(&self, [x, y, z]: [f64; 3]) -> [f64; 3] {
+    pub fn to_part(&self, a: [f64; 3]) -> [f64; 3] {
+        let [x, y, z] = match self.approach {
+            Approach::Slide => a,
+            Approach::Direct => crate::direct::from_direct(a),
+        };
         self.frame.to_part([x, self.side.to_part(y), z])
     }
 }
@@ -349,10 +364,19 @@ mod tests {
         let p = Placement {
             side: Side::Right,
             frame: Frame::parse("y,z,x").unwrap(),
+            approach: Approach::Slide,
         };
         // Vehicle (y, z, x) = (2, 3, 1), mirrored in y: (2, -3, 1).
         assert_eq!(p.to_analysis([1.0, 2.0, 3.0]), [2.0, -3.0, 1.0]);
         assert_eq!(p.to_part([2.0, -3.0, 1.0]), [1.0, 2.0, 3.0]);
+        // The direct approach turns the analysis frame last: (x, y, z) ->
+        // (y, -x, z), and back exactly.
+        let d = Placement {
+            approach: Approach::Direct,
+            ..p
+        };
+        assert_eq!(d.to_analysis([1.0, 2.0, 3.0]), [-3.0, -2.0, 1.0]);
+        assert_eq!(d.to_part([-3.0, -2.0, 1.0]), [1.0, 2.0, 3.0]);
     }
 
     #[test]

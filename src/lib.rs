@@ -11,6 +11,8 @@
 //! * [`push`] and [`slide`]: step 2, the fast path; [`paper`]: the
 //!   paper-literal reference;
 //! * [`engine`]: every angle and start, the colliding masks and composite;
+//! * [`direct`]: the direct approach (`--approach direct`), the knee-form
+//!   moved straight in -x until it first touches the part;
 //! * [`analysis`]: the pipeline above as one call, with its typed setup;
 //! * [`sanity`]: the checks that warn of a part in the wrong units or
 //!   facing the wrong way, and of a result with nothing struck.
@@ -42,6 +44,7 @@
 pub mod analysis;
 pub mod assembly;
 pub mod blind;
+pub mod direct;
 pub mod engine;
 pub mod frame;
 pub mod grid;
@@ -63,7 +66,9 @@ pub mod strike;
 pub mod summary;
 mod zbuffer;
 
-pub use analysis::{Analysis, AnalysisError, GridPlacement, Progress, Setup, SetupError, Status};
+pub use analysis::{
+    Analysis, AnalysisError, Approach, GridPlacement, Progress, Setup, SetupError, Status,
+};
 pub use assembly::PartSource;
 pub use engine::{Algorithm, AngleMask, EngineOptions, colliding_masks, composite, push_levels};
 pub use frame::{Frame, Placement};

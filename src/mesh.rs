@@ -161,12 +161,14 @@ impl PartFile {
         }
     }
 
-    /// How the file's coordinates map into the analysis frame: its frame,
-    /// then its side.
+    /// How the file's coordinates map into SPEC's analysis frame: its
+    /// frame, then its side (an analysis's own, with its approach, is
+    /// [`crate::Analysis::placement`]).
     pub fn placement(&self) -> Placement {
         Placement {
             side: self.side,
             frame: self.frame.clone(),
+            approach: crate::analysis::Approach::Slide,
         }
     }
 }

@@ -124,6 +124,13 @@ pub struct Summary {
     pub rate: String,
     /// `fast` or `paper`.
     pub algorithm: crate::Algorithm,
+    /// `slide` (push-and-slide, SPEC) or `direct` (the direct approach,
+    /// [`crate::direct`]: the grid, its origin and the heights are then in
+    /// the direct frame, and the deflection threshold, `sigma` and `rate`
+    /// are recorded but not used). Absent in runs of earlier versions
+    /// (slide).
+    #[serde(default)]
+    pub approach: crate::analysis::Approach,
     /// Worker threads.
     pub threads: usize,
     /// Per angle, in the order of `angles_deg`.
@@ -344,6 +351,11 @@ mod tests {
     fn a_written_summary_reads_back() {
         let s = Summary::from_json(&valid().to_string()).unwrap();
         assert_eq!(s.grid_size, [3, 4]);
+        // Runs of earlier versions were push-and-slide.
+        assert_eq!(s.approach, crate::Approach::Slide);
+        let s = with("approach", serde_json::json!("direct")).unwrap();
+        assert_eq!(s.approach, crate::Approach::Direct);
+        assert!(with("approach", serde_json::json!("sideways")).is_err());
     }
 
     #[test]

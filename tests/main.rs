@@ -3,6 +3,7 @@
 
 mod analytic;
 mod cli;
+mod direct;
 mod engine;
 mod first_hour;
 mod frames;

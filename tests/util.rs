@@ -79,7 +79,7 @@ pub fn random_grid_quantised(
 }
 
 /// The rotated triangle of SPEC at `angle_deg`, as (x, z).
-fn triangle(knee: &KneeForm, angle_deg: f64) -> [[f64; 2]; 3] {
+pub fn triangle(knee: &KneeForm, angle_deg: f64) -> [[f64; 2]; 3] {
     let t = angle_deg.to_radians();
     let l = knee.triangle_side;
     [
@@ -120,7 +120,7 @@ const TOL: f64 = 1e-9;
 /// is flat along the row and would place the end only within sqrt(ulp),
 /// 2e-7 mm, which breaks SPEC's 1e-9 mm ties (measured: it did, at 30
 /// degrees, where an edge runs along x and a row grazes its band).
-fn row_start(v: &[[f64; 2]; 3], r: f64, dz: f64) -> Option<f64> {
+pub fn row_start(v: &[[f64; 2]; 3], r: f64, dz: f64) -> Option<f64> {
     // Intervals of x where lo <= c0 + c1 x <= hi, intersected into `iv`.
     fn clip(iv: &mut (f64, f64), c0: f64, c1: f64, lo: f64, hi: f64) {
         if c1 == 0.0 {

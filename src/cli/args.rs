@@ -7,8 +7,8 @@ use anyhow::{Context, ensure};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use kneeform::strike::RateEstimate;
 use kneeform::{
-    Algorithm, Frame, GridPlacement, KneeForm, PartSource, Placement, Setup, SetupError, Side,
-    StrikeRule,
+    Algorithm, Approach, Frame, GridPlacement, KneeForm, PartSource, Placement, Setup, SetupError,
+    Side, StrikeRule,
 };
 
 /// UN Regulation No. 21 knee-form inspection: which areas of an interior
@@ -170,6 +170,16 @@ pub struct SetupArgs {
     /// slow). Both give identical results.
     #[arg(long, value_enum, default_value_t = Algorithm::Fast)]
     pub algorithm: Algorithm,
+    /// Which knee motion: `slide` (default; the paper's push-and-slide:
+    /// the knee-form pushed in +y against a surface facing -y, then slid
+    /// in -x, striking what turns it aside by more than --deflection) or
+    /// `direct` (its predecessor: the knee-form moved in -x until it first
+    /// touches the part, for surfaces facing +x such as an instrument
+    /// panel; the area is every first-contact point, within --e0, over
+    /// every position and angle; --deflection, --rate and --algorithm
+    /// are recorded but not used). See README, "Two approaches".
+    #[arg(long, value_enum, default_value_t = Approach::Slide, value_name = "APPROACH")]
+    pub approach: Approach,
     /// Worker threads (default: one per CPU). Results do not depend on it.
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
@@ -246,6 +256,13 @@ pub struct ReportArgs {
     /// (its SHA-256 must still be the run's).
     #[arg(long, value_name = "FILE")]
     pub part: Option<PathBuf>,
+    /// Another `analyze` run of the same part with the other --approach
+    /// (slide against direct): both areas painted on the same rendered
+    /// part, with the area only push-and-slide strikes (what the direct
+    /// approach cannot reach) and the area only the direct approach
+    /// touches.
+    #[arg(long, value_name = "RUN_DIR")]
+    pub compare: Option<PathBuf>,
 }
 
 /// Which starts a comparison uses.
@@ -443,6 +460,7 @@ impl SetupArgs {
             algorithm: self.algorithm,
             max_memory_bytes: self.max_memory * f64::from(1u32 << 30),
             blind_depth: self.blind_depth,
+            approach: self.approach,
         };
         setup.validate().map_err(with_flag)?;
         Ok((setup, self.threads))
@@ -471,6 +489,7 @@ impl PartArgs {
             placement: Placement {
                 side: self.side,
                 frame,
+                approach: Approach::Slide,
             },
         })
     }

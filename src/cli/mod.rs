@@ -66,6 +66,7 @@ pub fn harness_error(err: HarnessError) -> anyhow::Error {
         HarnessError::TieBand(_) => Some("--tie-band".into()),
         HarnessError::Pitches(_) => Some("--pitches".into()),
         HarnessError::EmptySample | HarnessError::Strip(_) => Some("--starts".into()),
+        HarnessError::DirectApproach => Some("--approach".into()),
         _ => None,
     };
     match flag {

@@ -20,6 +20,7 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
     let options = ReportOptions {
         verify_dirs: args.verify_dirs.clone(),
         part: args.part.clone(),
+        compare: args.compare.clone(),
         ..ReportOptions::new(&args.run_dir)
     };
     super::write_report(&options, &args.out, &args.out)

@@ -112,6 +112,9 @@ pub fn choose_pitch(
     auto: &AutoPitch,
     progress: &dyn Progress,
 ) -> Result<PitchChoice, HarnessError> {
+    if setup.approach == crate::analysis::Approach::Direct {
+        return Err(HarnessError::DirectApproach);
+    }
     super::verify::check_tolerance(auto.tolerance)?;
     if !(auto.budget_s.is_finite() && auto.budget_s > 0.0) {
         return Err(HarnessError::Budget(auto.budget_s));

@@ -335,6 +335,9 @@ pub fn converge(
     options: &ConvergeOptions,
     progress: &dyn Progress,
 ) -> Result<Convergence, HarnessError> {
+    if setup.approach == crate::analysis::Approach::Direct {
+        return Err(HarnessError::DirectApproach);
+    }
     options.validate()?;
     let pitches = &options.pitches;
     let ladder = Ladder::new(

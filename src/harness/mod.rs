@@ -68,6 +68,12 @@ pub enum HarnessError {
     /// The oracle refused the part or its options.
     #[error(transparent)]
     Oracle(#[from] kneeform_oracle::OracleError),
+    /// The setup asks for the direct approach, which the harness does not
+    /// compare yet: its exact side is the oracle's push-and-slide.
+    #[error(
+        "verify, converge and --pitch auto compare push-and-slide with the exact oracle; the direct approach is not compared yet (analyze it, and set it beside a slide run with report --compare)"
+    )]
+    DirectApproach,
     /// No start is placed on the part.
     #[error("no start is placed on this part: nothing to compare")]
     NoStarts,

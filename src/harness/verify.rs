@@ -164,6 +164,10 @@ pub(crate) fn verify_with(
     fault: Option<Fault>,
 ) -> Result<Verification, HarnessError> {
     setup.validate()?;
+    if setup.approach == crate::analysis::Approach::Direct {
+        return Err(HarnessError::DirectApproach);
+    }
+
     options.validate()?;
     let t = Instant::now();
     let triangles = &input.part.triangles;

@@ -287,6 +287,7 @@ mod tests {
         let placement = crate::frame::Placement {
             side: Side::Right,
             frame: crate::frame::Frame::parse("z,x,y").unwrap(),
+            approach: crate::analysis::Approach::Slide,
         };
         // Node (2, 0): analysis (0, -3, 2), vehicle (0, 3, 2); vehicle
         // (x, y, z) = part (z, x, y), so part (3, 2, 0).

@@ -24,6 +24,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
+use crate::analysis::Approach;
 use crate::frame::Placement;
 use crate::grid::{GridSpec, HeightGrid};
 use crate::mesh::Side;
@@ -122,6 +123,7 @@ pub fn write_depth_png(
 ) -> Result<(), PngError> {
     let side = placement.side;
     let frame = placement.frame.record().map(|r| r.given);
+    let direct = placement.approach == Approach::Direct;
     let (h_lo, h_hi) = finite_range(&grid.h);
     let window = crop_window(grid, None);
     let shown = window.crop(grid);
@@ -139,12 +141,15 @@ pub fn write_depth_png(
         }
     };
     let pixels: Vec<RGBColor> = heights.into_iter().map(colour).collect();
-    // The bar is in the part's y: on the right side, -h.
-    let (y_lo, y_hi) = match side {
-        Side::Left => (h_lo, h_hi),
-        Side::Right => (-h_hi, -h_lo),
+    // The bar is in the part's y: on the right side, -h; for the direct
+    // approach in its x, -h.
+    let flipped = direct || side == Side::Right;
+    let (y_lo, y_hi) = if flipped {
+        (-h_hi, -h_lo)
+    } else {
+        (h_lo, h_hi)
     };
-    let [top, bottom] = depth_bar_ends(side);
+    let [top, bottom] = depth_bar_ends(if flipped { Side::Right } else { Side::Left });
     let plot = Plot {
         grid: &shown,
         raster: &raster,
@@ -152,16 +157,18 @@ pub fn write_depth_png(
         title: &title,
         side,
         frame: frame.as_deref(),
+        approach: placement.approach,
         key: &[(NO_PART, "no part (the node's line misses it)")],
         rings: &[],
         marks: &[],
     };
     draw_plot(path, &plot, |area, bar_top, bar_bottom| {
         // With a frame the picture is in vehicle coordinates, and so is y.
-        let label = if frame.is_some() {
-            "y (mm, vehicle frame)"
-        } else {
-            "y (mm, part frame)"
+        let label = match (direct, frame.is_some()) {
+            (false, true) => "y (mm, vehicle frame)",
+            (false, false) => "y (mm, part frame)",
+            (true, true) => "x (mm, vehicle frame)",
+            (true, false) => "x (mm, part frame)",
         };
         let mut bar = colour_bar(area, label, y_lo..y_hi)?;
         bar.configure_mesh()
@@ -176,7 +183,11 @@ pub fn write_depth_png(
         let dy = (y_hi - y_lo) / BANDS as f64;
         bar.draw_series((0..BANDS).map(|k| {
             let lo = y_lo + k as f64 * dy;
-            let h = side.to_part(lo + 0.5 * dy);
+            let h = if flipped {
+                -(lo + 0.5 * dy)
+            } else {
+                lo + 0.5 * dy
+            };
             Rectangle::new([(0.0, lo), (1.0, lo + dy)], colour(h).filled())
         }))?;
         let style = (FONT, 13).into_text_style(area);
@@ -233,6 +244,7 @@ pub fn write_composite_png(
 ) -> Result<(), PngError> {
     let side = placement.side;
     let frame = placement.frame.record().map(|r| r.given);
+    let approach = placement.approach;
     if composite.len() != grid.spec.len() {
         return Err(PngError::Length {
             expected: grid.spec.len(),
@@ -284,6 +296,7 @@ pub fn write_composite_png(
         title,
         side,
         frame: frame.as_deref(),
+        approach,
         key: &key,
         rings: &rings,
         marks: &marks,
@@ -512,6 +525,9 @@ struct Plot<'a> {
     /// The `--frame` given, if any: the axes are then the vehicle's, not
     /// the part file's, and the view line says so.
     frame: Option<&'a str>,
+    /// For the direct approach the grid's columns are the part's y (the
+    /// direct frame, [`crate::direct`]), seen from +x.
+    approach: Approach,
     /// Swatches under the plot: colour and meaning.
     key: &'a [(RGBColor, &'a str)],
     /// Pixels (indices into `pixels`) to circle.
@@ -559,12 +575,13 @@ fn draw_plot(
             &(FONT, 20).into_text_style(&root),
             (MARGIN as i32, 10),
         )?;
+        let line = match plot.approach {
+            Approach::Slide => view_line(plot.side),
+            Approach::Direct => "Direct approach, seen from the knee (looking -x): y across, z up",
+        };
         let view = match plot.frame {
-            None => view_line(plot.side).to_string(),
-            Some(given) => format!(
-                "{}; vehicle axes (part placed by --frame {given})",
-                view_line(plot.side)
-            ),
+            None => line.to_string(),
+            Some(given) => format!("{line}; vehicle axes (part placed by --frame {given})"),
         };
         root.draw_text(
             &view,
@@ -621,11 +638,14 @@ fn draw_plot(
                 stroke,
             ))?;
         }
-        let x_label = |v: &f64| tick(&if reversed { -v } else { *v });
-        let x_desc = if reversed {
-            "x (mm), vehicle front \u{2192}"
-        } else {
-            "x (mm), vehicle front \u{2190}"
+        // The direct approach's columns are the analysed y (mirrored for
+        // the right side): the reversed axis is the part's y itself.
+        let direct = plot.approach == Approach::Direct;
+        let x_label = |v: &f64| tick(&if reversed && !direct { -v } else { *v });
+        let x_desc = match (direct, reversed) {
+            (true, _) => "y (mm)",
+            (false, true) => "x (mm), vehicle front \u{2192}",
+            (false, false) => "x (mm), vehicle front \u{2190}",
         };
         // With a frame the axes are the vehicle's, not the part file's.
         let (x_desc, z_desc) = match plot.frame {

@@ -19,7 +19,7 @@ use crate::summary::Summary;
 /// the writing time. Returns the summary written.
 pub fn write_analysis(out: &OutputDir, analysis: &Analysis) -> Result<Summary, WriteError> {
     let t = Instant::now();
-    let placement = analysis.input.placement();
+    let placement = analysis.placement();
     let node_file = analysis.node_file.as_deref();
     let grid = &analysis.grid;
     let (masks, counts) = (&analysis.masks, &analysis.composite);

@@ -6,6 +6,9 @@
 //!
 //! * `result`: the analysed side painted with the composite (the main
 //!   image, `#main-view`), its legend, and the oblique view;
+//! * `compare` (with `--compare`): a push-and-slide run and a direct one
+//!   of the same part, both areas on one rendered part, and what only
+//!   push-and-slide strikes;
 //! * `part`: the part's identity (file, SHA-256, triangles, bounding box,
 //!   units, frame; an assembly's files with each one's colliding area);
 //! * `method`: the knee-form (the assumed triangle side called out), grid,
@@ -21,8 +24,11 @@
 //! * `run-figures`: the images the run wrote.
 
 use maud::{DOCTYPE, Markup, PreEscaped, html};
+
+use crate::analysis::Approach;
 use serde_json::Value;
 
+use super::compare::{BOTH, Comparison, DIRECT_ONLY, MATCH_PITCHES, SLIDE_ONLY};
 use super::html::{ASYMP, MIDDOT, NBSP, SUP2, TIMES, cite, fmt_num, png_uri, svg_empty, utc_date};
 use super::run::Run;
 use super::verify::{Verdict, Verification, escape_pointer, scalars};
@@ -53,6 +59,9 @@ pub struct Inputs<'a> {
     pub pngs: &'a [Vec<u8>],
     /// Images the run wrote (file name, bytes).
     pub run_figures: &'a [(String, Vec<u8>)],
+    /// The comparison with a run of the other approach, with the PNG of
+    /// each of its figures.
+    pub comparison: Option<(&'a Comparison, &'a [Vec<u8>])>,
 }
 
 /// The version of this build, as the page names it.
@@ -95,13 +104,17 @@ pub fn document(inputs: &Inputs) -> String {
                     "\n"
                     p class="subtitle" {
                         (cite(SUMMARY, j, "/input_file")) " " (MIDDOT)
-                        " UN Regulation No." (NBSP) "21 knee-form push-and-slide (Inui, Gunji and Umezu) "
+                        " UN Regulation No." (NBSP) "21 knee-form "
+                        (approach_words(s.approach)) " "
                         (MIDDOT) " kneeform " (cite(SUMMARY, j, "/kneeform_version")) " " (MIDDOT)
                         " run of " (utc_date(s.run_unix_time))
                     }
                 }
                 "\n"
                 (result_section(inputs))
+                @if let Some((c, pngs)) = inputs.comparison {
+                    (compare_section(run, c, pngs))
+                }
                 (part_section(run))
                 (method_section(run))
                 (per_angle_section(inputs))
@@ -160,15 +173,136 @@ footer { margin-top: 32px; font-size: 11px; color: #555; border-top: 1px solid #
 }
 ";
 
+/// The approach in words.
+fn approach_words(approach: Approach) -> &'static str {
+    match approach {
+        Approach::Slide => "push-and-slide (Inui, Gunji and Umezu)",
+        Approach::Direct => {
+            "direct approach (the knee-form moved in -x until it first touches the part; Inui et al.'s predecessor method)"
+        }
+    }
+}
+
+/// The file the report cites the compared run's summary as.
+const COMPARE_SUMMARY: &str = "compare/summary.json";
+
+fn compare_section(run: &Run, c: &Comparison, pngs: &[Vec<u8>]) -> Markup {
+    let (slide, direct, slide_file, direct_file) = match run.summary.approach {
+        Approach::Slide => (run, &c.other, SUMMARY, COMPARE_SUMMARY),
+        Approach::Direct => (&c.other, run, COMPARE_SUMMARY, SUMMARY),
+    };
+    let swatch = |rgb: [u8; 3], text: &str| {
+        let [r, g, b] = rgb;
+        html! {
+            span style={ "display:inline-block;width:12px;height:12px;background:rgb(" (r) "," (g) "," (b) ")" } {}
+            " " (text) " "
+        }
+    };
+    let slide_only_area = c.slide_only as f64 * c.slide_pitch * c.slide_pitch;
+    let direct_only_area = c.direct_only as f64 * c.direct_pitch * c.direct_pitch;
+    let captions = [
+        "Face on, as push-and-slide sees the part (along its push).",
+        "Obliquely from behind the direct approach's knee-form (from +x, beside the analysed side, above).",
+    ];
+    html! {
+        section id="compare" {
+            "\n"
+            h2 { "Direct approach and push-and-slide" }
+            "\n"
+            p {
+                "The same part analysed both ways: push-and-slide ("
+                code { (slide.dir.display().to_string()) } ") and the direct approach ("
+                code { (direct.dir.display().to_string()) }
+                "), in which the knee-form moves in -x until it first touches the part. The direct approach cannot reach a surface behind one it touches first (the paper's Figure 2): a depression behind a protrusion."
+            }
+            "\n"
+            table class="compact" id="compare-table" {
+                "\n"
+                tr { th { "approach" } th class="num" { "composite nodes" } th class="num" { "area (mm" (SUP2) ")" } th class="num" { "pitch (mm)" } }
+                "\n"
+                tr {
+                    td { "push-and-slide" }
+                    td class="num" { (cite(slide_file, &slide.summary_json, "/composite_nodes")) }
+                    td class="num" { (cite(slide_file, &slide.summary_json, "/composite_area_mm2")) }
+                    td class="num" { (cite(slide_file, &slide.summary_json, "/pitch_mm")) }
+                }
+                "\n"
+                tr {
+                    td { "direct approach" }
+                    td class="num" { (cite(direct_file, &direct.summary_json, "/composite_nodes")) }
+                    td class="num" { (cite(direct_file, &direct.summary_json, "/composite_area_mm2")) }
+                    td class="num" { (cite(direct_file, &direct.summary_json, "/pitch_mm")) }
+                }
+                "\n"
+                tr id="slide-only" {
+                    td { "struck by push-and-slide only: what the direct approach misses" }
+                    td class="num" { (c.slide_only) }
+                    td class="num" { (fmt_num(slide_only_area)) }
+                    td class="num" { (fmt_num(c.slide_pitch)) }
+                }
+                "\n"
+                tr id="direct-only" {
+                    td { "touched by the direct approach only" }
+                    td class="num" { (c.direct_only) }
+                    td class="num" { (fmt_num(direct_only_area)) }
+                    td class="num" { (fmt_num(c.direct_pitch)) }
+                }
+                "\n"
+            }
+            "\n"
+            p class="headline" {
+                "The direct approach misses " b { (fmt_num(slide_only_area)) " mm" (SUP2) }
+                " that push-and-slide strikes (" (c.slide_only) " of its nodes lie farther than "
+                (fmt_num(c.match_mm)) " mm from every first-contact point of the direct approach)."
+            }
+            "\n"
+            p class="note" {
+                "A node counts as found by both when a colliding node of the other run lies within "
+                (fmt_num(MATCH_PITCHES)) " pitches (of the coarser run) of it, in 3-d: the two grids sample the part in different frames. Computed from both runs' "
+                code { "composite.csv" } "; each area is its run's own (nodes " (TIMES) " pitch" (SUP2) ", projected across its grid)."
+            }
+            "\n"
+            @for (k, (figure, png)) in c.figures.iter().zip(pngs).enumerate() {
+                figure {
+                    "\n"
+                    (image_tag(figure, png, &format!("compare-view-{k}"), "view", false))
+                    "\n"
+                    figcaption {
+                        (captions[k.min(1)]) " "
+                        (swatch(SLIDE_ONLY, "push-and-slide only"))
+                        (swatch(DIRECT_ONLY, "direct approach only"))
+                        (swatch(BOTH, "both"))
+                        "; grey: neither."
+                    }
+                    "\n"
+                }
+                "\n"
+            }
+        }
+        "\n"
+    }
+}
+
 fn result_section(inputs: &Inputs) -> Markup {
     let run = inputs.run;
     let s = &run.summary;
     let j = &run.summary_json;
     let views = inputs.views;
     let n = ramp_len(run);
-    let side_word = match s.side {
-        crate::Side::Left => "from -y (the left side's outside), vehicle front (-x) on the left",
-        crate::Side::Right => "from +y (the right side's outside), vehicle front (-x) on the right",
+    let direct = s.approach == Approach::Direct;
+    let side_word = match (direct, s.side) {
+        (true, _) => "seen along the knee's motion (from +x, looking -x)",
+        (false, crate::Side::Left) => {
+            "from -y (the left side's outside), vehicle front (-x) on the left"
+        }
+        (false, crate::Side::Right) => {
+            "from +y (the right side's outside), vehicle front (-x) on the right"
+        }
+    };
+    let strikes = if direct {
+        "whose knee-form, moving in -x, first touches the point (the direct approach)"
+    } else {
+        "whose sliding knee-form strikes the point (the paper's Figure 13)"
     };
     html! {
         section id="result" {
@@ -192,7 +326,7 @@ fn result_section(inputs: &Inputs) -> Markup {
                 figcaption {
                     "The analysed side seen along the push, " (side_word)
                     ", z up. Colour: the number of knee-form angles (of " (n)
-                    ") whose sliding knee-form strikes the point (the paper's Figure 13); grey: never struck. A point is coloured when it lies within half a pitch, in x and z, of a colliding grid node of "
+                    ") " (strikes) "; grey: never struck. A point is coloured when it lies within half a pitch, in " (if direct { "y" } else { "x" }) " and z, of a colliding grid node of "
                     code { "composite.csv" } "."
                     @if !run.blind_spots.is_empty() {
                         " Magenta: blind spots, grid cells where the part sticks out between the nodes unseen ("
@@ -371,11 +505,23 @@ fn method_section(run: &Run) -> Markup {
                 (row("Angles (degrees)", html! {
                     (c("/angles_deg")) " (" (s.angles_deg.len()) " angles)"
                 }))
-                (row("Deflection threshold", html! {
-                    (c("/deflection_deg")) " degrees (sigma = tan delta = " (c("/sigma"))
-                    "; rate estimated as " (c("/rate"))
-                    "): a point the knee-form meets is a strike only when the surface there turns it aside by more than this angle"
+                (row("Approach", html! {
+                    (c("/approach")) ": " (approach_words(s.approach))
                 }))
+                @if s.approach == Approach::Direct {
+                    (row("Deflection threshold", html! {
+                        (c("/deflection_deg")) " degrees: recorded, not used (the direct approach's knee-form does not slide; every first-contact point within e0 is in the area)"
+                    }))
+                    (row("Direct frame", html! {
+                        "the grid's columns are the part's y (analysis frame), its depth -x: the grid origin below is (y, z)"
+                    }))
+                } @else {
+                    (row("Deflection threshold", html! {
+                        (c("/deflection_deg")) " degrees (sigma = tan delta = " (c("/sigma"))
+                        "; rate estimated as " (c("/rate"))
+                        "): a point the knee-form meets is a strike only when the surface there turns it aside by more than this angle"
+                    }))
+                }
                 (row("Rounding tolerance e0", html! {
                     (c("/e0_mm")) " mm (absorbs floating-point rounding only)"
                 }))

@@ -19,6 +19,7 @@
 
 use std::path::{Path, PathBuf};
 
+mod compare;
 mod document;
 mod html;
 mod render;
@@ -139,6 +140,9 @@ pub struct ReportOptions {
     /// The run directory's name on the page, when `run_dir` is not (e.g. a
     /// staging directory about to be renamed).
     pub run_name: Option<PathBuf>,
+    /// Another `analyze` run of the same part with the other approach
+    /// (`--approach`), shown side by side with this one.
+    pub compare: Option<PathBuf>,
 }
 
 impl ReportOptions {
@@ -149,6 +153,7 @@ impl ReportOptions {
             verify_dirs: Vec::new(),
             part: None,
             run_name: None,
+            compare: None,
         }
     }
 }
@@ -182,6 +187,19 @@ fn build_report(options: &ReportOptions) -> Result<(String, Report), ReportError
     let masks = run.angle_masks(&angles)?;
     let masks: Vec<(f64, NodeCounts)> = angles.into_iter().zip(masks).collect();
     let views = render_views(&run, &masks);
+    let comparison = match &options.compare {
+        None => None,
+        Some(dir) => {
+            let other = Run::read(dir, options.part.as_deref())?;
+            let comparison = compare::Comparison::new(&run, other)?;
+            let pngs = comparison
+                .figures
+                .iter()
+                .map(|f| encode_png(&f.image))
+                .collect::<Result<Vec<_>, _>>()?;
+            Some((comparison, pngs))
+        }
+    };
     let mut pngs = vec![
         encode_png(&views.side.image)?,
         encode_png(&views.oblique.image)?,
@@ -206,6 +224,7 @@ fn build_report(options: &ReportOptions) -> Result<(String, Report), ReportError
         views: &views,
         pngs: &pngs,
         run_figures: &run_figures,
+        comparison: comparison.as_ref().map(|(c, pngs)| (c, pngs.as_slice())),
     });
     let report = Report {
         part_path: run.part_path,

@@ -6,6 +6,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use crate::analysis::Approach;
 use crate::frame::Frame;
 use crate::grid::GridSpec;
 use crate::mesh::{Part, Side, read_part_bytes, sha256_hex};
@@ -21,8 +22,9 @@ pub struct NodeCounts {
     pub spec: GridSpec,
     /// Per node, row-major by z (`j * nx + i`): number of angles (or 1/0).
     pub count: Vec<u16>,
-    /// Per node, the y of the node in the part's frame (mm) as the CSV
-    /// gave it; NaN for nodes not in the file.
+    /// Per node, its depth on the grid (mm: vehicle y for push-and-slide,
+    /// `-x` for the direct approach, [`GridAxes`]) from the CSV's point;
+    /// NaN for nodes not in the file.
     pub y: Vec<f64>,
 }
 
@@ -99,8 +101,34 @@ pub struct Run {
     pub part: Part,
     /// The run's `--frame` (none when it had none).
     pub frame: Frame,
+    /// How the drawn part's points map to the run's grid.
+    pub axes: GridAxes,
     /// `blind_spots.csv` (empty for runs of versions that wrote none).
     pub blind_spots: Vec<BlindRow>,
+}
+
+/// How a point the report draws (vehicle coordinates, mm) maps to a run's
+/// grid: for push-and-slide the grid is vehicle x, z with depth y (the
+/// side's mirror aside, as ever); for the direct approach
+/// ([`crate::direct`]) it is the direct frame, column coordinate the
+/// analysed y (vehicle y, mirrored for the right side), depth `-x`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridAxes {
+    /// The run's approach.
+    pub approach: Approach,
+    /// The run's side.
+    pub side: Side,
+}
+
+impl GridAxes {
+    /// `v` (vehicle coordinates, mm) as `[column coordinate, depth, z]` of
+    /// the run's grid.
+    pub fn grid(&self, v: [f64; 3]) -> [f64; 3] {
+        match self.approach {
+            Approach::Slide => v,
+            Approach::Direct => [self.side.to_part(v[1]), -v[0], v[2]],
+        }
+    }
 }
 
 /// One row of `blind_spots.csv`.
@@ -152,7 +180,11 @@ impl Run {
             ),
         })?;
         let frame = run_frame(&summary, &summary_path)?;
-        let composite = read_composite(&dir.join("composite.csv"), spec, &frame)?;
+        let axes = GridAxes {
+            approach: summary.approach,
+            side: summary.side,
+        };
+        let composite = read_composite(&dir.join("composite.csv"), spec, &frame, axes)?;
         let (part_path, mut part) = find_parts(dir, part, &summary)?;
         // With a frame, the part is drawn where the analysis put it: in
         // vehicle coordinates (the side's mirror aside, as ever).
@@ -176,6 +208,7 @@ impl Run {
             part_path,
             part,
             frame,
+            axes,
             blind_spots,
         })
     }
@@ -192,7 +225,7 @@ impl Run {
         while let Some(row) = rows.next_row()? {
             let angle: f64 = rows.parse(&row, 0)?;
             if let Some(mask) = masks.get_mut(&angle.to_bits()) {
-                let (k, y) = rows.node(&row, self.spec, &self.frame)?;
+                let (k, y) = rows.node(&row, self.spec, &self.frame, self.axes)?;
                 mask.count[k] = 1;
                 mask.y[k] = y;
             }
@@ -249,11 +282,16 @@ pub fn same_coordinate(v: f64, node: f64, pitch: f64) -> bool {
     (v - node).abs() <= ORIGIN_TOL * node.abs().max(pitch)
 }
 
-fn read_composite(path: &Path, spec: GridSpec, frame: &Frame) -> Result<NodeCounts, ReportError> {
+fn read_composite(
+    path: &Path,
+    spec: GridSpec,
+    frame: &Frame,
+    axes: GridAxes,
+) -> Result<NodeCounts, ReportError> {
     let mut counts = NodeCounts::empty(spec)?;
     let mut rows = CsvRows::open(path, &["i", "j", "x", "y", "z", "angles"])?;
     while let Some(row) = rows.next_row()? {
-        let (k, y) = rows.node(&row, spec, frame)?;
+        let (k, y) = rows.node(&row, spec, frame, axes)?;
         counts.count[k] = rows.parse(&row, 5)?;
         counts.y[k] = y;
     }
@@ -366,13 +404,16 @@ impl CsvRows {
 
     /// The node index of a row with `i`, `j`, `x`, `y`, `z` among its
     /// wanted columns (by those names), checked against the grid (a CSV of
-    /// another grid must not be painted on this one), and the node's y in
-    /// vehicle coordinates: the row's point (part frame) mapped by `frame`.
+    /// another grid must not be painted on this one), and the node's depth
+    /// on the grid: the row's point (part frame) mapped by `frame` into
+    /// vehicle coordinates, then by `axes` onto the grid (its y, for
+    /// push-and-slide).
     fn node(
         &self,
         row: &csv::StringRecord,
         spec: GridSpec,
         frame: &Frame,
+        axes: GridAxes,
     ) -> Result<(usize, f64), ReportError> {
         let col = |name: &str| {
             self.names
@@ -386,7 +427,7 @@ impl CsvRows {
         let y: f64 = self.parse(row, col("y"))?;
         let z: f64 = self.parse(row, col("z"))?;
         let part_point = [x, y, z];
-        let [x, y, z] = frame.to_vehicle(part_point);
+        let [x, y, z] = axes.grid(frame.to_vehicle(part_point));
         // Through a frame the point was mapped twice (to the part for the
         // CSV, back here): a few units in the last place of its largest
         // coordinate, in either frame, not of x or z alone.

@@ -20,7 +20,8 @@ use crate::mesh::Side;
 use crate::output::count_colour;
 
 use super::render::{Camera, Rgb, RgbImage, View, paint, rasterize};
-use super::run::{NodeCounts, Run};
+use super::run::{GridAxes, NodeCounts, Run};
+use crate::analysis::Approach;
 
 /// Width of the large views (pixels): sharp on a printed A4 page.
 pub const LARGE_WIDTH: usize = 1100;
@@ -69,6 +70,28 @@ pub fn oblique_camera(side: Side) -> Camera {
     Camera::looking(Vector3::new(0.55, side.to_part(1.0), -0.45), Vector3::z())
 }
 
+/// The face-on camera of a run: [`side_camera`] for push-and-slide; along
+/// the knee's motion (-x, z up) for the direct approach.
+pub fn run_camera(axes: GridAxes) -> Camera {
+    match axes.approach {
+        Approach::Slide => side_camera(axes.side),
+        Approach::Direct => Camera::looking(-Vector3::x(), Vector3::z()),
+    }
+}
+
+/// The oblique camera of a run: [`oblique_camera`] for push-and-slide;
+/// for the direct approach from behind the knee (+x), beside the analysed
+/// side and above, looking along its motion.
+pub fn run_oblique_camera(axes: GridAxes) -> Camera {
+    match axes.approach {
+        Approach::Slide => oblique_camera(axes.side),
+        Approach::Direct => Camera::looking(
+            Vector3::new(-1.0, 0.55 * axes.side.to_part(1.0), -0.45),
+            Vector3::z(),
+        ),
+    }
+}
+
 /// The number of colours of the composite's ramp: the angles analysed (or
 /// the largest count, if a file had more).
 pub fn ramp_len(run: &Run) -> usize {
@@ -104,7 +127,9 @@ pub fn render_views(run: &Run, masks: &[(f64, NodeCounts)]) -> Views {
         .map(|b| (b.i as i64, b.j as i64))
         .collect();
     let spec = run.spec;
+    let axes = run.axes;
     let in_blind_cell = |p: [f64; 3]| {
+        let p = axes.grid(p);
         let i = ((p[0] - spec.x(0)) / spec.pitch).floor() as i64;
         let j = ((p[2] - spec.z(0)) / spec.pitch).floor() as i64;
         blind.contains(&(i, j))
@@ -113,21 +138,23 @@ pub fn render_views(run: &Run, masks: &[(f64, NodeCounts)]) -> Views {
         if in_blind_cell(p) {
             return Some(BLIND_COLOUR);
         }
+        let p = axes.grid(p);
         composite
             .at(p[0], p[2])
             .map(|(c, _)| composite_colour(c, n))
     };
 
-    let view = View::fit(side_camera(run.summary.side), tris, LARGE_WIDTH, MARGIN);
+    let view = View::fit(run_camera(axes), tris, LARGE_WIDTH, MARGIN);
     let side = Figure {
         image: paint(&rasterize(tris, &view), by_count),
         view,
     };
 
     let y_tol = OBLIQUE_Y_TOL_PITCHES * run.spec.pitch;
-    let view = View::fit(oblique_camera(run.summary.side), tris, LARGE_WIDTH, MARGIN);
+    let view = View::fit(run_oblique_camera(axes), tris, LARGE_WIDTH, MARGIN);
     let oblique = Figure {
         image: paint(&rasterize(tris, &view), |p| {
+            let p = axes.grid(p);
             composite
                 .at(p[0], p[2])
                 .filter(|&(_, y)| (p[1] - y).abs() <= y_tol)
@@ -136,12 +163,15 @@ pub fn render_views(run: &Run, masks: &[(f64, NodeCounts)]) -> Views {
         view,
     };
 
-    let view = View::fit(side_camera(run.summary.side), tris, SMALL_WIDTH, MARGIN);
+    let view = View::fit(run_camera(axes), tris, SMALL_WIDTH, MARGIN);
     let small = rasterize(tris, &view);
     let per_angle = masks
         .iter()
         .map(|(angle, mask)| {
-            let image = paint(&small, |p| mask.at(p[0], p[2]).map(|_| ANGLE_COLOUR));
+            let image = paint(&small, |p| {
+                let p = axes.grid(p);
+                mask.at(p[0], p[2]).map(|_| ANGLE_COLOUR)
+            });
             (*angle, Figure { image, view })
         })
         .collect();

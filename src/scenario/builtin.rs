@@ -21,7 +21,7 @@ macro_rules! embedded {
 
 /// The scenario files, sorted by stem; a test checks that these are all
 /// the `.toml` files of `scenarios/`.
-const BUILTINS: [(&str, &str); 14] = embedded![
+const BUILTINS: [(&str, &str); 15] = embedded![
     "angled-features",
     "bump",
     "console",
@@ -29,6 +29,7 @@ const BUILTINS: [(&str, &str); 14] = embedded![
     "flat-wall",
     "groove",
     "growing-wave",
+    "pocket-behind-ridge",
     "ramp",
     "step",
     "switch-boss",

@@ -1,0 +1,214 @@
+//! Side by side (`kneeform report RUN --compare OTHER_RUN`): a
+//! push-and-slide run and a direct-approach run of the same part, both
+//! areas painted on the same rendered part, and what each finds that the
+//! other does not (the paper's Figure 2: the direct approach cannot reach a
+//! depression behind a protrusion).
+//!
+//! The two runs' grids lie in different frames (SPEC's x, z for the slide;
+//! the direct frame's y, z for the direct approach), so nodes are matched
+//! as points of the part: a node of one run is **found by the other** when
+//! one of the other's colliding nodes lies within [`MATCH_PITCHES`] of the
+//! coarser pitch (3-d distance, vehicle coordinates). The counts are
+//! computed from both runs' `composite.csv`.
+
+use std::collections::HashMap;
+
+use crate::analysis::Approach;
+
+use super::ReportError;
+use super::render::{Rgb, RgbImage, View, paint, rasterize};
+use super::run::{GridAxes, NodeCounts, Run};
+use super::views::{Figure, LARGE_WIDTH, OBLIQUE_Y_TOL_PITCHES, run_camera, run_oblique_camera};
+
+/// How near (in pitches of the coarser run) a node of the other run must be
+/// for a node to count as found by both: the two grids sample the surface
+/// at different nodes, up to a pitch apart along a face and half a
+/// diagonal across one; two pitches takes in both, and is far less than
+/// the knee-form (120 mm wide).
+pub const MATCH_PITCHES: f64 = 2.0;
+
+/// Colour of what only push-and-slide strikes.
+pub const SLIDE_ONLY: Rgb = [230, 97, 1];
+/// Colour of what only the direct approach touches.
+pub const DIRECT_ONLY: Rgb = [33, 102, 172];
+/// Colour of what both find.
+pub const BOTH: Rgb = [118, 42, 131];
+
+/// The comparison of the report's run with another run of the same part.
+#[derive(Debug)]
+pub struct Comparison {
+    /// The other run.
+    pub other: Run,
+    /// The part face on, as the slide sees it, and obliquely from behind
+    /// the direct approach's knee, painted with both areas.
+    pub figures: Vec<Figure>,
+    /// Composite nodes of the slide run found by no direct contact.
+    pub slide_only: usize,
+    /// Composite nodes of the direct run struck by no slide.
+    pub direct_only: usize,
+    /// The slide run's pitch (mm): `slide_only` nodes are that pitch
+    /// squared each.
+    pub slide_pitch: f64,
+    /// The direct run's pitch (mm).
+    pub direct_pitch: f64,
+    /// The match distance (mm).
+    pub match_mm: f64,
+}
+
+impl Comparison {
+    /// Compares `run` with `other`: the same part (SHA-256, scale, side,
+    /// frame), the other approach.
+    pub fn new(run: &Run, other: Run) -> Result<Comparison, ReportError> {
+        let (a, b) = (&run.summary, &other.summary);
+        let identity = |s: &crate::summary::Summary| {
+            let files: Vec<(String, bool)> = s
+                .files
+                .iter()
+                .map(|f| (f.sha256.clone(), f.ignored))
+                .collect();
+            (s.sha256.clone(), files)
+        };
+        let differs = if identity(a) != identity(b) {
+            Some("its part is not the run's (SHA-256)")
+        } else if a.scale != b.scale {
+            Some("its scale is not the run's")
+        } else if a.side != b.side {
+            Some("its side is not the run's")
+        } else if a.frame != b.frame {
+            Some("its --frame is not the run's")
+        } else if a.approach == b.approach {
+            Some("it has the run's approach: compare a slide run with a direct one")
+        } else {
+            None
+        };
+        if let Some(reason) = differs {
+            return Err(ReportError::Inconsistent {
+                path: other.dir.join("summary.json"),
+                reason: format!("cannot be compared with {}: {reason}", run.dir.display()),
+            });
+        }
+        let (slide, direct) = match a.approach {
+            Approach::Slide => (run, &other),
+            Approach::Direct => (&other, run),
+        };
+        let match_mm = MATCH_PITCHES * slide.spec.pitch.max(direct.spec.pitch);
+        let slide_points = points(slide);
+        let direct_points = points(direct);
+        let slide_only = unmatched(&slide_points, &direct_points, match_mm);
+        let direct_only = unmatched(&direct_points, &slide_points, match_mm);
+        let tris = &run.part.triangles;
+        let paint_both = |p: [f64; 3]| {
+            let s = hit(slide, p);
+            let d = hit(direct, p);
+            match (s, d) {
+                (true, true) => Some(BOTH),
+                (true, false) => Some(SLIDE_ONLY),
+                (false, true) => Some(DIRECT_ONLY),
+                (false, false) => None,
+            }
+        };
+        let figures = [run_camera(slide.axes), run_oblique_camera(direct.axes)]
+            .into_iter()
+            .map(|camera| {
+                let view = View::fit(camera, tris, LARGE_WIDTH, 8);
+                let image: RgbImage = paint(&rasterize(tris, &view), paint_both);
+                Figure { image, view }
+            })
+            .collect();
+        Ok(Comparison {
+            slide_pitch: slide.spec.pitch,
+            direct_pitch: direct.spec.pitch,
+            other,
+            figures,
+            slide_only,
+            direct_only,
+            match_mm,
+        })
+    }
+}
+
+/// Whether the surface point `p` (vehicle coordinates) is painted by
+/// `run`'s composite: within half a pitch of a colliding node across its
+/// grid, and within [`OBLIQUE_Y_TOL_PITCHES`] of the node's depth.
+fn hit(run: &Run, p: [f64; 3]) -> bool {
+    let g = run.axes.grid(p);
+    let tol = OBLIQUE_Y_TOL_PITCHES * run.spec.pitch;
+    run.composite
+        .at(g[0], g[2])
+        .is_some_and(|(_, depth)| (g[1] - depth).abs() <= tol)
+}
+
+/// The colliding nodes of `run`'s composite as points (vehicle
+/// coordinates, mm).
+fn points(run: &Run) -> Vec<[f64; 3]> {
+    let c: &NodeCounts = &run.composite;
+    let s = c.spec;
+    (0..s.len())
+        .filter(|&k| c.count[k] > 0)
+        .map(|k| vehicle(run.axes, [s.x(k % s.nx), c.y[k], s.z(k / s.nx)]))
+        .collect()
+}
+
+/// The inverse of [`GridAxes::grid`].
+fn vehicle(axes: GridAxes, [g0, g1, g2]: [f64; 3]) -> [f64; 3] {
+    match axes.approach {
+        Approach::Slide => [g0, g1, g2],
+        Approach::Direct => [-g1, axes.side.to_part(g0), g2],
+    }
+}
+
+/// How many of `these` have none of `those` within `d` (mm).
+fn unmatched(these: &[[f64; 3]], those: &[[f64; 3]], d: f64) -> usize {
+    let cell = |p: &[f64; 3]| p.map(|c| (c / d).floor() as i64);
+    let mut buckets: HashMap<[i64; 3], Vec<[f64; 3]>> = HashMap::new();
+    for p in those {
+        buckets.entry(cell(p)).or_default().push(*p);
+    }
+    these
+        .iter()
+        .filter(|p| {
+            let [ci, cj, ck] = cell(p);
+            let near = (-1..=1).any(|di| {
+                (-1..=1).any(|dj| {
+                    (-1..=1).any(|dk| {
+                        buckets.get(&[ci + di, cj + dj, ck + dk]).is_some_and(|b| {
+                            b.iter().any(|q| {
+                                let dd: f64 = (0..3).map(|n| (p[n] - q[n]).powi(2)).sum();
+                                dd <= d * d
+                            })
+                        })
+                    })
+                })
+            });
+            !near
+        })
+        .count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn points_are_matched_within_the_distance_only() {
+        let those = [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0]];
+        let these = [
+            [0.0, 1.9, 0.0],
+            [5.0, 0.0, 0.0],
+            [10.0, 0.0, -2.0],
+            [-2.1, 0.0, 0.0],
+        ];
+        assert_eq!(unmatched(&these, &those, 2.0), 2);
+    }
+
+    #[test]
+    fn grid_axes_and_vehicle_are_inverse() {
+        for side in [crate::Side::Left, crate::Side::Right] {
+            for approach in [Approach::Slide, Approach::Direct] {
+                let axes = GridAxes { approach, side };
+                let v = [1.5, -2.25, 3.0];
+                assert_eq!(vehicle(axes, axes.grid(v)), v);
+            }
+        }
+    }
+}
