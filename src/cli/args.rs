@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, ensure};
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand};
 use kneeform::strike::RateEstimate;
 use kneeform::{
     Algorithm, Approach, Frame, GridPlacement, KneeForm, PartSource, Placement, Setup, SetupError,
@@ -329,22 +329,6 @@ pub struct StudyArgs {
     pub setup: SetupArgs,
     #[command(flatten)]
     pub starts: StartArgs,
-    /// The inspection compared with the exact oracle: `slide` (SPEC's
-    /// push-and-slide) or `direct` (the knee-form comes from far in +x and
-    /// moves in -x until it first touches the part; the positions are
-    /// (y, z) of the knee-form's width centre and reference point, and
-    /// --deflection plays no part).
-    #[arg(long, value_enum, default_value_t = Approach::Slide)]
-    pub approach: Approach,
-}
-
-/// Which inspection `verify` and `converge` compare.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Approach {
-    /// SPEC's push-and-slide.
-    Slide,
-    /// The knee-form's first contact moving in -x (issue 12).
-    Direct,
 }
 
 /// `kneeform verify`.

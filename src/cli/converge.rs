@@ -5,10 +5,11 @@
 use std::process::ExitCode;
 
 use anyhow::Context;
+use kneeform::Approach;
 use kneeform::harness::{self, ConvergeOptions, DECIDED_METRICS};
 use kneeform::output;
 
-use super::args::{Approach, ConvergeArgs};
+use super::args::ConvergeArgs;
 use super::progress::Bars;
 
 /// Parses the pitch ladder, coarsest first, repeats removed; the library
@@ -35,7 +36,7 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
         tolerance: args.tolerance,
     };
     let (input, setup) = super::study_inputs(&args.study, options.validate())?;
-    if args.study.approach == Approach::Direct {
+    if setup.approach == Approach::Direct {
         return run_direct(args, &input, &setup, &options);
     }
     let study = harness::converge(&input, &setup, &options, &Bars::default())

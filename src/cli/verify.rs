@@ -4,10 +4,11 @@
 
 use std::process::ExitCode;
 
+use kneeform::Approach;
 use kneeform::harness::{self, VerifyOptions};
 use kneeform::output;
 
-use super::args::{Approach, VerifyArgs};
+use super::args::VerifyArgs;
 use super::progress::Bars;
 
 /// What would resolve a failure, in words: the pitch a first-order error
@@ -48,7 +49,7 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
         tolerance: args.tolerance,
     };
     let (input, setup) = super::study_inputs(&args.study, options.validate())?;
-    if args.study.approach == Approach::Direct {
+    if setup.approach == Approach::Direct {
         return run_direct(args, &input, &setup, &options);
     }
     let result = harness::verify(&input, &setup, &options, &Bars::default())

@@ -2,7 +2,7 @@
 //! direct`): per knee position and angle, the grid's first contact against
 //! the exact oracle's cast along -x ([`kneeform_oracle::evaluate_direct`]).
 //!
-//! **The definition** (ARCHITECTURE.md, "The direct approach"). In the
+//! **The definition** ([`crate::direct`], the engine). In the
 //! placed part's frame the knee-form comes from far in +x and moves in -x;
 //! a knee position `(y0, z0)` centres its width `W` on `y0` and puts its
 //! reference point at height `z0`. The grid side works in the direct frame
@@ -28,9 +28,12 @@
 //! `exact_only`), an oracle failure too; either fails the comparison.
 //!
 //! **Invariant:** as [`super::trace`] for the slide, this module re-runs
-//! the definition on the engine's grid (per position, which the engine's
-//! masks do not keep); the deflection threshold `sigma` plays no part in
-//! the direct approach (the knee does not slide).
+//! the definition on the engine's grid per position (the engine's masks
+//! keep no per-position contacts), with the engine's footprint; the
+//! engine's own levels ([`contact_levels`]) are checked equal to it, to
+//! the bit, at every position compared (`engine_mismatch`). The
+//! deflection threshold `sigma` plays no part in the direct approach (the
+//! knee does not slide).
 
 use std::time::Instant;
 
@@ -42,55 +45,22 @@ use super::compare::{StartSelection, choose_nodes, node_at};
 use super::converge::{Fit, fit_power_law};
 use super::verify::{check_selection, check_tolerance};
 use super::{ConvergeOptions, VerifyOptions};
-use crate::analysis::{Progress, Setup};
+use crate::analysis::{Approach, Progress, Setup};
+use crate::direct::{DirectFootprint, contact_levels, to_direct};
 use crate::grid::{GridSpec, HeightGrid};
-use crate::kneeform::{Footprint, KneeForm, NODE_TOL};
+use crate::kneeform::KneeForm;
 use crate::mesh::{Part, PartFile, Triangle};
 
 /// The metrics of the direct approach, in the order of `converge.csv`.
 pub const DIRECT_METRICS: [&str; 2] = ["level_error", "contact_distance"];
 
-/// The part in the direct frame `(x, y, z) -> (y, -x, z)` (a proper
-/// rotation: the winding and the outward side are kept).
+/// The part in the direct frame ([`to_direct`]: a proper rotation, the
+/// winding and the outward side kept), as the analysis samples it.
 pub fn to_direct_frame(triangles: &[Triangle]) -> Part {
     Part {
-        triangles: triangles
-            .iter()
-            .map(|t| t.map(|[x, y, z]| [y, -x, z]))
-            .collect(),
+        triangles: triangles.iter().map(|t| t.map(to_direct)).collect(),
         file_triangles: triangles.len(),
         degenerate: 0,
-    }
-}
-
-/// The knee-form's front laid on a grid at one angle: per footprint row
-/// `dj` the front end `a(dj p)` (mm, relative to the reference point), and
-/// the columns `-half..=half` its width covers.
-#[derive(Debug, Clone, PartialEq)]
-pub struct DirectFootprint {
-    /// The angle (degrees).
-    pub angle_deg: f64,
-    /// `(dj, a)` per row the footprint meets, bottom to top.
-    pub rows: Vec<(i64, f64)>,
-    /// Columns either side of the position covered by the width.
-    pub half: i64,
-}
-
-impl DirectFootprint {
-    /// The footprint of `knee` at `angle_deg` on a grid of pitch `pitch`.
-    pub fn new(knee: &KneeForm, angle_deg: f64, pitch: f64) -> DirectFootprint {
-        let fp = Footprint::new(knee, angle_deg);
-        let (lo, hi) = fp.z_range();
-        let first = ((lo - NODE_TOL) / pitch).ceil() as i64;
-        let last = ((hi + NODE_TOL) / pitch).floor() as i64;
-        let rows = (first..=last)
-            .filter_map(|dj| fp.row_interval(dj as f64 * pitch).map(|(a, _)| (dj, a)))
-            .collect();
-        DirectFootprint {
-            angle_deg,
-            rows,
-            half: ((knee.thickness / 2.0 + NODE_TOL) / pitch).floor() as i64,
-        }
     }
 }
 
@@ -114,14 +84,12 @@ pub fn grid_first_contact(
 ) -> Option<GridDirectContact> {
     let spec = grid.spec;
     let (nx, nz) = (spec.nx as i64, spec.nz as i64);
-    let (first, last) = (
-        (i0 as i64 - fp.half).max(0),
-        (i0 as i64 + fp.half).min(nx - 1),
-    );
+    let half = fp.half_width as i64;
+    let (first, last) = ((i0 as i64 - half).max(0), (i0 as i64 + half).min(nx - 1));
     // Every footprint node with a finite height, and its knee level there.
     let mut levels: Vec<((usize, usize), f64)> = Vec::new();
     for &(dj, a) in &fp.rows {
-        let j = j0 as i64 + dj;
+        let j = j0 as i64 + i64::from(dj);
         if !(0..nz).contains(&j) {
             continue;
         }
@@ -177,7 +145,9 @@ fn placed_nodes(grid: &HeightGrid, footprints: &[DirectFootprint]) -> Vec<bool> 
         };
         for j in 0..nz as i64 {
             for i in 0..nx as i64 {
-                if count(i - fp.half, i + fp.half, j + first.0, j + last.0) > 0 {
+                let half = fp.half_width as i64;
+                let (first, last) = (i64::from(first.0), i64::from(last.0));
+                if count(i - half, i + half, j + first, j + last) > 0 {
                     placed[(j * nx as i64 + i) as usize] = true;
                 }
             }
@@ -264,6 +234,9 @@ pub struct DirectCounts {
     pub exact_only: usize,
     /// Oracle queries that failed.
     pub oracle_failed: usize,
+    /// Positions whose level from the engine ([`contact_levels`]) is not
+    /// this module's transcription's, to the bit.
+    pub engine_mismatch: usize,
 }
 
 /// One grid's comparison with the exact casts.
@@ -281,11 +254,13 @@ pub struct DirectComparison {
 
 impl DirectComparison {
     /// Whether both metrics' max is within `tolerance` (mm) with no
-    /// one-sided position and no oracle failure.
+    /// one-sided position, no oracle failure and the engine's levels
+    /// equal to the transcription's.
     pub fn passes(&self, tolerance: f64) -> bool {
         let c = &self.counts;
         c.grid_only == 0
             && c.exact_only == 0
+            && c.engine_mismatch == 0
             && c.oracle_failed == 0
             && self.stats.iter().all(|(_, s)| s.max <= tolerance)
     }
@@ -330,8 +305,17 @@ pub fn compare_direct(
     let mut rows = Vec::with_capacity(traces.len());
     let mut counts = DirectCounts::default();
     for (fp, traces) in footprints.iter().zip(traces.chunks(positions.len().max(1))) {
+        let levels = contact_levels(grid, fp);
         for ((&node, &[y, z]), trace) in nodes.iter().zip(positions).zip(traces) {
             let grid_contact = grid_first_contact(grid, fp, node, e0);
+            // The engine's fast form must give this transcription's level
+            // to the bit (its erosion takes the same minima of the same
+            // sums): a difference is counted and fails the comparison.
+            let engine = levels[node.1 * spec.nx + node.0];
+            let mine = grid_contact.as_ref().map_or(f64::INFINITY, |g| g.level);
+            if engine.to_bits() != mine.to_bits() {
+                counts.engine_mismatch += 1;
+            }
             let mut row = DirectRow {
                 y,
                 z,
@@ -434,9 +418,14 @@ impl DirectStudy {
         selection: &StartSelection,
     ) -> Result<DirectStudy, HarnessError> {
         let part = to_direct_frame(&input.part.triangles);
+        // The direct approach's own default extent, whatever `setup` says.
+        let setup = Setup {
+            approach: Approach::Direct,
+            ..setup.clone()
+        };
         let spec = setup.grid_spec(&part)?;
         let grid = HeightGrid::sample(&part.triangles, spec);
-        let footprints = footprints(setup, spec.pitch);
+        let footprints = footprints(&setup, spec.pitch);
         let positions = match selection {
             StartSelection::At(given) => given.clone(),
             _ => {

@@ -68,10 +68,11 @@ pub enum HarnessError {
     /// The oracle refused the part or its options.
     #[error(transparent)]
     Oracle(#[from] kneeform_oracle::OracleError),
-    /// The setup asks for the direct approach, which the harness does not
-    /// compare yet: its exact side is the oracle's push-and-slide.
+    /// The setup asks for the direct approach of a call that compares
+    /// push-and-slide: the direct approach has its own
+    /// ([`verify_direct`], [`converge_direct`]); `--pitch auto` has none.
     #[error(
-        "verify, converge and --pitch auto compare push-and-slide with the exact oracle; the direct approach is not compared yet (analyze it, and set it beside a slide run with report --compare)"
+        "this compares push-and-slide with the exact oracle: the direct approach is compared by verify_direct and converge_direct (kneeform verify/converge --approach direct), and --pitch auto does not choose its pitch yet"
     )]
     DirectApproach,
     /// No start is placed on the part.
