@@ -181,6 +181,7 @@ pub fn write_direct_convergence(
             "grid_only",
             "exact_only",
             "oracle_failed",
+            "engine_mismatch",
             "pass",
         ])?;
         for r in &convergence.results {
@@ -200,6 +201,7 @@ pub fn write_direct_convergence(
                     c.grid_only.to_string(),
                     c.exact_only.to_string(),
                     c.oracle_failed.to_string(),
+                    c.engine_mismatch.to_string(),
                     pass.clone(),
                 ])?;
             }
