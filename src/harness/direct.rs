@@ -10,12 +10,12 @@
 //! +y' and the height grid `h(x', z') = min y' = -(max x)` (the existing
 //! z-buffer of the rotated part) is the first surface it meets. With
 //! `a(dz)` the footprint row's front end (the smallest x of `K_theta` at
-//! height `dz` above the reference point, [`Footprint::row_interval`]),
+//! height `dz` above the reference point, [`crate::kneeform::Footprint::row_interval`]),
 //! the knee's front at row `dz` is `y' = Y - a(dz)`, so the grid's first
 //! contact level of the position at node `(i0, j0)` is
 //! `Y* = min (h[i][j] + a(z_j - z_j0))` over the nodes with
 //! `|x'_i - x'_i0| <= W/2 + NODE_TOL` and `z_j - z_j0` in the footprint's
-//! z-range (closed, [`NODE_TOL`]), and its contacted nodes are those with
+//! z-range (closed, [`crate::kneeform::NODE_TOL`]), and its contacted nodes are those with
 //! `h + a <= Y* + e0`. A position with no finite `h` there is not placed.
 //! The exact level is `X*`, the reference point's x at first contact, and
 //! `Y* = -X*`.
