@@ -263,7 +263,8 @@ impl Setup {
         Ok(())
     }
 
-    /// The grid for `part` (analysis frame), at this setup's pitch: SPEC's
+    /// The grid for `part` (analysis frame; the direct frame for
+    /// [`Approach::Direct`]), at this setup's pitch: SPEC's
     /// default extent covers every requested angle and its mirror, so that
     /// a part mirrored in z gets the mirrored grid. Checked to have a
     /// bounded number of nodes and the analysis on it to fit the memory
@@ -446,13 +447,16 @@ pub enum Status {
 /// angle, their composite and what was found on the way.
 #[derive(Debug, Clone)]
 pub struct Analysis {
-    /// The part and its file's identity.
+    /// The part and its file's identity. For the direct approach its
+    /// triangles are in the direct frame, as its grid ([`Analysis::placement`]
+    /// maps both back).
     pub input: PartFile,
     /// The setup it ran with.
     pub setup: Setup,
     /// The height grid.
     pub grid: HeightGrid,
-    /// The footprints, laid on `grid`, in the order of `setup.angles`.
+    /// The footprints, laid on `grid`, in the order of `setup.angles`;
+    /// empty for the direct approach ([`crate::direct::DirectFootprint`]).
     pub footprints: Vec<GridFootprint>,
     /// For an assembly ([`crate::assembly`]): per grid node, the index
     /// (into the assembly's files) of the file whose surface set its
@@ -606,7 +610,11 @@ impl Analysis {
                 (grid, Some(files))
             }
         };
-        let footprints = setup.footprints(&spec);
+        // The slide's footprints; the direct approach lays its own fronts.
+        let footprints = match setup.approach {
+            Approach::Slide => setup.footprints(&spec),
+            Approach::Direct => Vec::new(),
+        };
         let sample_s = t.elapsed().as_secs_f64();
 
         let t = Instant::now();

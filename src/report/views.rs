@@ -16,12 +16,12 @@
 
 use nalgebra::Vector3;
 
-use crate::mesh::Side;
+use crate::analysis::Approach;
+use crate::mesh::{Side, Triangle};
 use crate::output::count_colour;
 
 use super::render::{Camera, Rgb, RgbImage, View, paint, rasterize};
 use super::run::{GridAxes, NodeCounts, Run};
-use crate::analysis::Approach;
 
 /// Width of the large views (pixels): sharp on a printed A4 page.
 pub const LARGE_WIDTH: usize = 1100;
@@ -92,6 +92,23 @@ pub fn run_oblique_camera(axes: GridAxes) -> Camera {
     }
 }
 
+/// [`View::fit`] at `width` pixels; for the direct approach, narrower
+/// when that would make the picture more than [`MAX_ASPECT`] times as tall
+/// as wide (seen along -x, a console side is a thin strip, and a picture
+/// 1100 pixels wide would be ten thousand tall).
+fn fit(axes: GridAxes, camera: Camera, tris: &[Triangle], width: usize) -> View {
+    let view = View::fit(camera, tris, width, MARGIN);
+    let tall = MAX_ASPECT * width as f64;
+    if axes.approach == Approach::Direct && view.height as f64 > tall {
+        let narrower = (width as f64 * tall / view.height as f64).floor() as usize;
+        return View::fit(camera, tris, narrower.max(4 * MARGIN), MARGIN);
+    }
+    view
+}
+
+/// The tallest a direct run's picture is, in widths.
+const MAX_ASPECT: f64 = 1.5;
+
 /// The number of colours of the composite's ramp: the angles analysed (or
 /// the largest count, if a file had more).
 pub fn ramp_len(run: &Run) -> usize {
@@ -144,14 +161,14 @@ pub fn render_views(run: &Run, masks: &[(f64, NodeCounts)]) -> Views {
             .map(|(c, _)| composite_colour(c, n))
     };
 
-    let view = View::fit(run_camera(axes), tris, LARGE_WIDTH, MARGIN);
+    let view = fit(axes, run_camera(axes), tris, LARGE_WIDTH);
     let side = Figure {
         image: paint(&rasterize(tris, &view), by_count),
         view,
     };
 
     let y_tol = OBLIQUE_Y_TOL_PITCHES * run.spec.pitch;
-    let view = View::fit(run_oblique_camera(axes), tris, LARGE_WIDTH, MARGIN);
+    let view = fit(axes, run_oblique_camera(axes), tris, LARGE_WIDTH);
     let oblique = Figure {
         image: paint(&rasterize(tris, &view), |p| {
             let p = axes.grid(p);
@@ -163,7 +180,7 @@ pub fn render_views(run: &Run, masks: &[(f64, NodeCounts)]) -> Views {
         view,
     };
 
-    let view = View::fit(run_camera(axes), tris, SMALL_WIDTH, MARGIN);
+    let view = fit(axes, run_camera(axes), tris, SMALL_WIDTH);
     let small = rasterize(tris, &view);
     let per_angle = masks
         .iter()
