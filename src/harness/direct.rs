@@ -765,3 +765,63 @@ pub fn converge_direct(
     };
     Ok(DirectConvergence { results, summary })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn placed_nodes_are_the_positions_with_a_first_contact() {
+        // A grid with a finite height at one node in 800 (a footprint
+        // covers about 600 at 8 mm), so that about half the positions see
+        // none under their footprint and many only at its edges;
+        // splitmix64 from a fixed seed.
+        let spec = GridSpec::explicit(-400.0, -480.0, 150, 120, 8.0);
+        let mut state = 7u64;
+        let mut next = || {
+            state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            z ^ (z >> 31)
+        };
+        let h = (0..spec.len())
+            .map(|_| {
+                let r = next();
+                if r % 800 == 0 {
+                    (r % 1000) as f64 / 100.0
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .collect();
+        let grid = HeightGrid { spec, h };
+        let knee = KneeForm::default();
+        let fronts: Vec<DirectFootprint> = [-30.0, 0.0, 30.0]
+            .iter()
+            .map(|&a| DirectFootprint::new(&knee, a, spec.pitch))
+            .collect();
+        let placed = placed_nodes(&grid, &fronts);
+        let (mut some, mut none) = (0, 0);
+        for j in 0..spec.nz {
+            for i in 0..spec.nx {
+                let want = fronts
+                    .iter()
+                    .any(|fp| grid_first_contact(&grid, fp, (i, j), 1e-6).is_some());
+                assert_eq!(placed[j * spec.nx + i], want, "node ({i}, {j})");
+                if want { some += 1 } else { none += 1 }
+            }
+        }
+        assert!(some > 100 && none > 100, "{some} placed, {none} not");
+    }
+
+    #[test]
+    fn stats_give_the_nearest_rank_median_and_p95() {
+        let s = DirectStats::of(&[3.0, -1.0, 2.0, 4.0]);
+        assert_eq!(
+            (s.max, s.p95, s.median, s.mean, s.n),
+            (4.0, 4.0, 2.0, 2.5, 4)
+        );
+        assert_eq!(DirectStats::of(&[]), DirectStats::default());
+    }
+}
