@@ -115,13 +115,14 @@ fn run_direct(
             .map(|(m, s)| format!("{m} max {:.4} median {:.4}", s.max, s.median))
             .collect();
         eprintln!(
-            "p = {:>6} mm: {} | {} both, {} grid only, {} exact only, {} failed",
+            "p = {:>6} mm: {} | {} both, {} grid only, {} exact only, {} failed, {} engine mismatches",
             r.pitch,
             stats.join(", "),
             c.counts.both,
             c.counts.grid_only,
             c.counts.exact_only,
-            c.counts.oracle_failed
+            c.counts.oracle_failed,
+            c.counts.engine_mismatch
         );
     }
     for (m, f) in &study.summary.fits {

@@ -145,8 +145,14 @@ fn run_direct(
     }
     let c = &s.counts;
     eprintln!(
-        "{:>16}: {} position-angle pairs, {} touched on both sides, {} on the grid only, {} exactly only, {} oracle failures",
-        "positions", c.compared, c.both, c.grid_only, c.exact_only, c.oracle_failed
+        "{:>16}: {} position-angle pairs, {} touched on both sides, {} on the grid only, {} exactly only, {} oracle failures, {} engine levels unlike the harness's",
+        "positions",
+        c.compared,
+        c.both,
+        c.grid_only,
+        c.exact_only,
+        c.oracle_failed,
+        c.engine_mismatch
     );
     let verdict = if s.pass { "PASS" } else { "FAIL" };
     eprintln!(
