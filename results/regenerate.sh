@@ -6,6 +6,7 @@
 #     bash results/regenerate.sh            # everything (about 10-20 minutes)
 #     bash results/regenerate.sh converge   # the convergence studies only
 #     bash results/regenerate.sh bench      # the benchmark only
+#     bash results/regenerate.sh converge-direct  # the direct approach's studies only
 #     bash results/regenerate.sh ab REV     # results/ab.md: this tree against
 #                                           # the commit REV, end to end, in one run
 #
@@ -29,6 +30,18 @@ if [[ "$what" == all || "$what" == converge ]]; then
     echo "== $name"
     "$bin" converge "$file" --pitches "$pitches" --angles=-30,0,30 --starts 60 --seed 1 \
       --tolerance 1 --out "results/converge/$name"
+  done
+fi
+
+if [[ "$what" == all || "$what" == converge || "$what" == converge-direct ]]; then
+  # The direct approach (issue 12) against its exact oracle on the smooth
+  # parts, turned by --frame -y,x,z so that their surface faces +x, towards
+  # the knee-form coming from +x. Same pitches, angles, starts and seed.
+  for name in tilted-wave wave ramp; do
+    echo "== $name (direct)"
+    "$bin" converge "scenarios/$name.toml" --frame=-y,x,z --approach direct \
+      --pitches 4,2,1,0.5 --angles=-30,0,30 --starts 60 --seed 1 \
+      --tolerance 1 --out "results/converge-direct/$name"
   done
 fi
 

@@ -64,6 +64,7 @@
 //! **Invariant:** the oracle does not depend on the `kneeform` engine.
 
 mod batch;
+mod direct;
 mod error;
 mod knee_form;
 mod part;
@@ -73,6 +74,9 @@ mod sweep;
 mod trace;
 
 pub use batch::evaluate;
+pub use direct::{
+    DirectContact, DirectOptions, DirectStatus, DirectTrace, direct_contact, evaluate_direct,
+};
 pub use error::OracleError;
 pub use knee_form::{KneeForm, KneeFormDims};
 pub use part::{Part, Side};

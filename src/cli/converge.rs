@@ -5,6 +5,7 @@
 use std::process::ExitCode;
 
 use anyhow::Context;
+use kneeform::Approach;
 use kneeform::harness::{self, ConvergeOptions, DECIDED_METRICS};
 use kneeform::output;
 
@@ -35,6 +36,9 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
         tolerance: args.tolerance,
     };
     let (input, setup) = super::study_inputs(&args.study, options.validate())?;
+    if setup.approach == Approach::Direct {
+        return run_direct(args, &input, &setup, &options);
+    }
     let study = harness::converge(&input, &setup, &options, &Bars::default())
         .map_err(super::harness_error)?;
     eprintln!(
@@ -79,6 +83,53 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
             r.pitch,
             study.summary.predicted_full_time_s.unwrap_or(f64::NAN)
         ),
+        (Some(t), None) => eprintln!("kneeform: no pitch tried is within {t} mm"),
+        _ => {}
+    }
+    eprintln!("kneeform: results in {}", args.out.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `converge --approach direct`: the grid's first contacts against the
+/// exact casts along -x at every pitch, and the fitted order.
+fn run_direct(
+    args: &ConvergeArgs,
+    input: &kneeform::PartFile,
+    setup: &kneeform::Setup,
+    options: &ConvergeOptions,
+) -> anyhow::Result<ExitCode> {
+    let study = harness::converge_direct(input, setup, options, &Bars::default())
+        .map_err(super::harness_error)?;
+    eprintln!(
+        "exact oracle (direct): {} positions x {} angles in {:.1} s",
+        study.summary.starts,
+        setup.angles.len(),
+        study.summary.oracle_s
+    );
+    output::write_direct_convergence(&args.out, &study)?;
+    for r in &study.results {
+        let c = &r.comparison;
+        let stats: Vec<String> = c
+            .stats
+            .iter()
+            .map(|(m, s)| format!("{m} max {:.4} median {:.4}", s.max, s.median))
+            .collect();
+        eprintln!(
+            "p = {:>6} mm: {} | {} both, {} grid only, {} exact only, {} failed, {} engine mismatches",
+            r.pitch,
+            stats.join(", "),
+            c.counts.both,
+            c.counts.grid_only,
+            c.counts.exact_only,
+            c.counts.oracle_failed,
+            c.counts.engine_mismatch
+        );
+    }
+    for (m, f) in &study.summary.fits {
+        eprintln!("{m:>16}: max error ~ {:.3} p^{:.2}", f.c, f.alpha);
+    }
+    match (args.tolerance, study.summary.recommended_pitch_mm) {
+        (Some(t), Some(p)) => eprintln!("kneeform: the coarsest pitch within {t} mm is {p} mm"),
         (Some(t), None) => eprintln!("kneeform: no pitch tried is within {t} mm"),
         _ => {}
     }

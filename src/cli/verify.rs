@@ -4,6 +4,7 @@
 
 use std::process::ExitCode;
 
+use kneeform::Approach;
 use kneeform::harness::{self, VerifyOptions};
 use kneeform::output;
 
@@ -48,6 +49,9 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
         tolerance: args.tolerance,
     };
     let (input, setup) = super::study_inputs(&args.study, options.validate())?;
+    if setup.approach == Approach::Direct {
+        return run_direct(args, &input, &setup, &options);
+    }
     let result = harness::verify(&input, &setup, &options, &Bars::default())
         .map_err(super::harness_error)?;
     output::write_verification(&args.out, &result)?;
@@ -118,4 +122,47 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
         );
         Ok(ExitCode::from(1))
     }
+}
+
+/// `verify --approach direct`: the grid's first contacts against the exact
+/// casts along -x.
+fn run_direct(
+    args: &VerifyArgs,
+    input: &kneeform::PartFile,
+    setup: &kneeform::Setup,
+    options: &VerifyOptions,
+) -> anyhow::Result<ExitCode> {
+    let result = harness::verify_direct(input, setup, options, &Bars::default())
+        .map_err(super::harness_error)?;
+    output::write_direct_verification(&args.out, &result)?;
+    let s = &result.summary;
+    for name in harness::DIRECT_METRICS {
+        let stats = &s.metrics[name];
+        eprintln!(
+            "{name:>16}: max {:.4}  p95 {:.4}  median {:.4} mm  (n = {})",
+            stats.max, stats.p95, stats.median, stats.n
+        );
+    }
+    let c = &s.counts;
+    eprintln!(
+        "{:>16}: {} position-angle pairs, {} touched on both sides, {} on the grid only, {} exactly only, {} oracle failures, {} engine levels unlike the harness's",
+        "positions",
+        c.compared,
+        c.both,
+        c.grid_only,
+        c.exact_only,
+        c.oracle_failed,
+        c.engine_mismatch
+    );
+    let verdict = if s.pass { "PASS" } else { "FAIL" };
+    eprintln!(
+        "kneeform: {verdict} (direct approach) at tolerance {} mm; results in {}",
+        s.tolerance_mm,
+        args.out.display()
+    );
+    Ok(if s.pass {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
 }

@@ -90,9 +90,23 @@ pub fn select_starts(
             *p |= y.is_finite();
         }
     }
-    let mut nodes: Vec<(usize, usize)> = (0..spec.len())
+    let nodes: Vec<(usize, usize)> = (0..spec.len())
         .filter(|&n| placed[n])
         .map(|n| (n % nx, n / nx))
+        .collect();
+    choose_nodes(&spec, nodes, selection)
+}
+
+/// The nodes of `selection` among `nodes` (row-major): all of them, those
+/// of a strip, or a seeded sample, back in row-major order. The slide's
+/// starts and the direct approach's positions are chosen alike.
+pub(super) fn choose_nodes(
+    spec: &crate::grid::GridSpec,
+    nodes: Vec<(usize, usize)>,
+    selection: &StartSelection,
+) -> Vec<(usize, usize)> {
+    let mut nodes: Vec<(usize, usize)> = nodes
+        .into_iter()
         .filter(|&(_, j)| match selection {
             StartSelection::Strip { z } => (z[0]..=z[1]).contains(&spec.z(j)),
             _ => true,
@@ -121,7 +135,7 @@ fn nearest_node(spec: &crate::grid::GridSpec, x: f64, z: f64) -> Option<(usize, 
 }
 
 /// The node at `(x, z)` (mm), within rounding (1e-6 mm).
-fn node_at(spec: &crate::grid::GridSpec, x: f64, z: f64) -> Option<(usize, usize)> {
+pub(super) fn node_at(spec: &crate::grid::GridSpec, x: f64, z: f64) -> Option<(usize, usize)> {
     let (i, j) = nearest_node(spec, x, z)?;
     ((spec.x(i) - x).abs() < 1e-6 && (spec.z(j) - z).abs() < 1e-6).then_some((i, j))
 }

@@ -25,6 +25,7 @@
 pub mod auto;
 pub mod compare;
 pub mod converge;
+pub mod direct;
 pub mod metrics;
 pub mod nearest;
 pub mod trace;
@@ -39,6 +40,10 @@ pub use compare::{
     exact_traces, select_starts,
 };
 pub use converge::{ConvergeOptions, ConvergeSummary, Convergence, PitchResult, converge};
+pub use direct::{
+    DIRECT_METRICS, DirectComparison, DirectConvergence, DirectRow, DirectStats,
+    DirectVerification, converge_direct, verify_direct,
+};
 pub use metrics::{DECIDED_METRICS, METRICS, Stats, TieBand};
 pub use trace::{GridContact, GridTrace};
 pub use verify::{
@@ -63,10 +68,11 @@ pub enum HarnessError {
     /// The oracle refused the part or its options.
     #[error(transparent)]
     Oracle(#[from] kneeform_oracle::OracleError),
-    /// The setup asks for the direct approach, which the harness does not
-    /// compare yet: its exact side is the oracle's push-and-slide.
+    /// The setup asks for the direct approach of a call that compares
+    /// push-and-slide: the direct approach has its own
+    /// ([`verify_direct`], [`converge_direct`]); `--pitch auto` has none.
     #[error(
-        "verify, converge and --pitch auto compare push-and-slide with the exact oracle; the direct approach is not compared yet (analyze it, and set it beside a slide run with report --compare)"
+        "this compares push-and-slide with the exact oracle: the direct approach is compared by verify_direct and converge_direct (kneeform verify/converge --approach direct), and --pitch auto does not choose its pitch yet"
     )]
     DirectApproach,
     /// No start is placed on the part.

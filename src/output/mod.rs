@@ -38,7 +38,10 @@ pub use self::png::{
     BLIND_COLOUR, CROP_MARGIN, NO_PART, PngError, RING_BELOW, RING_COLOUR, Window, composite_key,
     crop_window, depth_bar_ends, view_line, write_composite_png, write_depth_png,
 };
-pub use self::results::{write_analysis, write_convergence, write_verification};
+pub use self::results::{
+    write_analysis, write_convergence, write_direct_convergence, write_direct_verification,
+    write_verification,
+};
 pub(crate) use self::stl::to_stl_triangle;
 pub use self::stl::write_colliding_area;
 

@@ -1,6 +1,8 @@
 //! Each command's result files, from the library's results: an analysis
 //! ([`write_analysis`]), a verification ([`write_verification`]), a
-//! convergence study ([`write_convergence`]).
+//! convergence study ([`write_convergence`]), and the same two for the
+//! direct approach ([`write_direct_verification`],
+//! [`write_direct_convergence`]).
 
 use std::io::{BufWriter, Write};
 use std::path::Path;
@@ -8,7 +10,7 @@ use std::time::Instant;
 
 use super::{OutputDir, WriteError};
 use crate::analysis::Analysis;
-use crate::harness::{Convergence, Verification};
+use crate::harness::{Convergence, DirectConvergence, DirectVerification, Verification};
 use crate::summary::Summary;
 
 /// Writes the files of an analysis into the staged directory `out`: the
@@ -133,6 +135,88 @@ pub fn write_convergence(dir: &Path, convergence: &Convergence) -> Result<(), Wr
     }
     write_json(&out.path("converge.json"), &convergence.summary)?;
     super::write_plots(out.path(".").as_path(), results, &convergence.fits)?;
+    commit(out, dir)
+}
+
+/// Writes a direct verification into `dir`: `verify.csv` (one row per
+/// position and angle) and `verify.json` (`"approach": "direct"`).
+pub fn write_direct_verification(
+    dir: &Path,
+    verification: &DirectVerification,
+) -> Result<(), WriteError> {
+    let out = OutputDir::stage(dir).map_err(|source| WriteError::Commit {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    write_rows(&out.path("verify.csv"), &verification.comparison.rows)?;
+    write_json(&out.path("verify.json"), &verification.summary)?;
+    commit(out, dir)
+}
+
+/// Writes a direct convergence study into `dir`: `converge.csv` (both
+/// metrics at every pitch), `verify_<pitch>mm.csv` (each pitch's rows) and
+/// `converge.json` (`"approach": "direct"`).
+pub fn write_direct_convergence(
+    dir: &Path,
+    convergence: &DirectConvergence,
+) -> Result<(), WriteError> {
+    let out = OutputDir::stage(dir).map_err(|source| WriteError::Commit {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let tolerance = convergence.summary.tolerance_mm;
+    let path = out.path("converge.csv");
+    (|| -> csv::Result<()> {
+        let mut csv = csv::Writer::from_path(&path)?;
+        csv.write_record([
+            "approach",
+            "pitch_mm",
+            "metric",
+            "max",
+            "p95",
+            "median",
+            "mean",
+            "n",
+            "both",
+            "grid_only",
+            "exact_only",
+            "oracle_failed",
+            "engine_mismatch",
+            "pass",
+        ])?;
+        for r in &convergence.results {
+            let c = &r.comparison.counts;
+            let pass = tolerance.map_or(String::new(), |t| r.comparison.passes(t).to_string());
+            for (metric, s) in &r.comparison.stats {
+                csv.write_record([
+                    "direct".to_string(),
+                    r.pitch.to_string(),
+                    metric.clone(),
+                    s.max.to_string(),
+                    s.p95.to_string(),
+                    s.median.to_string(),
+                    s.mean.to_string(),
+                    s.n.to_string(),
+                    c.both.to_string(),
+                    c.grid_only.to_string(),
+                    c.exact_only.to_string(),
+                    c.oracle_failed.to_string(),
+                    c.engine_mismatch.to_string(),
+                    pass.clone(),
+                ])?;
+            }
+        }
+        csv.flush()?;
+        Ok(())
+    })()
+    .map_err(WriteError::at(&path))?;
+    for r in &convergence.results {
+        write_rows(
+            &out.path(format!("verify_{}mm.csv", r.pitch)),
+            &r.comparison.rows,
+        )?;
+    }
+    write_json(&out.path("converge.json"), &convergence.summary)?;
     commit(out, dir)
 }
 

@@ -1,0 +1,827 @@
+//! `verify` and `converge` for the **direct approach** (`--approach
+//! direct`): per knee position and angle, the grid's first contact against
+//! the exact oracle's cast along -x ([`kneeform_oracle::evaluate_direct`]).
+//!
+//! **The definition** ([`crate::direct`], the engine). In the
+//! placed part's frame the knee-form comes from far in +x and moves in -x;
+//! a knee position `(y0, z0)` centres its width `W` on `y0` and puts its
+//! reference point at height `z0`. The grid side works in the direct frame
+//! `D: (x, y, z) -> (x', y', z') = (y, -x, z)`, where the knee moves in
+//! +y' and the height grid `h(x', z') = min y' = -(max x)` (the existing
+//! z-buffer of the rotated part) is the first surface it meets. With
+//! `a(dz)` the footprint row's front end (the smallest x of `K_theta` at
+//! height `dz` above the reference point, [`crate::kneeform::Footprint::row_interval`]),
+//! the knee's front at row `dz` is `y' = Y - a(dz)`, so the grid's first
+//! contact level of the position at node `(i0, j0)` is
+//! `Y* = min (h[i][j] + a(z_j - z_j0))` over the nodes with
+//! `|x'_i - x'_i0| <= W/2 + NODE_TOL` and `z_j - z_j0` in the footprint's
+//! z-range (closed, [`crate::kneeform::NODE_TOL`]), and its contacted nodes are those with
+//! `h + a <= Y* + e0`. A position with no finite `h` there is not placed.
+//! The exact level is `X*`, the reference point's x at first contact, and
+//! `Y* = -X*`.
+//!
+//! **Metrics**, per position and angle where both touch:
+//! `level_error = |Y*_grid - Y*_exact|` (mm), and `contact_distance`, from
+//! the exact contact (the cast's witness) to the nearest grid-contacted
+//! node of that position, in the y-z plane (the position plane, mm). A
+//! position placed on one side only is counted (`grid_only`,
+//! `exact_only`), an oracle failure too; either fails the comparison.
+//!
+//! **Invariant:** as [`super::trace`] for the slide, this module re-runs
+//! the definition on the engine's grid per position (the engine's masks
+//! keep no per-position contacts), with the engine's footprint; the
+//! engine's own levels ([`contact_levels`]) are checked equal to it, to
+//! the bit, at every position compared (`engine_mismatch`). The
+//! deflection threshold `sigma` plays no part in the direct approach (the
+//! knee does not slide).
+
+use std::time::Instant;
+
+use kneeform_oracle::{DirectOptions, DirectStatus, DirectTrace, KneeFormDims};
+use serde::{Deserialize, Serialize};
+
+use super::HarnessError;
+use super::compare::{StartSelection, choose_nodes, node_at};
+use super::converge::{Fit, fit_power_law};
+use super::verify::{check_selection, check_tolerance};
+use super::{ConvergeOptions, VerifyOptions};
+use crate::analysis::{Approach, Progress, Setup};
+use crate::direct::{DirectFootprint, contact_levels, to_direct};
+use crate::grid::{GridSpec, HeightGrid};
+use crate::kneeform::KneeForm;
+use crate::mesh::{Part, PartFile, Triangle};
+
+/// The metrics of the direct approach, in the order of `converge.csv`.
+pub const DIRECT_METRICS: [&str; 2] = ["level_error", "contact_distance"];
+
+/// The part in the direct frame ([`to_direct`]: a proper rotation, the
+/// winding and the outward side kept), as the analysis samples it.
+pub fn to_direct_frame(triangles: &[Triangle]) -> Part {
+    Part {
+        triangles: triangles.iter().map(|t| t.map(to_direct)).collect(),
+        file_triangles: triangles.len(),
+        degenerate: 0,
+    }
+}
+
+/// The grid's first contact of one position (direct frame).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GridDirectContact {
+    /// `Y*` (mm): the level of the knee-form's reference point along y'.
+    pub level: f64,
+    /// The contacted nodes `(i, j)`: `h + a <= Y* + e0`.
+    pub contacted: Vec<(usize, usize)>,
+}
+
+/// The grid's first contact of the position at node `(i0, j0)` of `grid`
+/// (direct frame), or `None` when no node of the footprint has a finite
+/// height. `e0` (mm) is SPEC's rounding tolerance, which makes ties.
+pub fn grid_first_contact(
+    grid: &HeightGrid,
+    fp: &DirectFootprint,
+    (i0, j0): (usize, usize),
+    e0: f64,
+) -> Option<GridDirectContact> {
+    let spec = grid.spec;
+    let (nx, nz) = (spec.nx as i64, spec.nz as i64);
+    let half = fp.half_width as i64;
+    let (first, last) = ((i0 as i64 - half).max(0), (i0 as i64 + half).min(nx - 1));
+    // Every footprint node with a finite height, and its knee level there.
+    let mut levels: Vec<((usize, usize), f64)> = Vec::new();
+    for &(dj, a) in &fp.rows {
+        let j = j0 as i64 + i64::from(dj);
+        if !(0..nz).contains(&j) {
+            continue;
+        }
+        for i in first..=last {
+            let h = grid.at(i as usize, j as usize);
+            if h.is_finite() {
+                levels.push(((i as usize, j as usize), h + a));
+            }
+        }
+    }
+    let level = levels.iter().map(|l| l.1).fold(f64::INFINITY, f64::min);
+    if !level.is_finite() {
+        return None;
+    }
+    let contacted = levels
+        .iter()
+        .filter(|l| l.1 <= level + e0)
+        .map(|l| l.0)
+        .collect();
+    Some(GridDirectContact { level, contacted })
+}
+
+/// The nodes of `grid` at which the knee-form is placed at one angle of
+/// `footprints` at least (a finite height under its footprint).
+fn placed_nodes(grid: &HeightGrid, footprints: &[DirectFootprint]) -> Vec<bool> {
+    let spec = grid.spec;
+    let (nx, nz) = (spec.nx, spec.nz);
+    // Counts of finite heights over [0, i) x [0, j), so that each
+    // footprint's rectangle of nodes is counted in four look-ups.
+    let mut sum = vec![0u32; (nx + 1) * (nz + 1)];
+    for j in 0..nz {
+        for i in 0..nx {
+            let finite = u32::from(grid.at(i, j).is_finite());
+            sum[(j + 1) * (nx + 1) + i + 1] =
+                finite + sum[j * (nx + 1) + i + 1] + sum[(j + 1) * (nx + 1) + i]
+                    - sum[j * (nx + 1) + i];
+        }
+    }
+    let count = |i0: i64, i1: i64, j0: i64, j1: i64| -> u32 {
+        // Nodes in [i0, i1] x [j0, j1], clipped to the grid.
+        let (i0, i1) = (i0.max(0), i1.min(nx as i64 - 1));
+        let (j0, j1) = (j0.max(0), j1.min(nz as i64 - 1));
+        if i0 > i1 || j0 > j1 {
+            return 0;
+        }
+        let at = |i: i64, j: i64| sum[j as usize * (nx + 1) + i as usize];
+        at(i1 + 1, j1 + 1) + at(i0, j0) - at(i0, j1 + 1) - at(i1 + 1, j0)
+    };
+    let mut placed = vec![false; spec.len()];
+    for fp in footprints {
+        let (Some(first), Some(last)) = (fp.rows.first(), fp.rows.last()) else {
+            continue;
+        };
+        for j in 0..nz as i64 {
+            for i in 0..nx as i64 {
+                let half = fp.half_width as i64;
+                let (first, last) = (i64::from(first.0), i64::from(last.0));
+                if count(i - half, i + half, j + first, j + last) > 0 {
+                    placed[(j * nx as i64 + i) as usize] = true;
+                }
+            }
+        }
+    }
+    placed
+}
+
+/// Max, 95th percentile, median and mean of absolute values, and their
+/// count (all zero when empty).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct DirectStats {
+    /// Largest value (mm).
+    pub max: f64,
+    /// 95th percentile, nearest rank (mm).
+    pub p95: f64,
+    /// Median, nearest rank (mm).
+    pub median: f64,
+    /// Mean (mm).
+    pub mean: f64,
+    /// Number of values.
+    pub n: usize,
+}
+
+impl DirectStats {
+    /// Statistics of the absolute values of `values`.
+    pub fn of(values: &[f64]) -> DirectStats {
+        if values.is_empty() {
+            return DirectStats::default();
+        }
+        let mut v: Vec<f64> = values.iter().map(|x| x.abs()).collect();
+        v.sort_by(f64::total_cmp);
+        let rank = |q: f64| v[((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
+        DirectStats {
+            max: v[v.len() - 1],
+            p95: rank(0.95),
+            median: rank(0.5),
+            mean: v.iter().sum::<f64>() / v.len() as f64,
+            n: v.len(),
+        }
+    }
+}
+
+/// One position at one angle: both sides' first contacts and the errors.
+/// Positions and points in mm, in the placed part's frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DirectRow {
+    /// The position's y (the centre of the knee-form's width).
+    pub y: f64,
+    /// The position's z (the reference point's height).
+    pub z: f64,
+    /// Angle (degrees).
+    pub angle_deg: f64,
+    /// `both`, `grid_only`, `exact_only`, `neither` or `oracle_failed`.
+    pub status: String,
+    /// The grid's `X* = -Y*` (the reference point's x at first contact).
+    pub grid_level: Option<f64>,
+    /// The exact `X*`.
+    pub exact_level: Option<f64>,
+    /// `|Y*_grid - Y*_exact|`.
+    pub level_error: Option<f64>,
+    /// The exact contact point's y and z.
+    pub exact_y: Option<f64>,
+    /// See `exact_y`.
+    pub exact_z: Option<f64>,
+    /// From the exact contact to the nearest grid-contacted node, in y-z.
+    pub contact_distance: Option<f64>,
+    /// Grid-contacted nodes (ties within `e0`).
+    pub grid_contacted: usize,
+    /// Exact contact points (ties within `e0` of travel).
+    pub exact_ties: usize,
+}
+
+/// Counts of a direct comparison.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct DirectCounts {
+    /// Position-angle pairs compared.
+    pub compared: usize,
+    /// Touched on both sides.
+    pub both: usize,
+    /// Placed on the grid, passed by the exact knee-form.
+    pub grid_only: usize,
+    /// Touched by the exact knee-form, no finite height on the grid.
+    pub exact_only: usize,
+    /// Oracle queries that failed.
+    pub oracle_failed: usize,
+    /// Positions whose level from the engine ([`contact_levels`]) is not
+    /// this module's transcription's, to the bit.
+    pub engine_mismatch: usize,
+}
+
+/// One grid's comparison with the exact casts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DirectComparison {
+    /// Per position and angle, angle-major.
+    pub rows: Vec<DirectRow>,
+    /// Per [`DIRECT_METRICS`] name, its statistics.
+    pub stats: Vec<(String, DirectStats)>,
+    /// Counts.
+    pub counts: DirectCounts,
+    /// Seconds for the grid's first contacts.
+    pub grid_s: f64,
+}
+
+impl DirectComparison {
+    /// Whether both metrics' max is within `tolerance` (mm) with no
+    /// one-sided position, no oracle failure and the engine's levels
+    /// equal to the transcription's.
+    pub fn passes(&self, tolerance: f64) -> bool {
+        let c = &self.counts;
+        c.grid_only == 0
+            && c.exact_only == 0
+            && c.engine_mismatch == 0
+            && c.oracle_failed == 0
+            && self.stats.iter().all(|(_, s)| s.max <= tolerance)
+    }
+
+    /// The statistics of metric `name`.
+    pub fn stat(&self, name: &str) -> DirectStats {
+        self.stats
+            .iter()
+            .find(|(m, _)| m == name)
+            .map_or_else(DirectStats::default, |(_, s)| *s)
+    }
+}
+
+/// Compares the grid's first contacts at `positions` (mm; `(y0, z0)`,
+/// nodes of `grid`, which is in the direct frame) with `traces`
+/// (angle-major, one per position and angle of `footprints`).
+pub fn compare_direct(
+    grid: &HeightGrid,
+    footprints: &[DirectFootprint],
+    positions: &[[f64; 2]],
+    traces: &[DirectTrace],
+    e0: f64,
+) -> Result<DirectComparison, HarnessError> {
+    let spec = grid.spec;
+    if traces.len() != positions.len() * footprints.len() {
+        return Err(HarnessError::TraceCount {
+            traces: traces.len(),
+            expected: positions.len() * footprints.len(),
+        });
+    }
+    let nodes = positions
+        .iter()
+        .map(|&[y, z]| {
+            node_at(&spec, y, z).ok_or(HarnessError::StartNotANode {
+                x: y,
+                z,
+                pitch: spec.pitch,
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let t = Instant::now();
+    let mut rows = Vec::with_capacity(traces.len());
+    let mut counts = DirectCounts::default();
+    for (fp, traces) in footprints.iter().zip(traces.chunks(positions.len().max(1))) {
+        let levels = contact_levels(grid, fp);
+        for ((&node, &[y, z]), trace) in nodes.iter().zip(positions).zip(traces) {
+            let grid_contact = grid_first_contact(grid, fp, node, e0);
+            // The engine's fast form must give this transcription's level
+            // to the bit (its erosion takes the same minima of the same
+            // sums): a difference is counted and fails the comparison.
+            let engine = levels[node.1 * spec.nx + node.0];
+            let mine = grid_contact.as_ref().map_or(f64::INFINITY, |g| g.level);
+            if engine.to_bits() != mine.to_bits() {
+                counts.engine_mismatch += 1;
+            }
+            let mut row = DirectRow {
+                y,
+                z,
+                angle_deg: fp.angle_deg,
+                status: String::new(),
+                grid_level: grid_contact.as_ref().map(|g| -g.level),
+                exact_level: None,
+                level_error: None,
+                exact_y: None,
+                exact_z: None,
+                contact_distance: None,
+                grid_contacted: grid_contact.as_ref().map_or(0, |g| g.contacted.len()),
+                exact_ties: 0,
+            };
+            counts.compared += 1;
+            row.status = match (&trace.status, &grid_contact) {
+                (DirectStatus::Failed(_), _) => {
+                    counts.oracle_failed += 1;
+                    "oracle_failed"
+                }
+                (DirectStatus::Clear, None) => "neither",
+                (DirectStatus::Clear, Some(_)) => {
+                    counts.grid_only += 1;
+                    "grid_only"
+                }
+                (DirectStatus::Contact(c), g) => {
+                    row.exact_level = Some(c.level);
+                    row.exact_y = Some(c.witness[1]);
+                    row.exact_z = Some(c.witness[2]);
+                    row.exact_ties = c.ties.len();
+                    match g {
+                        None => {
+                            counts.exact_only += 1;
+                            "exact_only"
+                        }
+                        Some(g) => {
+                            counts.both += 1;
+                            row.level_error = Some((g.level + c.level).abs());
+                            row.contact_distance = g
+                                .contacted
+                                .iter()
+                                .map(|&(i, j)| {
+                                    (spec.x(i) - c.witness[1]).hypot(spec.z(j) - c.witness[2])
+                                })
+                                .min_by(f64::total_cmp);
+                            "both"
+                        }
+                    }
+                }
+            }
+            .into();
+            rows.push(row);
+        }
+    }
+    let grid_s = t.elapsed().as_secs_f64();
+    let collect =
+        |f: fn(&DirectRow) -> Option<f64>| -> Vec<f64> { rows.iter().filter_map(f).collect() };
+    let stats = vec![
+        (
+            DIRECT_METRICS[0].to_string(),
+            DirectStats::of(&collect(|r| r.level_error)),
+        ),
+        (
+            DIRECT_METRICS[1].to_string(),
+            DirectStats::of(&collect(|r| r.contact_distance)),
+        ),
+    ];
+    Ok(DirectComparison {
+        rows,
+        stats,
+        counts,
+        grid_s,
+    })
+}
+
+/// The oracle's options for `knee` and rounding tolerance `e0` (mm).
+pub fn direct_oracle_options(knee: &KneeForm, e0: f64) -> DirectOptions {
+    DirectOptions {
+        knee_form: KneeFormDims {
+            length: knee.triangle_side,
+            radius: knee.radius,
+            width: knee.thickness,
+        },
+        tie_tolerance: e0,
+    }
+}
+
+/// The rotated part's grid at `setup`'s pitch, its footprints, and the
+/// positions of `selection` on it (mm).
+struct DirectStudy {
+    part: Part,
+    spec: GridSpec,
+    positions: Vec<[f64; 2]>,
+}
+
+impl DirectStudy {
+    fn new(
+        input: &PartFile,
+        setup: &Setup,
+        selection: &StartSelection,
+    ) -> Result<DirectStudy, HarnessError> {
+        let part = to_direct_frame(&input.part.triangles);
+        // The direct approach's own default extent, whatever `setup` says.
+        let setup = Setup {
+            approach: Approach::Direct,
+            ..setup.clone()
+        };
+        let spec = setup.grid_spec(&part)?;
+        let grid = HeightGrid::sample(&part.triangles, spec);
+        let footprints = footprints(&setup, spec.pitch);
+        let positions = match selection {
+            StartSelection::At(given) => given.clone(),
+            _ => {
+                let placed = placed_nodes(&grid, &footprints);
+                let nodes = (0..spec.len())
+                    .filter(|&n| placed[n])
+                    .map(|n| (n % spec.nx, n / spec.nx))
+                    .collect();
+                choose_nodes(&spec, nodes, selection)
+                    .iter()
+                    .map(|&(i, j)| [spec.x(i), spec.z(j)])
+                    .collect()
+            }
+        };
+        if positions.is_empty() {
+            return Err(HarnessError::NoStarts);
+        }
+        Ok(DirectStudy {
+            part,
+            spec,
+            positions,
+        })
+    }
+
+    /// The exact casts of the positions at `setup`'s angles.
+    fn exact(
+        &self,
+        input: &PartFile,
+        setup: &Setup,
+        progress: &dyn Progress,
+    ) -> Result<(Vec<DirectTrace>, f64), HarnessError> {
+        progress.begin(
+            &format!(
+                "exact oracle (direct): {} positions x {} angles",
+                self.positions.len(),
+                setup.angles.len()
+            ),
+            None,
+        );
+        let t = Instant::now();
+        let part = kneeform_oracle::Part::from_triangles(&input.part.triangles)?;
+        let traces = kneeform_oracle::evaluate_direct(
+            &part,
+            &self.positions,
+            &setup.angles,
+            &direct_oracle_options(&setup.knee, setup.rule.e0),
+        );
+        progress.end();
+        Ok((traces?, t.elapsed().as_secs_f64()))
+    }
+}
+
+fn footprints(setup: &Setup, pitch: f64) -> Vec<DirectFootprint> {
+    setup
+        .angles
+        .iter()
+        .map(|&a| DirectFootprint::new(&setup.knee, a, pitch))
+        .collect()
+}
+
+/// `verify.json` of the direct approach.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DirectVerifySummary {
+    /// Always `direct`.
+    pub approach: String,
+    /// Version of kneeform.
+    pub kneeform_version: String,
+    /// The part as given.
+    pub input_file: String,
+    /// SHA-256 of the part file's bytes (hex).
+    pub input_sha256: String,
+    /// Factor from the file's units to mm.
+    pub scale: f64,
+    /// `left` or `right`.
+    pub side: crate::Side,
+    /// `--frame`, absent without one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame: Option<crate::frame::FrameRecord>,
+    /// Grid pitch (mm).
+    pub pitch_mm: f64,
+    /// The tolerance both metrics' max is held to (mm).
+    pub tolerance_mm: f64,
+    /// Whether both are within it, with no one-sided position or failure.
+    pub pass: bool,
+    /// Angles (degrees).
+    pub angles_deg: Vec<f64>,
+    /// Knee-form L, R, W (mm).
+    pub knee_form_mm: [f64; 3],
+    /// Rounding tolerance e0 (mm): the ties of both sides.
+    pub e0_mm: f64,
+    /// The deflection threshold plays no part in the direct approach.
+    pub note: String,
+    /// `all`, the sample size, a strip or the number given.
+    pub starts: String,
+    /// The sample's seed.
+    pub seed: u64,
+    /// Per metric: max, p95, median, mean (mm) and count.
+    pub metrics: std::collections::BTreeMap<String, DirectStats>,
+    /// Counts.
+    pub counts: DirectCounts,
+    /// Seconds: the grid's first contacts, the oracle's casts.
+    pub grid_s: f64,
+    /// See `grid_s`.
+    pub oracle_s: f64,
+}
+
+const NOTE: &str = "direct approach: the knee-form moves in -x until it first touches the part; the deflection threshold sigma plays no part";
+
+/// A direct verification: the comparison and `verify.json`.
+#[derive(Debug, Clone)]
+pub struct DirectVerification {
+    /// Per-position rows and statistics.
+    pub comparison: DirectComparison,
+    /// `verify.json`.
+    pub summary: DirectVerifySummary,
+}
+
+fn starts_text(selection: &StartSelection) -> (String, u64) {
+    match *selection {
+        StartSelection::All => ("all".into(), 0),
+        StartSelection::Sample { count, seed } => (count.to_string(), seed),
+        StartSelection::Strip { z } => (format!("strip:{}:{}", z[0], z[1]), 0),
+        StartSelection::At(ref starts) => (format!("{} given", starts.len()), 0),
+    }
+}
+
+/// Verifies the direct approach's grid first contacts against the exact
+/// casts at `setup`'s pitch; positions are `(y0, z0)` nodes of the grid.
+pub fn verify_direct(
+    input: &PartFile,
+    setup: &Setup,
+    options: &VerifyOptions,
+    progress: &dyn Progress,
+) -> Result<DirectVerification, HarnessError> {
+    setup.validate()?;
+    check_selection(&options.selection)?;
+    check_tolerance(options.tolerance)?;
+    let study = DirectStudy::new(input, setup, &options.selection)?;
+    let (traces, oracle_s) = study.exact(input, setup, progress)?;
+    let grid = HeightGrid::sample(&study.part.triangles, study.spec);
+    let comparison = compare_direct(
+        &grid,
+        &footprints(setup, setup.pitch),
+        &study.positions,
+        &traces,
+        setup.rule.e0,
+    )?;
+    let (starts, seed) = starts_text(&options.selection);
+    let summary = DirectVerifySummary {
+        approach: "direct".into(),
+        kneeform_version: env!("CARGO_PKG_VERSION").into(),
+        input_file: input.path.display().to_string(),
+        input_sha256: input.sha256.clone(),
+        scale: input.scale,
+        side: input.side,
+        frame: input.frame.record(),
+        pitch_mm: setup.pitch,
+        tolerance_mm: options.tolerance,
+        pass: comparison.passes(options.tolerance),
+        angles_deg: setup.angles.clone(),
+        knee_form_mm: [
+            setup.knee.triangle_side,
+            setup.knee.radius,
+            setup.knee.thickness,
+        ],
+        e0_mm: setup.rule.e0,
+        note: NOTE.into(),
+        starts,
+        seed,
+        metrics: comparison.stats.iter().cloned().collect(),
+        counts: comparison.counts,
+        grid_s: comparison.grid_s,
+        oracle_s,
+    };
+    Ok(DirectVerification {
+        comparison,
+        summary,
+    })
+}
+
+/// One pitch of a direct convergence study.
+#[derive(Debug, Clone)]
+pub struct DirectPitchResult {
+    /// The pitch (mm).
+    pub pitch: f64,
+    /// The comparison there.
+    pub comparison: DirectComparison,
+    /// Grid nodes.
+    pub nodes: usize,
+}
+
+/// `converge.json` of the direct approach.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DirectConvergeSummary {
+    /// Always `direct`.
+    pub approach: String,
+    /// Version of kneeform.
+    pub kneeform_version: String,
+    /// The part as given.
+    pub input_file: String,
+    /// SHA-256 of the part file's bytes (hex).
+    pub input_sha256: String,
+    /// Factor from the file's units to mm.
+    pub scale: f64,
+    /// `left` or `right`.
+    pub side: crate::Side,
+    /// `--frame`, absent without one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame: Option<crate::frame::FrameRecord>,
+    /// Knee-form L, R, W (mm).
+    pub knee_form_mm: [f64; 3],
+    /// The pitches, coarsest first (mm).
+    pub pitches_mm: Vec<f64>,
+    /// Per metric, the fit of its max error, where it has one.
+    pub fits: std::collections::BTreeMap<String, Fit>,
+    /// Per metric, the fit of its median error, where it has one.
+    pub fits_median: std::collections::BTreeMap<String, Fit>,
+    /// The tolerance asked for (mm).
+    pub tolerance_mm: Option<f64>,
+    /// The coarsest pitch meeting it (mm).
+    pub recommended_pitch_mm: Option<f64>,
+    /// Angles of the study (degrees).
+    pub angles_deg: Vec<f64>,
+    /// Rounding tolerance e0 (mm).
+    pub e0_mm: f64,
+    /// The deflection threshold plays no part in the direct approach.
+    pub note: String,
+    /// Positions compared per angle.
+    pub starts: usize,
+    /// The sample's seed.
+    pub seed: u64,
+    /// Seconds of the oracle's casts.
+    pub oracle_s: f64,
+}
+
+/// A direct convergence study.
+#[derive(Debug, Clone)]
+pub struct DirectConvergence {
+    /// Every pitch, coarsest first.
+    pub results: Vec<DirectPitchResult>,
+    /// `converge.json`.
+    pub summary: DirectConvergeSummary,
+}
+
+/// The direct approach compared with the exact casts at every pitch of
+/// `options`, on the coarsest grid's positions (nodes of every finer grid,
+/// since the pitches nest); the oracle runs once.
+pub fn converge_direct(
+    input: &PartFile,
+    setup: &Setup,
+    options: &ConvergeOptions,
+    progress: &dyn Progress,
+) -> Result<DirectConvergence, HarnessError> {
+    options.validate()?;
+    let pitches = &options.pitches;
+    let coarse_setup = Setup {
+        pitch: pitches[0],
+        ..setup.clone()
+    };
+    coarse_setup.validate()?;
+    let study = DirectStudy::new(input, &coarse_setup, &options.selection)?;
+    let c = study.spec;
+    let spec_at = |p: f64| {
+        let r = (c.pitch / p).round() as usize;
+        GridSpec::explicit(c.x(0), c.z(0), (c.nx - 1) * r + 1, (c.nz - 1) * r + 1, p)
+    };
+    for &p in pitches {
+        setup.check_memory(&spec_at(p), study.part.triangles.len())?;
+    }
+    let (traces, oracle_s) = study.exact(input, setup, progress)?;
+    let mut results = Vec::new();
+    for &p in pitches {
+        let spec = spec_at(p);
+        progress.begin(
+            &format!("pitch {p} mm: {} x {} grid (direct)", spec.nx, spec.nz),
+            None,
+        );
+        let grid = HeightGrid::sample(&study.part.triangles, spec);
+        let comparison = compare_direct(
+            &grid,
+            &footprints(setup, p),
+            &study.positions,
+            &traces,
+            setup.rule.e0,
+        );
+        progress.end();
+        results.push(DirectPitchResult {
+            pitch: p,
+            comparison: comparison?,
+            nodes: spec.len(),
+        });
+    }
+    let fit = |pick: fn(&DirectStats) -> f64| -> std::collections::BTreeMap<String, Fit> {
+        DIRECT_METRICS
+            .iter()
+            .filter_map(|m| {
+                let points: Vec<(f64, f64)> = results
+                    .iter()
+                    .map(|r| (r.pitch, pick(&r.comparison.stat(m))))
+                    .collect();
+                fit_power_law(&points).map(|f| (m.to_string(), f))
+            })
+            .collect()
+    };
+    let recommended = options.tolerance.and_then(|t| {
+        results
+            .iter()
+            .filter(|r| r.comparison.passes(t))
+            .map(|r| r.pitch)
+            .max_by(f64::total_cmp)
+    });
+    let (_, seed) = starts_text(&options.selection);
+    let summary = DirectConvergeSummary {
+        approach: "direct".into(),
+        kneeform_version: env!("CARGO_PKG_VERSION").into(),
+        input_file: input.path.display().to_string(),
+        input_sha256: input.sha256.clone(),
+        scale: input.scale,
+        side: input.side,
+        frame: input.frame.record(),
+        knee_form_mm: [
+            setup.knee.triangle_side,
+            setup.knee.radius,
+            setup.knee.thickness,
+        ],
+        pitches_mm: pitches.clone(),
+        fits: fit(|s| s.max),
+        fits_median: fit(|s| s.median),
+        tolerance_mm: options.tolerance,
+        recommended_pitch_mm: recommended,
+        angles_deg: setup.angles.clone(),
+        e0_mm: setup.rule.e0,
+        note: NOTE.into(),
+        starts: study.positions.len(),
+        seed,
+        oracle_s,
+    };
+    Ok(DirectConvergence { results, summary })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn placed_nodes_are_the_positions_with_a_first_contact() {
+        // A grid with a finite height at one node in 800 (a footprint
+        // covers about 600 at 8 mm), so that about half the positions see
+        // none under their footprint and many only at its edges;
+        // splitmix64 from a fixed seed.
+        let spec = GridSpec::explicit(-400.0, -480.0, 150, 120, 8.0);
+        let mut state = 7u64;
+        let mut next = || {
+            state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            z ^ (z >> 31)
+        };
+        let h = (0..spec.len())
+            .map(|_| {
+                let r = next();
+                if r % 800 == 0 {
+                    (r % 1000) as f64 / 100.0
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .collect();
+        let grid = HeightGrid { spec, h };
+        let knee = KneeForm::default();
+        let fronts: Vec<DirectFootprint> = [-30.0, 0.0, 30.0]
+            .iter()
+            .map(|&a| DirectFootprint::new(&knee, a, spec.pitch))
+            .collect();
+        let placed = placed_nodes(&grid, &fronts);
+        let (mut some, mut none) = (0, 0);
+        for j in 0..spec.nz {
+            for i in 0..spec.nx {
+                let want = fronts
+                    .iter()
+                    .any(|fp| grid_first_contact(&grid, fp, (i, j), 1e-6).is_some());
+                assert_eq!(placed[j * spec.nx + i], want, "node ({i}, {j})");
+                if want { some += 1 } else { none += 1 }
+            }
+        }
+        assert!(some > 100 && none > 100, "{some} placed, {none} not");
+    }
+
+    #[test]
+    fn stats_give_the_nearest_rank_median_and_p95() {
+        let s = DirectStats::of(&[3.0, -1.0, 2.0, 4.0]);
+        assert_eq!(
+            (s.max, s.p95, s.median, s.mean, s.n),
+            (4.0, 4.0, 2.0, 2.5, 4)
+        );
+        assert_eq!(DirectStats::of(&[]), DirectStats::default());
+    }
+}
