@@ -460,6 +460,21 @@ impl Analysis {
         setup: &Setup,
         progress: &dyn Progress,
     ) -> Result<Analysis, AnalysisError> {
+        Analysis::of_source_at(source, setup, None, progress)
+    }
+
+    /// As [`Analysis::of_source`], with push and slide computed only at
+    /// the angles `only` (indices into `setup.angles`) when given: a shard
+    /// of the run ([`crate::shard`]). The other angles' masks are empty
+    /// (no node, no placed start, no blind spot met); all else (the grid,
+    /// the blind spots, the memory estimate, the warnings about the part
+    /// and the angles) is the whole run's.
+    pub fn of_source_at(
+        source: &PartSource,
+        setup: &Setup,
+        only: Option<&[usize]>,
+        progress: &dyn Progress,
+    ) -> Result<Analysis, AnalysisError> {
         setup.validate()?;
         crate::mesh::check_scale(source.scale)?;
         let angle_warnings = sanity::angle_warnings(&setup.angles);
@@ -506,7 +521,7 @@ impl Analysis {
             crate::mesh::binary_stl_len(n)
         };
         let read = MemoryEstimate::reading(read_bytes, n);
-        let mut analysis = Analysis::run_checked(input, setup, progress, angle_warnings)?;
+        let mut analysis = Analysis::run_checked(input, setup, only, progress, angle_warnings)?;
         analysis.timings.read_s = read_s;
         if read.bytes() > analysis.memory.bytes() {
             analysis.memory = read;
@@ -526,12 +541,13 @@ impl Analysis {
         for w in &angle_warnings {
             progress.warn(w);
         }
-        Analysis::run_checked(input, setup, progress, angle_warnings)
+        Analysis::run_checked(input, setup, None, progress, angle_warnings)
     }
 
     fn run_checked(
         input: PartFile,
         setup: &Setup,
+        only: Option<&[usize]>,
         progress: &dyn Progress,
         mut warnings: Vec<Warning>,
     ) -> Result<Analysis, AnalysisError> {
@@ -573,7 +589,8 @@ impl Analysis {
         let blind_s = t.elapsed().as_secs_f64();
 
         let t = Instant::now();
-        progress.begin("push and slide", Some(footprints.len() as u64));
+        let computed = only.map_or(footprints.len(), <[usize]>::len);
+        progress.begin("push and slide", Some(computed as u64));
         let options = EngineOptions {
             rule: setup.rule,
             algorithm: setup.algorithm,
@@ -586,7 +603,11 @@ impl Analysis {
                 })
                 .collect(),
         };
-        let masks = colliding_masks(&grid, &footprints, &options, &|| progress.step());
+        let step = || progress.step();
+        let masks = match only {
+            None => colliding_masks(&grid, &footprints, &options, &step),
+            Some(only) => crate::shard::masks_at(&grid, &footprints, &options, only, &step),
+        };
         progress.end();
         let push_slide_s = t.elapsed().as_secs_f64();
 

@@ -26,9 +26,9 @@ fn shared_meshes() -> PathBuf {
 
 const OUTPUTS: [&str; 6] = [
     "summary.json",
-    "colliding_points.csv",
     "composite.csv",
     "colliding_area.stl",
+    "colliding_area.ply",
     "depth.png",
     "composite.png",
 ];
@@ -203,12 +203,17 @@ fn thread_count_does_not_change_any_byte() {
     let scratch = scratch_dir("threads");
     let part = scratch.join("part.stl");
     write_stl(&part, &builtin("depression").unwrap().triangulate(None)).unwrap();
-    analyse_to(&part, &scratch.join("one"), &["--threads", "1"]);
-    analyse_to(&part, &scratch.join("many"), &[]);
+    analyse_to(
+        &part,
+        &scratch.join("one"),
+        &["--threads", "1", "--points-csv"],
+    );
+    analyse_to(&part, &scratch.join("many"), &["--points-csv"]);
     for f in [
         "colliding_points.csv",
         "composite.csv",
         "colliding_area.stl",
+        "colliding_area.ply",
     ] {
         let a = std::fs::read(scratch.join("one").join(f)).unwrap();
         let b = std::fs::read(scratch.join("many").join(f)).unwrap();
@@ -266,8 +271,16 @@ fn right_side_of_a_mirrored_part_gives_the_mirrored_result() {
     let (left, right) = (scratch.join("left.stl"), scratch.join("right.stl"));
     write_stl(&left, &tris).unwrap();
     write_stl(&right, &mirrored(&tris, 1)).unwrap();
-    analyse_to(&left, &scratch.join("l"), &["--side", "left"]);
-    analyse_to(&right, &scratch.join("r"), &["--side", "right"]);
+    analyse_to(
+        &left,
+        &scratch.join("l"),
+        &["--side", "left", "--points-csv"],
+    );
+    analyse_to(
+        &right,
+        &scratch.join("r"),
+        &["--side", "right", "--points-csv"],
+    );
     // y is column 4 of colliding_points (angle_deg,i,j,x,y,z) and column 3
     // of composite (i,j,x,y,z,angles).
     for (f, y_col) in [("colliding_points.csv", 4), ("composite.csv", 3)] {
@@ -300,8 +313,8 @@ fn part_mirrored_in_z_gives_the_composite_mirrored_with_angles_swapped() {
     let (a, b) = (scratch.join("a.stl"), scratch.join("b.stl"));
     write_stl(&a, &tris).unwrap();
     write_stl(&b, &mirrored(&tris, 2)).unwrap();
-    analyse_to(&a, &scratch.join("a"), &[]);
-    analyse_to(&b, &scratch.join("b"), &[]);
+    analyse_to(&a, &scratch.join("a"), &["--points-csv"]);
+    analyse_to(&b, &scratch.join("b"), &["--points-csv"]);
     // colliding_points: angle_deg,i,j,x,y,z -> key (angle, x, z).
     let key = |rows: Vec<Vec<String>>, flip: f64| {
         let mut keys: Vec<(i64, i64, i64)> = rows

@@ -12,4 +12,5 @@ mod hostile;
 mod oracle;
 mod report;
 mod resolution;
+mod shard;
 mod util;

@@ -55,7 +55,18 @@ fn step_run(name: &str, side: &str) -> PathBuf {
         kneeform(
             &dir,
             &[
-                "analyze", "part.stl", "--pitch", PITCH, ANGLES, "--side", side, "--out", "run",
+                "analyze",
+                "part.stl",
+                "--pitch",
+                PITCH,
+                ANGLES,
+                "--side",
+                side,
+                "--out",
+                "run",
+                // The long table too: the tests check the report's masks
+                // (from composite.csv) against it.
+                "--points-csv",
             ],
         ),
         "analyze",
