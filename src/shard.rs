@@ -583,7 +583,8 @@ fn read_shard(dir: &Path) -> Result<ShardFiles, ShardError> {
     }
     let summary = &record.summary;
     let origin_ok = grid_matches(summary, &header.spec);
-    if !origin_ok || header.has_files != !summary.files.is_empty() {
+    // An assembly's shards hold its files per node, and only its.
+    if !origin_ok || header.has_files == summary.files.is_empty() {
         return Err(bad_bin("its grid is not the one shard.json describes"));
     }
     let common_end =
