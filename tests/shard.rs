@@ -112,9 +112,16 @@ fn merge(shards: &[&Path], out: &Path) -> Output {
 
 #[test]
 fn four_shards_merged_are_the_unsharded_run_byte_for_byte() {
-    // A smooth wave, and a thin rib the grid misses (blind spots met and
-    // nothing struck, with their warnings).
-    for (name, extra) in [("wave", &[][..]), ("thin-rib", &[][..])] {
+    // A smooth wave; a thin rib the grid misses (blind spots met and
+    // nothing struck, with their warnings); an assembly of two files
+    // (each node's file) turned by a frame (mapped back by the merge).
+    let bump = scenario("bump");
+    let assembly = [bump.as_str(), "--frame", "-x,y,-z"];
+    for (name, extra) in [
+        ("wave", &[][..]),
+        ("thin-rib", &[][..]),
+        ("wave", &assembly[..]),
+    ] {
         let dir = scratch_dir(&format!("shard-{name}"));
         let part = scenario(name);
         let whole = dir.join("whole");
