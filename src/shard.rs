@@ -289,6 +289,22 @@ struct ShardFiles {
     header: Header,
 }
 
+/// What every shard of a run holds alike, decoded.
+struct Common {
+    grid: HeightGrid,
+    node_file: Option<Vec<u32>>,
+    blind_spots: Vec<BlindSpot>,
+}
+
+/// One angle of a shard, decoded: its index among the run's angles, its
+/// placed starts, its mask and the blind spots it meets.
+struct ShardAngle {
+    index: usize,
+    placed: usize,
+    mask: Vec<u8>,
+    probes: Vec<bool>,
+}
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Header {
     spec: GridSpec,
@@ -355,11 +371,21 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, ShardError> {
     let header = first.header;
     let spec = header.spec;
     let n = spec.len();
-    let (grid, node_file, mut blind_spots) = first.common(n)?;
+    let Common {
+        grid,
+        node_file,
+        mut blind_spots,
+    } = first.common(n)?;
     let mut masks: Vec<Option<AngleMask>> = vec![None; angles.len()];
     let mut per_angle: Vec<Option<AngleSummary>> = vec![None; angles.len()];
     for s in &shards {
-        for (a, placed, mask, probes) in s.angles(n)? {
+        for ShardAngle {
+            index: a,
+            placed,
+            mask,
+            probes,
+        } in s.angles(n)?
+        {
             let colliding = mask.iter().filter(|&&v| v != 0).count();
             let row = &s.record.summary.per_angle[a];
             if row.placed_starts != placed || row.colliding_nodes != colliding {
@@ -657,11 +683,7 @@ impl ShardFiles {
     }
 
     /// The grid, an assembly's files per node and the blind spots.
-    #[allow(clippy::type_complexity)]
-    fn common(
-        &self,
-        n: usize,
-    ) -> Result<(HeightGrid, Option<Vec<u32>>, Vec<BlindSpot>), ShardError> {
+    fn common(&self, n: usize) -> Result<Common, ShardError> {
         let mut at = HEADER_LEN;
         let word = |k: usize| u64::from_le_bytes(self.bin[k..k + 8].try_into().expect("8"));
         let h: Vec<f64> = (0..n).map(|k| f64::from_bits(word(at + 8 * k))).collect();
@@ -701,13 +723,15 @@ impl ShardFiles {
             at += BLIND_LEN;
         }
         debug_assert_eq!(at, self.common_end);
-        Ok((HeightGrid { spec, h }, node_file, blind))
+        Ok(Common {
+            grid: HeightGrid { spec, h },
+            node_file,
+            blind_spots: blind,
+        })
     }
 
-    /// Per angle of the shard: its index, placed starts, mask and probes
-    /// met.
-    #[allow(clippy::type_complexity)]
-    fn angles(&self, n: usize) -> Result<Vec<(usize, usize, Vec<u8>, Vec<bool>)>, ShardError> {
+    /// The shard's angles, decoded.
+    fn angles(&self, n: usize) -> Result<Vec<ShardAngle>, ShardError> {
         let word = |k: usize| u64::from_le_bytes(self.bin[k..k + 8].try_into().expect("8"));
         let mut at = self.common_end;
         let count = word(at) as usize;
@@ -726,7 +750,12 @@ impl ShardFiles {
             at += n.div_ceil(8);
             let probes: Vec<bool> = unpack_bits(&self.bin[at..], self.header.blind).collect();
             at += self.header.blind.div_ceil(8);
-            out.push((a, placed, mask, probes));
+            out.push(ShardAngle {
+                index: a,
+                placed,
+                mask,
+                probes,
+            });
         }
         Ok(out)
     }
