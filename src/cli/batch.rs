@@ -4,7 +4,8 @@
 //! has succeeded, its fingerprint (this kneeform's version, the item's
 //! arguments and the SHA-256 of its part files) is written into its
 //! output directory as `batch-item.json`. An item whose directory holds a
-//! run (`summary.json`) with the same fingerprint is skipped, so a batch
+//! run (`summary.json`, or a shard's `shard.json`) with the same
+//! fingerprint is skipped, so a batch
 //! killed part way and started again loses only the item it was running:
 //! `analyze` leaves no partial directory, and an item whose fingerprint
 //! was not yet written runs again.
@@ -167,12 +168,14 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Whether `out` holds a complete run of this fingerprint.
+/// Whether `out` holds a complete run (or shard: `--shard` in the item's
+/// flags) of this fingerprint.
 fn is_done(out: &Path, fingerprint: &str) -> bool {
     let recorded = std::fs::read_to_string(out.join(FINGERPRINT_FILE))
         .ok()
         .and_then(|t| serde_json::from_str::<Fingerprint>(&t).ok());
-    out.join("summary.json").is_file() && recorded.is_some_and(|r| r.fingerprint == fingerprint)
+    let complete = out.join("summary.json").is_file() || out.join("shard.json").is_file();
+    complete && recorded.is_some_and(|r| r.fingerprint == fingerprint)
 }
 
 /// SHA-256 over this kneeform's version, `argv` and each part file's
