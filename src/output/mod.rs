@@ -568,6 +568,14 @@ mod tests {
     }
 
     #[test]
+    fn this_process_runs_and_no_process_has_the_largest_pid() {
+        if Path::new("/proc/self").exists() {
+            assert!(process_runs(std::process::id()));
+            assert!(!process_runs(u32::MAX));
+        }
+    }
+
+    #[test]
     fn drop_without_commit_leaves_nothing() {
         let root = temp_dir("drop");
         let final_dir = root.join("run");
