@@ -15,6 +15,10 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<ExitCode> {
         points_csv: args.points_csv,
     };
     let summary = kneeform::shard::write_merged(&out, &merged, &options)?;
+    // The whole run's warnings: a shard's own were of its angles alone.
+    for w in &summary.warnings {
+        eprintln!("kneeform: warning: {w}");
+    }
     out.commit()
         .with_context(|| format!("cannot move results into {}", args.out.display()))?;
     eprintln!(
