@@ -781,7 +781,7 @@ impl Analysis {
 }
 
 /// Per probe, the angles (degrees) at which it was met.
-fn probes_met(masks: &[AngleMask], probes: usize) -> Vec<Vec<f64>> {
+pub(crate) fn probes_met(masks: &[AngleMask], probes: usize) -> Vec<Vec<f64>> {
     (0..probes)
         .map(|k| {
             masks

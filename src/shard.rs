@@ -410,12 +410,9 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, ShardError> {
         .map(|(m, a)| m.ok_or_else(|| ShardError::Mismatch(format!("no shard holds angle {a}"))))
         .collect::<Result<_, _>>()?;
     let composite = crate::engine::composite(&masks);
-    for (k, b) in blind_spots.iter_mut().enumerate() {
-        b.met_angles_deg = masks
-            .iter()
-            .filter(|m| m.probes_met.get(k) == Some(&true))
-            .map(|m| m.angle_deg)
-            .collect();
+    let met = crate::analysis::probes_met(&masks, blind_spots.len());
+    for (b, met) in blind_spots.iter_mut().zip(met) {
+        b.met_angles_deg = met;
     }
     let mut merged = summary.clone();
     merged.per_angle = per_angle.into_iter().flatten().collect();
