@@ -499,6 +499,21 @@ impl Analysis {
         setup: &Setup,
         progress: &dyn Progress,
     ) -> Result<Analysis, AnalysisError> {
+        Analysis::of_source_at(source, setup, None, progress)
+    }
+
+    /// As [`Analysis::of_source`], with push and slide computed only at
+    /// the angles `only` (indices into `setup.angles`) when given: a shard
+    /// of the run ([`crate::shard`]). The other angles' masks are empty
+    /// (no node, no placed start, no blind spot met); all else (the grid,
+    /// the blind spots, the memory estimate, the warnings about the part
+    /// and the angles) is the whole run's.
+    pub fn of_source_at(
+        source: &PartSource,
+        setup: &Setup,
+        only: Option<&[usize]>,
+        progress: &dyn Progress,
+    ) -> Result<Analysis, AnalysisError> {
         setup.validate()?;
         crate::mesh::check_scale(source.scale)?;
         let angle_warnings = sanity::angle_warnings(&setup.angles);
@@ -545,7 +560,7 @@ impl Analysis {
             crate::mesh::binary_stl_len(n)
         };
         let read = MemoryEstimate::reading(read_bytes, n);
-        let mut analysis = Analysis::run_checked(input, setup, progress, angle_warnings)?;
+        let mut analysis = Analysis::run_checked(input, setup, only, progress, angle_warnings)?;
         analysis.timings.read_s = read_s;
         if read.bytes() > analysis.memory.bytes() {
             analysis.memory = read;
@@ -565,12 +580,13 @@ impl Analysis {
         for w in &angle_warnings {
             progress.warn(w);
         }
-        Analysis::run_checked(input, setup, progress, angle_warnings)
+        Analysis::run_checked(input, setup, None, progress, angle_warnings)
     }
 
     fn run_checked(
         mut input: PartFile,
         setup: &Setup,
+        only: Option<&[usize]>,
         progress: &dyn Progress,
         mut warnings: Vec<Warning>,
     ) -> Result<Analysis, AnalysisError> {
@@ -630,25 +646,51 @@ impl Analysis {
                 y: b.y,
             })
             .collect();
+        let computed = only.map_or(setup.angles.len(), <[usize]>::len);
+        let step = || progress.step();
         let masks = match setup.approach {
             Approach::Slide => {
-                progress.begin("push and slide", Some(footprints.len() as u64));
+                progress.begin("push and slide", Some(computed as u64));
                 let options = EngineOptions {
                     rule: setup.rule,
                     algorithm: setup.algorithm,
                     start_rows: None,
                     probes,
                 };
-                colliding_masks(&grid, &footprints, &options, &|| progress.step())
+                match only {
+                    None => colliding_masks(&grid, &footprints, &options, &step),
+                    Some(only) => crate::shard::masks_at(&grid, &footprints, &options, only, &step),
+                }
             }
             Approach::Direct => {
-                progress.begin("direct approach", Some(setup.angles.len() as u64));
-                let fronts: Vec<DirectFootprint> = setup
-                    .angles
+                progress.begin("direct approach", Some(computed as u64));
+                let all: Vec<usize> = (0..setup.angles.len()).collect();
+                let chosen = only.unwrap_or(&all);
+                let fronts: Vec<DirectFootprint> = chosen
                     .iter()
-                    .map(|&a| DirectFootprint::new(&setup.knee, a, spec.pitch))
+                    .map(|&a| DirectFootprint::new(&setup.knee, setup.angles[a], spec.pitch))
                     .collect();
-                direct_masks(&grid, &fronts, setup.rule.e0, &probes, &|| progress.step())
+                let found = direct_masks(&grid, &fronts, setup.rule.e0, &probes, &step);
+                if only.is_none() {
+                    found
+                } else {
+                    // A shard's other angles: nothing computed, nothing struck.
+                    let mut masks: Vec<AngleMask> = setup
+                        .angles
+                        .iter()
+                        .map(|&angle_deg| AngleMask {
+                            angle_deg,
+                            mask: vec![0; spec.len()],
+                            placed: 0,
+                            colliding: 0,
+                            probes_met: vec![false; probes.len()],
+                        })
+                        .collect();
+                    for (&a, m) in chosen.iter().zip(found) {
+                        masks[a] = m;
+                    }
+                    masks
+                }
             }
         };
         progress.end();
@@ -836,7 +878,7 @@ impl Analysis {
 }
 
 /// Per probe, the angles (degrees) at which it was met.
-fn probes_met(masks: &[AngleMask], probes: usize) -> Vec<Vec<f64>> {
+pub(crate) fn probes_met(masks: &[AngleMask], probes: usize) -> Vec<Vec<f64>> {
     (0..probes)
         .map(|k| {
             masks

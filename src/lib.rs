@@ -60,6 +60,7 @@ pub mod push;
 pub mod report;
 pub mod sanity;
 pub mod scenario;
+pub mod shard;
 mod simd;
 pub mod slide;
 pub mod strike;

@@ -49,6 +49,8 @@ fn run(cli: &Cli) -> anyhow::Result<ExitCode> {
         }
         Command::Verify(args) => return cli::verify::run(args),
         Command::Converge(args) => return cli::converge::run(args),
+        Command::Merge(args) => return cli::merge::run(args),
+        Command::Batch(args) => return cli::batch::run(args),
         Command::Report(args) => cli::report::run(args)?,
     }
     Ok(ExitCode::SUCCESS)

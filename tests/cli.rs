@@ -26,9 +26,9 @@ fn shared_meshes() -> PathBuf {
 
 const OUTPUTS: [&str; 6] = [
     "summary.json",
-    "colliding_points.csv",
     "composite.csv",
     "colliding_area.stl",
+    "colliding_area.ply",
     "depth.png",
     "composite.png",
 ];
@@ -203,12 +203,17 @@ fn thread_count_does_not_change_any_byte() {
     let scratch = scratch_dir("threads");
     let part = scratch.join("part.stl");
     write_stl(&part, &builtin("depression").unwrap().triangulate(None)).unwrap();
-    analyse_to(&part, &scratch.join("one"), &["--threads", "1"]);
-    analyse_to(&part, &scratch.join("many"), &[]);
+    analyse_to(
+        &part,
+        &scratch.join("one"),
+        &["--threads", "1", "--points-csv"],
+    );
+    analyse_to(&part, &scratch.join("many"), &["--points-csv"]);
     for f in [
         "colliding_points.csv",
         "composite.csv",
         "colliding_area.stl",
+        "colliding_area.ply",
     ] {
         let a = std::fs::read(scratch.join("one").join(f)).unwrap();
         let b = std::fs::read(scratch.join("many").join(f)).unwrap();
@@ -266,8 +271,16 @@ fn right_side_of_a_mirrored_part_gives_the_mirrored_result() {
     let (left, right) = (scratch.join("left.stl"), scratch.join("right.stl"));
     write_stl(&left, &tris).unwrap();
     write_stl(&right, &mirrored(&tris, 1)).unwrap();
-    analyse_to(&left, &scratch.join("l"), &["--side", "left"]);
-    analyse_to(&right, &scratch.join("r"), &["--side", "right"]);
+    analyse_to(
+        &left,
+        &scratch.join("l"),
+        &["--side", "left", "--points-csv"],
+    );
+    analyse_to(
+        &right,
+        &scratch.join("r"),
+        &["--side", "right", "--points-csv"],
+    );
     // y is column 4 of colliding_points (angle_deg,i,j,x,y,z) and column 3
     // of composite (i,j,x,y,z,angles).
     for (f, y_col) in [("colliding_points.csv", 4), ("composite.csv", 3)] {
@@ -294,14 +307,77 @@ fn right_side_of_a_mirrored_part_gives_the_mirrored_result() {
 }
 
 #[test]
+fn composite_masks_hold_exactly_the_colliding_points() {
+    // composite.csv's angle_mask is colliding_points.csv's rows, packed:
+    // bit a for summary.json's angles_deg[a]; angles in the run's order,
+    // not sorted.
+    let scratch = scratch_dir("masks");
+    let part = scratch.join("part.stl");
+    write_stl(&part, &asymmetric_part()).unwrap();
+    let run = scratch.join("run");
+    let out = kneeform(&[
+        "analyze",
+        part.to_str().unwrap(),
+        "--out",
+        run.to_str().unwrap(),
+        "--pitch",
+        "2.5",
+        "--angles=30,-30,0,-12,12",
+        "--points-csv",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(run.join("summary.json")).unwrap()).unwrap();
+    let angles: Vec<f64> = summary["angles_deg"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a.as_f64().unwrap())
+        .collect();
+    assert_eq!(angles, [30.0, -30.0, 0.0, -12.0, 12.0]);
+    let mut from_points: Vec<(String, String, u64)> = csv_rows(&run.join("colliding_points.csv"))
+        .into_iter()
+        .map(|r| {
+            let a = angles
+                .iter()
+                .position(|&a| a == r[0].parse::<f64>().unwrap());
+            (r[1].clone(), r[2].clone(), a.unwrap() as u64)
+        })
+        .collect();
+    let mut from_masks = Vec::new();
+    for r in csv_rows(&run.join("composite.csv")) {
+        let hex = r[6].strip_prefix("0x").expect("0x");
+        assert_eq!(hex.len(), 2, "one digit per four angles: {r:?}");
+        let bits = u64::from_str_radix(hex, 16).unwrap();
+        assert_eq!(
+            bits.count_ones().to_string(),
+            r[5],
+            "the count is the set's: {r:?}"
+        );
+        for a in (0..angles.len() as u64).filter(|a| bits >> a & 1 == 1) {
+            from_masks.push((r[0].clone(), r[1].clone(), a));
+        }
+    }
+    from_points.sort();
+    from_masks.sort();
+    assert!(from_points.len() > 100, "too few points to prove anything");
+    assert_eq!(from_points, from_masks);
+    std::fs::remove_dir_all(&scratch).unwrap();
+}
+
+#[test]
 fn part_mirrored_in_z_gives_the_composite_mirrored_with_angles_swapped() {
     let scratch = scratch_dir("zmirror");
     let tris = asymmetric_part();
     let (a, b) = (scratch.join("a.stl"), scratch.join("b.stl"));
     write_stl(&a, &tris).unwrap();
     write_stl(&b, &mirrored(&tris, 2)).unwrap();
-    analyse_to(&a, &scratch.join("a"), &[]);
-    analyse_to(&b, &scratch.join("b"), &[]);
+    analyse_to(&a, &scratch.join("a"), &["--points-csv"]);
+    analyse_to(&b, &scratch.join("b"), &["--points-csv"]);
     // colliding_points: angle_deg,i,j,x,y,z -> key (angle, x, z).
     let key = |rows: Vec<Vec<String>>, flip: f64| {
         let mut keys: Vec<(i64, i64, i64)> = rows

@@ -506,7 +506,6 @@ fn a_report_failure_keeps_the_analysis_and_exits_3() {
     let files = entries(&dir.join("run"));
     for f in [
         "summary.json",
-        "colliding_points.csv",
         "composite.csv",
         "colliding_area.stl",
         "colliding_area.ply",

@@ -13,4 +13,5 @@ mod hostile;
 mod oracle;
 mod report;
 mod resolution;
+mod shard;
 mod util;

@@ -55,7 +55,18 @@ fn step_run(name: &str, side: &str) -> PathBuf {
         kneeform(
             &dir,
             &[
-                "analyze", "part.stl", "--pitch", PITCH, ANGLES, "--side", side, "--out", "run",
+                "analyze",
+                "part.stl",
+                "--pitch",
+                PITCH,
+                ANGLES,
+                "--side",
+                side,
+                "--out",
+                "run",
+                // The long table too: the tests check the report's masks
+                // (from composite.csv) against it.
+                "--points-csv",
             ],
         ),
         "analyze",
@@ -514,6 +525,56 @@ fn side_views_are_coloured_exactly_on_the_csv_node_cells() {
         }
         std::fs::remove_dir_all(dir).unwrap();
     }
+}
+
+#[test]
+fn a_run_of_an_earlier_version_is_drawn_from_its_colliding_points() {
+    // Earlier versions wrote composite.csv without `angle_mask` and the
+    // per-angle sets in colliding_points.csv: the report draws the same.
+    let dir = step_run("report-old-run", "left");
+    ok(
+        kneeform(&dir, &["report", "run", "--out", "new.html"]),
+        "report",
+    );
+    let path = dir.join("run/composite.csv");
+    let mut reader = csv::Reader::from_path(&path).unwrap();
+    let headers = reader.headers().unwrap().clone();
+    let mask = headers.iter().position(|h| h == "angle_mask").unwrap();
+    let mut old = csv::Writer::from_writer(Vec::new());
+    let keep = |r: &csv::StringRecord| -> Vec<String> {
+        r.iter()
+            .enumerate()
+            .filter(|&(k, _)| k != mask)
+            .map(|(_, f)| f.to_string())
+            .collect()
+    };
+    old.write_record(keep(&headers)).unwrap();
+    for r in reader.records() {
+        old.write_record(keep(&r.unwrap())).unwrap();
+    }
+    std::fs::write(&path, old.into_inner().unwrap()).unwrap();
+    ok(
+        kneeform(&dir, &["report", "run", "--out", "old.html"]),
+        "report of the old run",
+    );
+    let (new, old) = (
+        std::fs::read_to_string(dir.join("new.html")).unwrap(),
+        std::fs::read_to_string(dir.join("old.html")).unwrap(),
+    );
+    for k in 0..3 {
+        let id = format!("angle-view-{k}");
+        assert_eq!(
+            attr(img_by_id(&new, &id), "src"),
+            attr(img_by_id(&old, &id), "src"),
+            "{id}"
+        );
+    }
+    // Without either, the report says which file it lacks.
+    std::fs::remove_file(dir.join("run/colliding_points.csv")).unwrap();
+    let out = kneeform(&dir, &["report", "run", "--out", "none.html"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("colliding_points.csv"));
+    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]

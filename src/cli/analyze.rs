@@ -2,13 +2,13 @@
 //! as CSV, STL, PNG and `summary.json`, all in one directory that appears
 //! whole or not at all.
 
-use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::{Context, bail, ensure};
 use kneeform::Analysis;
 use kneeform::harness::{self, AutoPitch};
-use kneeform::output::{self, OutputDir};
+use kneeform::output;
+use kneeform::shard::{Shard, ShardError};
 
 use super::args::{AnalyzeArgs, PitchArg};
 use super::progress::Bars;
@@ -33,9 +33,33 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         ),
         (false, None) => None,
     };
+    let shard = args
+        .shard
+        .as_deref()
+        .map(Shard::parse)
+        .transpose()
+        .context("--shard")?;
+    if let Some(shard) = shard {
+        ensure!(
+            !auto,
+            "--shard needs a pitch in mm: every shard must sample the same grid, and --pitch auto chooses one per run"
+        );
+        ensure!(
+            !args.report && !args.points_csv,
+            "--report and --points-csv are for the merged run: pass them to `kneeform merge`"
+        );
+        let angles = setup.angles.len();
+        if shard.count > angles {
+            return Err(ShardError::TooMany {
+                shards: shard.count,
+                angles,
+            })
+            .context("--shard");
+        }
+    }
     // Before any work: where the results go, so that an unwritable or
     // occupied --out is said now, not after the computation.
-    let out = stage_output(&args.out, args.force)?;
+    let out = super::stage_output(&args.out, args.force)?;
     super::set_threads(threads)?;
     let bars = Bars::default();
     let mut choice = None;
@@ -66,9 +90,26 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         setup.pitch = chosen.pitch_mm;
         choice = Some(chosen);
     }
-    let mut analysis = Analysis::of_source(&source, &setup, &bars)?;
+    let only = shard.map(|s| s.angle_indices(setup.angles.len()));
+    let mut analysis = Analysis::of_source_at(&source, &setup, only.as_deref(), &bars)?;
     analysis.pitch_choice = choice;
-    let summary = output::write_analysis(&out, &analysis)?;
+    if let Some(shard) = shard {
+        kneeform::shard::write_shard(&out, &analysis, shard)?;
+        out.commit()
+            .with_context(|| format!("cannot move the shard into {}", args.out.display()))?;
+        eprintln!(
+            "kneeform: shard {shard}: {} of {} angles written to {}; `kneeform merge` puts the {} shards together",
+            only.as_ref().map_or(0, Vec::len),
+            setup.angles.len(),
+            args.out.display(),
+            shard.count
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    let options = output::WriteOptions {
+        points_csv: args.points_csv,
+    };
+    let summary = output::write_analysis(&out, &analysis, &options)?;
     // Held until the report is written: no other run replaces the
     // directory under it.
     let _lock = out
@@ -131,38 +172,4 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// Checks `out` before any work and stages the run's files beside it. An
-/// existing directory is replaced only with `force`, and only when it is
-/// an earlier run's (it holds `summary.json`) or empty: --force must not
-/// remove a directory of someone else's files. Staging creates a directory
-/// beside `out`, so an unwritable place fails here.
-pub fn stage_output(out: &Path, force: bool) -> anyhow::Result<OutputDir> {
-    match std::fs::metadata(out) {
-        Ok(meta) if !meta.is_dir() => {
-            bail!("--out {} is a file, not a directory", out.display())
-        }
-        Ok(_) => {
-            ensure!(
-                force,
-                "--out {} already exists: pass --force to replace it, or choose another --out",
-                out.display()
-            );
-            let is_run = out.join("summary.json").is_file();
-            let is_empty = std::fs::read_dir(out)
-                .with_context(|| format!("cannot read --out {}", out.display()))?
-                .next()
-                .is_none();
-            ensure!(
-                is_run || is_empty,
-                "--out {} is not a kneeform run directory (no summary.json), so --force will not replace it: choose another --out",
-                out.display()
-            );
-        }
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-        Err(e) => return Err(e).with_context(|| format!("cannot use --out {}", out.display())),
-    }
-    OutputDir::stage_replacing(out)
-        .with_context(|| format!("cannot write the results to {}", out.display()))
 }

@@ -39,6 +39,15 @@ pub enum Command {
     /// Compare grid and oracle at several pitches: errors, fitted orders of
     /// convergence, and the coarsest pitch meeting --tolerance.
     Converge(ConvergeArgs),
+    /// Merge the shards of one analysis (`analyze --shard K/N`, one
+    /// directory each) into the run's results, byte for byte those of the
+    /// unsharded run (clock readings aside).
+    Merge(MergeArgs),
+    /// Run the analyses a manifest lists (parts, variants), one after the
+    /// other, skipping those whose output directory holds a complete run
+    /// of the same item: a killed batch started again resumes where it
+    /// was, losing only the item it was running.
+    Batch(BatchArgs),
     /// Write the evidence report of a run: one self-contained HTML file
     /// with views of the part, the colliding area per angle, and the
     /// verification results of any VERIFY_DIR given.
@@ -229,6 +238,20 @@ pub struct AnalyzeArgs {
     /// only the report fails (exit code 3).
     #[arg(long)]
     pub report: bool,
+    /// Also write colliding_points.csv: one row per colliding node per
+    /// angle (angle_deg,i,j,x,y,z; mm, shortest round-trip decimals). Off
+    /// by default: composite.csv holds the same sets, one row per node with
+    /// its angles as a bit mask (angle_mask), some fifty times smaller.
+    #[arg(long)]
+    pub points_csv: bool,
+    /// Compute one shard of the angles and write it as a partial result
+    /// (shard.json, shard.bin) for `kneeform merge`: shard K of N takes
+    /// the run's angles a (0-based, in --angles order) with a % N == K - 1.
+    /// 1 <= K <= N <= the number of angles. A Slurm array task passes
+    /// `--shard $((SLURM_ARRAY_TASK_ID + 1))/N`, a Kubernetes Indexed Job
+    /// `--shard $((JOB_COMPLETION_INDEX + 1))/N`. Default: every angle.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
     /// With --pitch auto: the largest decided area distance (mm) allowed
     /// between the grid's colliding area and the exact knee-form's, on a
     /// sample of starts, and between the chosen grid and the next finer.
@@ -239,6 +262,40 @@ pub struct AnalyzeArgs {
     /// with the pitch and time it would need.
     #[arg(long, default_value_t = kneeform::harness::AutoPitch::DEFAULT_BUDGET_S, value_name = "S")]
     pub budget_s: f64,
+}
+
+/// `kneeform merge`.
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The shards' directories (`analyze --shard K/N --out DIR`), one per
+    /// shard, in any order; every K from 1 to N exactly once.
+    #[arg(required = true, value_name = "SHARD_DIR")]
+    pub shards: Vec<PathBuf>,
+    /// Output directory of the merged run (created; it appears whole or
+    /// not at all). An existing one is refused unless --force is given.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Replace an existing --out directory of an earlier run (one holding
+    /// summary.json, or empty) with the merged results, whole.
+    #[arg(long)]
+    pub force: bool,
+    /// Also write colliding_points.csv (as `analyze --points-csv`).
+    #[arg(long)]
+    pub points_csv: bool,
+}
+
+/// `kneeform batch`.
+#[derive(Debug, Args)]
+pub struct BatchArgs {
+    /// The manifest (TOML): `[[item]]` tables, each one `kneeform
+    /// analyze` with `part = "FILE"` (or a list: an assembly), `out =
+    /// "DIR"` and optionally `pitch` (mm), `angles` (as --angles), `side`
+    /// and `args = ["--flag", "value", ...]` (any other analyze flags); a
+    /// `[defaults]` table of the same flags applies to every item first.
+    /// Paths are relative to the manifest's directory, where the items
+    /// run.
+    #[arg(value_name = "MANIFEST.toml")]
+    pub manifest: PathBuf,
 }
 
 /// `kneeform report`.

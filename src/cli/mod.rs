@@ -2,8 +2,10 @@
 
 pub mod analyze;
 pub mod args;
+pub mod batch;
 pub mod bench;
 pub mod converge;
+pub mod merge;
 pub mod progress;
 pub mod report;
 pub mod scenario;
@@ -13,6 +15,7 @@ use std::path::Path;
 
 use anyhow::Context;
 use kneeform::harness::HarnessError;
+use kneeform::output::OutputDir;
 use kneeform::report::ReportOptions;
 use kneeform::{PartFile, Setup};
 
@@ -105,6 +108,42 @@ pub fn set_threads(threads: Option<usize>) -> anyhow::Result<()> {
             .build_global()?;
     }
     Ok(())
+}
+
+/// Checks `out` before any work and stages the run's files beside it. An
+/// existing directory is replaced only with `force`, and only when it is
+/// an earlier run's (it holds `summary.json`) or empty: --force must not
+/// remove a directory of someone else's files. Staging creates a directory
+/// beside `out`, so an unwritable place fails here.
+pub fn stage_output(out: &Path, force: bool) -> anyhow::Result<OutputDir> {
+    use anyhow::{bail, ensure};
+    match std::fs::metadata(out) {
+        Ok(meta) if !meta.is_dir() => {
+            bail!("--out {} is a file, not a directory", out.display())
+        }
+        Ok(_) => {
+            ensure!(
+                force,
+                "--out {} already exists: pass --force to replace it, or choose another --out",
+                out.display()
+            );
+            // A run's directory, or a shard's.
+            let is_run = out.join("summary.json").is_file() || out.join("shard.json").is_file();
+            let is_empty = std::fs::read_dir(out)
+                .with_context(|| format!("cannot read --out {}", out.display()))?
+                .next()
+                .is_none();
+            ensure!(
+                is_run || is_empty,
+                "--out {} is not a kneeform run directory (no summary.json), so --force will not replace it: choose another --out",
+                out.display()
+            );
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err(e).with_context(|| format!("cannot use --out {}", out.display())),
+    }
+    OutputDir::stage_replacing(out)
+        .with_context(|| format!("cannot write the results to {}", out.display()))
 }
 
 #[cfg(test)]

@@ -1,5 +1,7 @@
-//! CSV tables of the result: the colliding points of every angle, and the
-//! composite count per node.
+//! CSV tables of the result: the composite, one row per colliding node
+//! with its count and its set of angles (the default, compact table), and
+//! on request the colliding points of every angle, one row per node and
+//! angle (`analyze --points-csv`).
 //!
 //! Coordinates are the part's own (mm): the node's x and z and its height,
 //! mapped back with [`Placement::to_part`] (y mirrored for the right side,
@@ -7,8 +9,10 @@
 //! column: the index, in `summary.json`'s `files`, of the file whose
 //! surface set the node's height; a single part's tables have no such
 //! column. Rows come in a fixed order
-//! (angle, then row j, then column i) and numbers in Rust's shortest
-//! round-trip form, so the same result always gives the same bytes.
+//! (angle, then row j, then column i) and numbers in a fixed form (the
+//! composite's coordinates rounded to 1 um, the colliding points' in Rust's
+//! shortest round-trip form), so the same result always gives the same
+//! bytes.
 
 use std::fmt::Write as _;
 use std::io::{self, Write};
@@ -74,32 +78,44 @@ pub fn write_colliding_points<W: Write>(
     Ok(())
 }
 
-/// Writes `i,j,x,y,z,angles`: one row per node that at least one angle
-/// marks colliding, in increasing j, then i; `angles` is the composite
-/// count. Coordinates as in [`write_colliding_points`]; with `node_file`
-/// (an assembly's attribution per node), a last column `file`.
+/// Writes `i,j,x,y,z,angles,angle_mask`: one row per node that at least
+/// one angle marks colliding, in increasing j, then i; `angles` is the
+/// composite count and `angle_mask` the set of those angles, a hex bit
+/// mask over the run's angles in their order ([`angle_mask`]). The
+/// coordinates are the node's in the part's frame, rounded to 1 um
+/// ([`micrometres`]); with `node_file` (an assembly's attribution per
+/// node), a last column `file`.
 ///
-/// Fails with [`io::ErrorKind::InvalidInput`] when `composite` does not have
-/// one entry per grid node.
+/// This is the run's compact per-angle result: `colliding_points.csv`
+/// ([`write_colliding_points`]) holds the same sets, one row per node and
+/// angle, some fifty times larger.
+///
+/// Fails with [`io::ErrorKind::InvalidInput`] when `composite` or a mask
+/// does not have one entry per grid node.
 pub fn write_composite<W: Write>(
     w: W,
     grid: &HeightGrid,
+    masks: &[AngleMask],
     composite: &[u16],
     placement: &Placement,
     node_file: Option<&[u32]>,
 ) -> csv::Result<()> {
     check_len("composite", composite.len(), grid)?;
+    for m in masks {
+        check_len("colliding mask", m.mask.len(), grid)?;
+    }
     if let Some(files) = node_file {
         check_len("file attribution", files.len(), grid)?;
     }
     let mut out = csv::Writer::from_writer(w);
-    let header = ["i", "j", "x", "y", "z", "angles", "file"];
-    out.write_record(&header[..6 + usize::from(node_file.is_some())])?;
+    let header = ["i", "j", "x", "y", "z", "angles", "angle_mask", "file"];
+    out.write_record(&header[..7 + usize::from(node_file.is_some())])?;
     let mut row = Row::default();
     for (k, &count) in composite.iter().enumerate().filter(|&(_, &c)| c > 0) {
         row.start();
-        row.node(grid, k, placement);
+        row.node_rounded(grid, k, placement);
         row.int(usize::from(count));
+        row.mask(masks, k);
         if let Some(files) = node_file {
             row.int(files[k] as usize);
         }
@@ -107,6 +123,45 @@ pub fn write_composite<W: Write>(
     }
     out.flush()?;
     Ok(())
+}
+
+/// The digits after the point of a coordinate in `composite.csv`: 1 um.
+pub const MICROMETRE_DIGITS: usize = 3;
+
+/// `v` (mm) rounded to 1 um and written without trailing zeros: the
+/// binary value's exact decimal expansion rounded half to even at the
+/// third digit (Rust's `{:.3}`, the same on every machine), then `12.340`
+/// as `12.34`, `12.000` as `12` and `-0` as `0`. Every value round-trips
+/// to within half a micrometre.
+pub fn micrometres(v: f64) -> String {
+    let mut s = String::new();
+    push_micrometres(&mut s, v);
+    s
+}
+
+fn push_micrometres(s: &mut String, v: f64) {
+    let start = s.len();
+    write!(s, "{v:.MICROMETRE_DIGITS$}").expect("writing to a String cannot fail");
+    if s[start..].contains('.') {
+        let kept = s.trim_end_matches('0').trim_end_matches('.').len();
+        s.truncate(kept);
+    }
+    if &s[start..] == "-0" {
+        s.truncate(start);
+        s.push('0');
+    }
+}
+
+/// The set of angles (bit `a` for `masks[a]`, in the run's order) at
+/// which node `k` collides, as `0x` and `ceil(n / 4)` hex digits, the most
+/// significant first: angle 0 is the last digit's lowest bit. A reader
+/// takes angle `a` as `(int(mask, 16) >> a) & 1` (Python's `int` takes the
+/// `0x`); the prefix keeps pandas and polars from reading a mask of decimal
+/// digits as a number.
+pub fn angle_mask(masks: &[AngleMask], k: usize) -> String {
+    let mut row = Row::default();
+    row.mask(masks, k);
+    row.text
 }
 
 fn check_len(what: &str, len: usize, grid: &HeightGrid) -> csv::Result<()> {
@@ -162,6 +217,34 @@ impl Row {
         self.num(z);
     }
 
+    /// `i, j, x, y, z` of node `k` as [`Row::node`], the coordinates
+    /// rounded to 1 um ([`micrometres`]).
+    fn node_rounded(&mut self, grid: &HeightGrid, k: usize, placement: &Placement) {
+        let (i, j) = (k % grid.spec.nx, k / grid.spec.nx);
+        self.int(i);
+        self.int(j);
+        let [x, y, z] = placement.to_part([grid.spec.x(i), grid.h[k], grid.spec.z(j)]);
+        for v in [x, y, z] {
+            push_micrometres(&mut self.text, v);
+            self.ends.push(self.text.len());
+        }
+    }
+
+    /// Node `k`'s [`angle_mask`].
+    fn mask(&mut self, masks: &[AngleMask], k: usize) {
+        self.text.push_str("0x");
+        let digits = masks.len().div_ceil(4).max(1);
+        for d in (0..digits).rev() {
+            let nibble = (0..4).fold(0u32, |n, b| {
+                let set = masks.get(4 * d + b).is_some_and(|m| m.mask[k] != 0);
+                n | (u32::from(set) << b)
+            });
+            self.text
+                .push(char::from_digit(nibble, 16).expect("a nibble is a hex digit"));
+        }
+        self.ends.push(self.text.len());
+    }
+
     fn fields(&self) -> impl Iterator<Item = &str> {
         self.field_range(0..self.ends.len())
     }
@@ -205,6 +288,44 @@ mod tests {
         }
     }
 
+    fn composite_of(masks: &[AngleMask]) -> Vec<u16> {
+        crate::engine::composite(masks)
+    }
+
+    #[test]
+    fn coordinates_are_micrometres_without_noise() {
+        for (v, s) in [
+            (313.71999999999997, "313.72"),
+            (-234.35999999999999, "-234.36"),
+            (12.0, "12"),
+            (0.0004, "0"),
+            (-0.0004, "0"),
+            (-0.0, "0"),
+            (1.0005, "1"),
+            (1.0015, "1.002"),
+            (-7.12345, "-7.123"),
+            (1e-3, "0.001"),
+        ] {
+            assert_eq!(micrometres(v), s, "{v}");
+            // Symmetric: a mirrored side negates y and nothing else.
+            let negated = match micrometres(v.abs()) {
+                zero if zero == "0" => zero,
+                m => format!("-{m}"),
+            };
+            assert_eq!(micrometres(-v.abs()), negated, "{v}");
+        }
+    }
+
+    #[test]
+    fn a_mask_has_a_digit_per_four_angles_angle_zero_lowest() {
+        let masks: Vec<AngleMask> = (0..9)
+            .map(|a| mask(f64::from(a), vec![u8::from(a == 0 || a == 8)]))
+            .collect();
+        assert_eq!(angle_mask(&masks, 0), "0x101");
+        assert_eq!(angle_mask(&masks[..1], 0), "0x1");
+        assert_eq!(angle_mask(&[], 0), "0x0");
+    }
+
     fn text(write: impl FnOnce(&mut Vec<u8>)) -> String {
         let mut buf = Vec::new();
         write(&mut buf);
@@ -244,15 +365,24 @@ mod tests {
     #[test]
     fn composite_lists_counted_nodes_only() {
         let g = grid();
+        let masks = [
+            mask(-5.0, vec![0, 1, 0, 1, 0, 1]),
+            mask(0.0, vec![0, 1, 0, 1, 0, 0]),
+            mask(5.0, vec![0, 0, 0, 1, 0, 0]),
+            mask(10.0, vec![0, 1, 0, 0, 0, 0]),
+            mask(15.0, vec![0, 0, 0, 1, 0, 0]),
+        ];
+        let counts = composite_of(&masks);
         let out = text(|buf| {
-            write_composite(buf, &g, &[0, 3, 0, 61, 0, 1], &Side::Left.into(), None).unwrap()
+            write_composite(buf, &g, &masks, &counts, &Side::Left.into(), None).unwrap()
         });
+        // Angle a is bit a: node 1 at -5, 0 and 10 is 0b01011.
         assert_eq!(
             out,
-            "i,j,x,y,z,angles\n\
-             1,0,-0.5,1.25,2,3\n\
-             0,1,-1,0.1,2.5,61\n\
-             2,1,0,7,2.5,1\n"
+            "i,j,x,y,z,angles,angle_mask\n\
+             1,0,-0.5,1.25,2,3,0x0b\n\
+             0,1,-1,0.1,2.5,4,0x17\n\
+             2,1,0,7,2.5,1,0x01\n"
         );
     }
 
@@ -273,11 +403,15 @@ mod tests {
              0,0,1,-1,0.1,2.5,2\n\
              5,2,1,0,7,2.5,1\n"
         );
+        let counts = composite_of(&masks);
         let out =
-            text(|buf| write_composite(buf, &g, &[0, 3, 0, 0, 0, 1], &left, Some(&files)).unwrap());
+            text(|buf| write_composite(buf, &g, &masks, &counts, &left, Some(&files)).unwrap());
         assert_eq!(
             out,
-            "i,j,x,y,z,angles,file\n1,0,-0.5,1.25,2,3,1\n2,1,0,7,2.5,1,1\n"
+            "i,j,x,y,z,angles,angle_mask,file\n\
+             1,0,-0.5,1.25,2,1,0x1,1\n\
+             0,1,-1,0.1,2.5,1,0x1,2\n\
+             2,1,0,7,2.5,1,0x2,1\n"
         );
     }
 
@@ -291,15 +425,18 @@ mod tests {
         };
         // Node (2, 0): analysis (0, -3, 2), vehicle (0, 3, 2); vehicle
         // (x, y, z) = part (z, x, y), so part (3, 2, 0).
-        let out =
-            text(|buf| write_composite(buf, &g, &[0, 0, 4, 0, 0, 0], &placement, None).unwrap());
-        assert_eq!(out, "i,j,x,y,z,angles\n2,0,3,2,0,4\n");
+        let masks = [mask(0.0, vec![0, 0, 1, 0, 0, 0])];
+        let out = text(|buf| {
+            write_composite(buf, &g, &masks, &composite_of(&masks), &placement, None).unwrap()
+        });
+        assert_eq!(out, "i,j,x,y,z,angles,angle_mask\n2,0,3,2,0,1,0x1\n");
     }
 
     #[test]
     fn wrong_length_is_refused() {
         let g = grid();
-        let err = write_composite(Vec::new(), &g, &[1, 2], &Side::Left.into(), None).unwrap_err();
+        let err =
+            write_composite(Vec::new(), &g, &[], &[1, 2], &Side::Left.into(), None).unwrap_err();
         assert!(err.to_string().contains("2 entries"), "{err}");
         let err = write_colliding_points(
             Vec::new(),

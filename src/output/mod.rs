@@ -1,9 +1,10 @@
-//! Result files: the colliding points and the composite as CSV, the
-//! colliding area as a binary STL surface, and the height grid and the
-//! composite as PNG images.
+//! Result files: the composite (and on request the colliding points) as
+//! CSV, the colliding area as a binary STL surface, and the height grid and
+//! the composite as PNG images.
 //!
-//! * [`write_colliding_points`], [`write_composite`]: CSV tables, one row
-//!   per node, in the part's own coordinates (mm);
+//! * [`write_composite`]: a CSV table, one row per colliding node with its
+//!   count and set of angles, in the part's own coordinates (mm, to 1 um);
+//!   [`write_colliding_points`]: one row per node and angle (on request);
 //! * [`write_colliding_area`]: the composite area as a triangle surface in
 //!   the part's coordinates (mm), facing the knee;
 //! * [`write_depth_png`], [`write_composite_png`]: images with mm axes, the
@@ -29,7 +30,9 @@ mod results;
 mod stl;
 mod surface;
 
-pub use self::csv::{write_colliding_points, write_composite};
+pub use self::csv::{
+    MICROMETRE_DIGITS, angle_mask, micrometres, write_colliding_points, write_composite,
+};
 pub use self::plot::write_plots;
 pub use self::ply::write_colliding_area_ply;
 pub(crate) use self::png::count_colour;
@@ -39,8 +42,8 @@ pub use self::png::{
     crop_window, depth_bar_ends, view_line, write_composite_png, write_depth_png,
 };
 pub use self::results::{
-    write_analysis, write_convergence, write_direct_convergence, write_direct_verification,
-    write_verification,
+    RunResults, WriteOptions, write_analysis, write_convergence, write_direct_convergence,
+    write_direct_verification, write_results, write_verification,
 };
 pub(crate) use self::stl::to_stl_triangle;
 pub use self::stl::write_colliding_area;
@@ -262,7 +265,7 @@ pub fn remove_staged() {
 /// Removes the stagings of `name` in `parent` left by processes that no
 /// longer run (killed with SIGKILL, or by a power cut): entries
 /// `.<name>.partial-<pid>-<n>` (and their `.old` asides) whose `<pid>` is
-/// not a running process. Where the system cannot say (no `/proc`),
+/// not a running process (none, or a zombie). Where the system cannot say (no `/proc`),
 /// nothing is removed.
 fn clear_stale_stagings(parent: &Path, name: &std::ffi::OsStr) {
     if !Path::new("/proc/self").exists() {
@@ -280,11 +283,25 @@ fn clear_stale_stagings(parent: &Path, name: &std::ffi::OsStr) {
         let Some(pid) = rest.split('-').next().and_then(|p| p.parse::<u32>().ok()) else {
             continue;
         };
-        let alive = Path::new("/proc").join(pid.to_string()).exists();
-        if !alive {
+        if !process_runs(pid) {
             let _ = std::fs::remove_dir_all(entry.path());
         }
     }
+}
+
+/// Whether process `pid` runs: `/proc/<pid>` exists and is not a zombie
+/// (a process killed whose parent died too waits as a zombie until
+/// something reaps it, which in a container may be never).
+fn process_runs(pid: u32) -> bool {
+    let Ok(stat) = std::fs::read_to_string(Path::new("/proc").join(pid.to_string()).join("stat"))
+    else {
+        return Path::new("/proc").join(pid.to_string()).exists();
+    };
+    // `pid (name) state ...`: the name may hold spaces and parentheses.
+    let state = stat
+        .rfind(')')
+        .and_then(|end| stat[end + 1..].split_whitespace().next());
+    !matches!(state, Some("Z" | "X"))
 }
 
 /// Syncs the file or directory at `path` to disk.
@@ -549,6 +566,14 @@ mod tests {
         }
         drop(ours);
         std::fs::remove_dir_all(root).unwrap();
+    }
+
+    #[test]
+    fn this_process_runs_and_no_process_has_the_largest_pid() {
+        if Path::new("/proc/self").exists() {
+            assert!(process_runs(std::process::id()));
+            assert!(!process_runs(u32::MAX));
+        }
     }
 
     #[test]

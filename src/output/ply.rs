@@ -9,7 +9,8 @@
 //! vertex `quality`, MeshLab's scalar per vertex. Faces join colliding nodes
 //! as in the STL (a cell with four colliding corners gives two triangles,
 //! one with three gives one), and a node in no face gets a small square of
-//! its own colour. ASCII PLY, so the file can be read and diffed as text.
+//! its own colour. ASCII PLY, so the file can be read and diffed as text;
+//! coordinates to 1 um, as in `composite.csv`.
 
 use std::io::{self, Write};
 
@@ -17,6 +18,7 @@ use crate::frame::Placement;
 use crate::grid::HeightGrid;
 
 use super::count_colour;
+use super::csv::micrometres;
 use super::surface::{AreaSurface, to_part, wound};
 
 /// Writes the composite area (nodes with `composite > 0`) as an ASCII PLY
@@ -58,15 +60,14 @@ pub fn write_colliding_area_ply<W: Write>(
     for &(v, count) in &mesh.vertices {
         let [x, y, z] = to_part(v, placement);
         let c = count_colour(usize::from(count), n);
-        // -0 is written as 0, as in the CSV files: mirroring a zero height
-        // must not change the file.
-        let num = |v: f64| if v == 0.0 { 0.0 } else { v };
+        // To 1 um, as composite.csv (-0 as 0: mirroring a zero height must
+        // not change the file).
         writeln!(
             w,
             "{} {} {} {} {} {} {count}",
-            num(x),
-            num(y),
-            num(z),
+            micrometres(x),
+            micrometres(y),
+            micrometres(z),
             c.0,
             c.1,
             c.2

@@ -1,8 +1,8 @@
 //! Each command's result files, from the library's results: an analysis
-//! ([`write_analysis`]), a verification ([`write_verification`]), a
-//! convergence study ([`write_convergence`]), and the same two for the
-//! direct approach ([`write_direct_verification`],
-//! [`write_direct_convergence`]).
+//! ([`write_analysis`], or [`write_results`] from its results merged from
+//! shards), a verification ([`write_verification`]), a convergence study
+//! ([`write_convergence`]), and the same two for the direct approach
+//! ([`write_direct_verification`], [`write_direct_convergence`]).
 
 use std::io::{BufWriter, Write};
 use std::path::Path;
@@ -10,19 +10,90 @@ use std::time::Instant;
 
 use super::{OutputDir, WriteError};
 use crate::analysis::Analysis;
+use crate::blind::BlindSpot;
+use crate::engine::AngleMask;
+use crate::frame::Placement;
+use crate::grid::HeightGrid;
 use crate::harness::{Convergence, DirectConvergence, DirectVerification, Verification};
 use crate::summary::Summary;
 
+/// What [`write_analysis`] writes besides the default files.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct WriteOptions {
+    /// Also `colliding_points.csv`, one row per colliding node per angle
+    /// (`analyze --points-csv`): the sets `composite.csv`'s `angle_mask`
+    /// holds, some fifty times larger.
+    pub points_csv: bool,
+}
+
+/// An analysis's results as the writers take them: from an
+/// [`Analysis`], or from the shards of one, merged (`kneeform merge`).
+#[derive(Debug, Clone, Copy)]
+pub struct RunResults<'a> {
+    /// The height grid.
+    pub grid: &'a HeightGrid,
+    /// The colliding mask per angle, in the run's order.
+    pub masks: &'a [AngleMask],
+    /// Per node, the angles at which it collides.
+    pub composite: &'a [u16],
+    /// An assembly's file per node.
+    pub node_file: Option<&'a [u32]>,
+    /// Where the part's frame is.
+    pub placement: &'a Placement,
+    /// The blind spots, with the angles meeting them.
+    pub blind_spots: &'a [BlindSpot],
+    /// The knee-form's triangle side L (mm), for the composite's title.
+    pub triangle_side: f64,
+}
+
+impl<'a> RunResults<'a> {
+    /// The results of `analysis`.
+    pub fn of(analysis: &'a Analysis, placement: &'a Placement) -> RunResults<'a> {
+        RunResults {
+            grid: &analysis.grid,
+            masks: &analysis.masks,
+            composite: &analysis.composite,
+            node_file: analysis.node_file.as_deref(),
+            placement,
+            blind_spots: &analysis.blind_spots,
+            triangle_side: analysis.setup.knee.triangle_side,
+        }
+    }
+}
+
 /// Writes the files of an analysis into the staged directory `out`: the
-/// colliding points and the composite as CSV, the colliding area as STL
-/// and PLY, the depth and composite images, and `summary.json` last, with
-/// the writing time. Returns the summary written.
-pub fn write_analysis(out: &OutputDir, analysis: &Analysis) -> Result<Summary, WriteError> {
+/// composite as CSV (with `options.points_csv`, the colliding points too),
+/// the colliding area as STL and PLY, the depth and composite images, and
+/// `summary.json` last, with the writing time. Returns the summary written.
+pub fn write_analysis(
+    out: &OutputDir,
+    analysis: &Analysis,
+    options: &WriteOptions,
+) -> Result<Summary, WriteError> {
     let t = Instant::now();
     let placement = analysis.placement();
-    let node_file = analysis.node_file.as_deref();
-    let grid = &analysis.grid;
-    let (masks, counts) = (&analysis.masks, &analysis.composite);
+    write_results(
+        out,
+        &RunResults::of(analysis, &placement),
+        analysis.summary(),
+        options,
+        t,
+    )
+}
+
+/// Writes `results` and `summary` (its `write_s` and `total_s` set from
+/// `started`, `peak_rss_mib` measured) into the staged directory `out`:
+/// [`write_analysis`]'s files.
+pub fn write_results(
+    out: &OutputDir,
+    results: &RunResults,
+    mut summary: Summary,
+    options: &WriteOptions,
+    started: Instant,
+) -> Result<Summary, WriteError> {
+    let placement = results.placement;
+    let (grid, masks, counts) = (results.grid, results.masks, results.composite);
+    let node_file = results.node_file;
     let file =
         |name: &str, write: &dyn Fn(&mut BufWriter<std::fs::File>) -> std::io::Result<()>| {
             let path = out.path(name);
@@ -34,42 +105,43 @@ pub fn write_analysis(out: &OutputDir, analysis: &Analysis) -> Result<Summary, W
                 })
                 .map_err(WriteError::at(&path))
         };
-    file("colliding_points.csv", &|w| {
-        Ok(super::write_colliding_points(
-            w, grid, masks, &placement, node_file,
-        )?)
-    })?;
+    if options.points_csv {
+        file("colliding_points.csv", &|w| {
+            Ok(super::write_colliding_points(
+                w, grid, masks, placement, node_file,
+            )?)
+        })?;
+    }
     file("composite.csv", &|w| {
         Ok(super::write_composite(
-            w, grid, counts, &placement, node_file,
+            w, grid, masks, counts, placement, node_file,
         )?)
     })?;
     file("colliding_area.stl", &|w| {
-        super::write_colliding_area(w, grid, counts, &placement).map(drop)
+        super::write_colliding_area(w, grid, counts, placement).map(drop)
     })?;
     file("colliding_area.ply", &|w| {
-        super::write_colliding_area_ply(w, grid, counts, masks.len(), &placement).map(drop)
+        super::write_colliding_area_ply(w, grid, counts, masks.len(), placement).map(drop)
     })?;
-    super::write_depth_png(&out.path("depth.png"), grid, &placement)?;
+    super::write_depth_png(&out.path("depth.png"), grid, placement)?;
     let title = format!(
         "Composite colliding area, {} angles (L = {} mm)",
         masks.len(),
-        analysis.setup.knee.triangle_side
+        results.triangle_side
     );
-    let blind: Vec<(usize, usize)> = analysis.blind_spots.iter().map(|b| (b.i, b.j)).collect();
+    let blind: Vec<(usize, usize)> = results.blind_spots.iter().map(|b| (b.i, b.j)).collect();
     super::write_composite_png(
         &out.path("composite.png"),
         grid,
         counts,
         masks.len(),
         &title,
-        &placement,
+        placement,
         &blind,
     )?;
-    write_blind_spots(&out.path("blind_spots.csv"), analysis)?;
-    let mut summary = analysis.summary();
+    write_blind_spots(&out.path("blind_spots.csv"), results.blind_spots)?;
     let t_ = &mut summary.timings;
-    t_.write_s = t.elapsed().as_secs_f64();
+    t_.write_s = started.elapsed().as_secs_f64();
     t_.total_s = t_.read_s + t_.sample_s + t_.push_slide_s + t_.write_s;
     summary.peak_rss_mib = crate::memory::peak_rss_bytes().map(|b| b / (1024.0 * 1024.0));
     write_json(&out.path("summary.json"), &summary)?;
@@ -224,11 +296,11 @@ pub fn write_direct_convergence(
 /// where (cell `i, j`; `x, z` of its lowest point, mm, part frame), how
 /// deep and wide, the pitch resolving it, and the angles at which the
 /// knee-form meets it (`;`-separated, empty when none).
-fn write_blind_spots(path: &Path, analysis: &Analysis) -> Result<(), WriteError> {
+fn write_blind_spots(path: &Path, spots: &[BlindSpot]) -> Result<(), WriteError> {
     (|| -> csv::Result<()> {
         let mut csv = csv::Writer::from_path(path)?;
         csv.write_record(crate::blind::CSV_COLUMNS)?;
-        for b in &analysis.blind_spots {
+        for b in spots {
             let angles: Vec<String> = b.met_angles_deg.iter().map(f64::to_string).collect();
             csv.write_record([
                 b.i.to_string(),

@@ -582,7 +582,7 @@ fn per_angle_section(inputs: &Inputs) -> Markup {
                 figcaption {
                     "The analysed side at single knee-form angles (the paper's Figure 12): in "
                     span style=(format!("color: rgb({r},{g},{b}); font-weight: bold")) { "red" }
-                    ", the points that angle strikes (" code { "colliding_points.csv" } ")."
+                    ", the points that angle strikes (" code { "composite.csv" } "'s " code { "angle_mask" } ")."
                 }
                 "\n"
             }

@@ -1,6 +1,7 @@
 //! Reading an `analyze` run directory back: `summary.json` (typed, and as
 //! raw JSON so the report can cite every number by its JSON pointer), the
-//! composite and per-angle masks from the CSV files, and the part, re-read
+//! composite and per-angle masks from `composite.csv` (or an earlier
+//! version's `colliding_points.csv`), and the part, re-read
 //! from the file the run names and checked against its SHA-256.
 
 use std::collections::BTreeMap;
@@ -214,8 +215,60 @@ impl Run {
     }
 
     /// The colliding masks of `angles` (degrees, each one of the run's),
-    /// from `colliding_points.csv`, as counts of 1.
+    /// as counts of 1: from `composite.csv`'s `angle_mask` (bit `a` for
+    /// the run's angle `a`), or, for a run of a version that wrote no
+    /// masks, from `colliding_points.csv`.
     pub fn angle_masks(&self, angles: &[f64]) -> Result<Vec<NodeCounts>, ReportError> {
+        let composite = self.dir.join("composite.csv");
+        if !CsvRows::open(&composite, &[])?.has_column("angle_mask") {
+            return self.angle_masks_of_points(angles);
+        }
+        let run_angles = &self.summary.angles_deg;
+        let bits: Vec<usize> = angles
+            .iter()
+            .map(|a| {
+                run_angles
+                    .iter()
+                    .position(|r| r.to_bits() == a.to_bits())
+                    .ok_or_else(|| ReportError::Inconsistent {
+                        path: self.dir.join("summary.json"),
+                        reason: format!("angle {a} is not one of the run's"),
+                    })
+            })
+            .collect::<Result<_, _>>()?;
+        let mut masks: Vec<NodeCounts> = angles
+            .iter()
+            .map(|_| NodeCounts::empty(self.spec))
+            .collect::<Result<_, _>>()?;
+        let mut rows = CsvRows::open(&composite, &["i", "j", "x", "y", "z", "angle_mask"])?;
+        let digits = run_angles.len().div_ceil(4).max(1);
+        while let Some(row) = rows.next_row()? {
+            let (k, y) = rows.node(&row, self.spec, &self.frame, self.axes)?;
+            let field = row.get(rows.columns[5]).unwrap_or("");
+            let hex = field
+                .strip_prefix("0x")
+                .filter(|h| h.len() == digits && h.bytes().all(|b| b.is_ascii_hexdigit()))
+                .ok_or_else(|| {
+                    rows.bad(format!(
+                        "angle_mask = {field:?} is not 0x and {digits} hex digits"
+                    ))
+                })?;
+            for (mask, &a) in masks.iter_mut().zip(&bits) {
+                // Digit d (from the right) holds angles 4d..4d+4.
+                let digit = hex.as_bytes()[digits - 1 - a / 4];
+                let nibble = char::from(digit).to_digit(16).expect("checked hex");
+                if nibble >> (a % 4) & 1 == 1 {
+                    mask.count[k] = 1;
+                    mask.y[k] = y;
+                }
+            }
+        }
+        Ok(masks)
+    }
+
+    /// [`Run::angle_masks`] from `colliding_points.csv`, as earlier
+    /// versions wrote it by default.
+    fn angle_masks_of_points(&self, angles: &[f64]) -> Result<Vec<NodeCounts>, ReportError> {
         let path = self.dir.join("colliding_points.csv");
         let mut masks: BTreeMap<u64, NodeCounts> = angles
             .iter()
@@ -282,6 +335,12 @@ pub fn same_coordinate(v: f64, node: f64, pitch: f64) -> bool {
     (v - node).abs() <= ORIGIN_TOL * node.abs().max(pitch)
 }
 
+/// How far a coordinate of a `composite.csv` with an `angle_mask` may be
+/// from its node (mm): it was rounded to 1 um, half a micrometre per
+/// coordinate, and through a `--frame` rotation up to sqrt(3) times that
+/// in one vehicle coordinate (0.87 um); 1 um bounds both.
+pub const ROUNDED_TOL_MM: f64 = 1e-3;
+
 fn read_composite(
     path: &Path,
     spec: GridSpec,
@@ -341,6 +400,10 @@ struct CsvRows {
     columns: Vec<usize>,
     names: Vec<String>,
     line: u64,
+    headers: csv::StringRecord,
+    /// How far a coordinate may be from its node beyond float rounding
+    /// (mm): [`ROUNDED_TOL_MM`] in a table of rounded coordinates.
+    rounding: f64,
 }
 
 impl CsvRows {
@@ -364,13 +427,21 @@ impl CsvRows {
                     .ok_or_else(|| bad(format!("no column {w:?}")))
             })
             .collect::<Result<_, _>>()?;
+        // The compact composite (it has the masks) rounds to 1 um.
+        let rounded = headers.iter().any(|h| h == "angle_mask");
         Ok(CsvRows {
             path: path.to_path_buf(),
             reader,
             columns,
             names: wanted.iter().map(|w| w.to_string()).collect(),
             line: 1,
+            headers,
+            rounding: if rounded { ROUNDED_TOL_MM } else { 0.0 },
         })
+    }
+
+    fn has_column(&self, name: &str) -> bool {
+        self.headers.iter().any(|h| h == name)
     }
 
     fn bad(&self, reason: String) -> ReportError {
@@ -440,11 +511,10 @@ impl CsvRows {
                 .fold(spec.pitch, |m, c| m.max(c.abs()))
         };
         let scale = spec.pitch.max(reach);
-        if i >= spec.nx
-            || j >= spec.nz
-            || !same_coordinate(x, spec.x(i), scale)
-            || !same_coordinate(z, spec.z(j), scale)
-        {
+        let near = |v: f64, node: f64| {
+            same_coordinate(v, node, scale) || (v - node).abs() <= self.rounding
+        };
+        if i >= spec.nx || j >= spec.nz || !near(x, spec.x(i)) || !near(z, spec.z(j)) {
             return Err(self.bad(format!(
                 "node ({i}, {j}) at x = {x}, z = {z} is not a node of the run's {} x {} grid",
                 spec.nx, spec.nz

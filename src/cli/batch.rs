@@ -1,0 +1,197 @@
+//! `kneeform batch MANIFEST.toml`: many analyses (parts, variants) one
+//! after the other, resumable. Each item of the manifest is one `kneeform
+//! analyze`, run as a child process of this binary with `--force`; when it
+//! has succeeded, its fingerprint (this kneeform's version, the item's
+//! arguments and the SHA-256 of its part files) is written into its
+//! output directory as `batch-item.json`. An item whose directory holds a
+//! run (`summary.json`, or a shard's `shard.json`) with the same
+//! fingerprint is skipped, so a batch
+//! killed part way and started again loses only the item it was running:
+//! `analyze` leaves no partial directory, and an item whose fingerprint
+//! was not yet written runs again.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+
+use anyhow::{Context, bail, ensure};
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use super::args::BatchArgs;
+
+/// The manifest file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Manifest {
+    /// Flags of every item: its own `pitch`, `angles` and `side` replace
+    /// these, its `args` follow these.
+    #[serde(default)]
+    defaults: Flags,
+    /// The analyses, in order.
+    #[serde(default, rename = "item")]
+    items: Vec<Item>,
+}
+
+/// `analyze` flags: a few by name, any others as written.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Flags {
+    pitch: Option<f64>,
+    angles: Option<String>,
+    side: Option<String>,
+    #[serde(default)]
+    args: Vec<String>,
+}
+
+/// One analysis.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Item {
+    /// Its part file(s): one path, or several (an assembly).
+    part: PartPaths,
+    /// Its output directory.
+    out: PathBuf,
+    #[serde(flatten)]
+    flags: Flags,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+enum PartPaths {
+    One(PathBuf),
+    Many(Vec<PathBuf>),
+}
+
+impl Flags {
+    /// Appends the flags of `item` over `defaults`: its `pitch`, `angles`
+    /// and `side` replace the defaults', its `args` follow theirs.
+    fn push_onto(defaults: &Flags, item: &Flags, argv: &mut Vec<String>) {
+        if let Some(p) = item.pitch.or(defaults.pitch) {
+            argv.extend(["--pitch".into(), p.to_string()]);
+        }
+        if let Some(a) = item.angles.as_ref().or(defaults.angles.as_ref()) {
+            argv.push(format!("--angles={a}"));
+        }
+        if let Some(s) = item.side.as_ref().or(defaults.side.as_ref()) {
+            argv.extend(["--side".into(), s.clone()]);
+        }
+        argv.extend(defaults.args.iter().chain(&item.args).cloned());
+    }
+}
+
+/// `batch-item.json`: what an item's run was made from.
+#[derive(Debug, Serialize, Deserialize, PartialEq)]
+struct Fingerprint {
+    /// SHA-256 over the version, the arguments and the parts' SHA-256.
+    fingerprint: String,
+    /// The `analyze` arguments (run in the manifest's directory).
+    args: Vec<String>,
+}
+
+/// The file in an item's output directory holding its [`Fingerprint`].
+const FINGERPRINT_FILE: &str = "batch-item.json";
+
+pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
+    let text = std::fs::read_to_string(&args.manifest)
+        .with_context(|| format!("cannot read the manifest {}", args.manifest.display()))?;
+    let manifest: Manifest = toml::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("{}", e.message()))
+        .with_context(|| format!("manifest {}", args.manifest.display()))?;
+    ensure!(
+        !manifest.items.is_empty(),
+        "manifest {}: no [[item]]: each is one analysis (part, out, flags)",
+        args.manifest.display()
+    );
+    // Relative paths in the manifest are relative to its directory: the
+    // items run there.
+    let base = match args.manifest.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let mut outs = std::collections::BTreeSet::new();
+    for (k, item) in manifest.items.iter().enumerate() {
+        ensure!(
+            outs.insert(&item.out),
+            "manifest {}: item {} writes to {}, as an earlier item does",
+            args.manifest.display(),
+            k + 1,
+            item.out.display()
+        );
+    }
+    let exe = std::env::current_exe().context("cannot find this kneeform binary")?;
+    let total = manifest.items.len();
+    let (mut ran, mut skipped) = (0, 0);
+    for (k, item) in manifest.items.iter().enumerate() {
+        let parts = match &item.part {
+            PartPaths::One(p) => vec![p.clone()],
+            PartPaths::Many(p) => p.clone(),
+        };
+        let mut argv = vec!["analyze".to_string()];
+        argv.extend(parts.iter().map(|p| p.display().to_string()));
+        argv.extend(["--out".into(), item.out.display().to_string()]);
+        Flags::push_onto(&manifest.defaults, &item.flags, &mut argv);
+        let what = format!("batch item {}/{total}, {}", k + 1, item.out.display());
+        let fingerprint = fingerprint(&base, &parts, &argv).with_context(|| what.clone())?;
+        let out = base.join(&item.out);
+        if is_done(&out, &fingerprint) {
+            eprintln!("kneeform: {what}: skipped, its run is complete (same fingerprint)");
+            skipped += 1;
+            continue;
+        }
+        eprintln!("kneeform: {what}: kneeform {}", argv.join(" "));
+        // --force: an earlier run of another fingerprint is replaced whole
+        // (never a directory of other files: analyze refuses those).
+        let status = Command::new(&exe)
+            .args(&argv)
+            .arg("--force")
+            .current_dir(&base)
+            .status()
+            .with_context(|| format!("{what}: cannot start {}", exe.display()))?;
+        if !status.success() {
+            bail!(
+                "{what} failed ({status}); the items before it are complete, and `kneeform batch` again resumes here"
+            );
+        }
+        let record = Fingerprint {
+            fingerprint: fingerprint.clone(),
+            args: argv,
+        };
+        let text = serde_json::to_string_pretty(&record)? + "\n";
+        kneeform::output::write_file_atomically(&out.join(FINGERPRINT_FILE), |w| {
+            use std::io::Write;
+            w.write_all(text.as_bytes())
+        })
+        .with_context(|| format!("{what}: cannot record its fingerprint"))?;
+        ran += 1;
+    }
+    eprintln!("kneeform: batch done: {ran} items run, {skipped} skipped (complete)");
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Whether `out` holds a complete run (or shard: `--shard` in the item's
+/// flags) of this fingerprint.
+fn is_done(out: &Path, fingerprint: &str) -> bool {
+    let recorded = std::fs::read_to_string(out.join(FINGERPRINT_FILE))
+        .ok()
+        .and_then(|t| serde_json::from_str::<Fingerprint>(&t).ok());
+    let complete = out.join("summary.json").is_file() || out.join("shard.json").is_file();
+    complete && recorded.is_some_and(|r| r.fingerprint == fingerprint)
+}
+
+/// SHA-256 over this kneeform's version, `argv` and each part file's
+/// SHA-256.
+fn fingerprint(base: &Path, parts: &[PathBuf], argv: &[String]) -> anyhow::Result<String> {
+    let mut hash = Sha256::new();
+    hash.update(env!("CARGO_PKG_VERSION").as_bytes());
+    for a in argv {
+        hash.update((a.len() as u64).to_le_bytes());
+        hash.update(a.as_bytes());
+    }
+    for p in parts {
+        let path = base.join(p);
+        let bytes = kneeform::limits::read_bounded(&path, kneeform::limits::MAX_PART_FILE_BYTES)
+            .with_context(|| format!("cannot read the part {}", path.display()))?;
+        hash.update(kneeform::mesh::sha256_hex(&bytes).as_bytes());
+    }
+    Ok(hash.finalize().iter().map(|b| format!("{b:02x}")).collect())
+}
