@@ -151,10 +151,7 @@ pub fn write_results(
 /// Writes `verify.csv` (one row per start and angle) and `verify.json`
 /// into `dir`, which appears with both or is left as it was.
 pub fn write_verification(dir: &Path, verification: &Verification) -> Result<(), WriteError> {
-    let out = OutputDir::stage(dir).map_err(|source| WriteError::Commit {
-        path: dir.to_path_buf(),
-        source,
-    })?;
+    let out = stage(dir)?;
     write_rows(&out.path("verify.csv"), &verification.comparison.rows)?;
     write_json(&out.path("verify.json"), &verification.summary)?;
     commit(out, dir)
@@ -165,10 +162,7 @@ pub fn write_verification(dir: &Path, verification: &Verification) -> Result<(),
 /// `converge.json` and the plots; `dir` appears with all of them or is
 /// left as it was.
 pub fn write_convergence(dir: &Path, convergence: &Convergence) -> Result<(), WriteError> {
-    let out = OutputDir::stage(dir).map_err(|source| WriteError::Commit {
-        path: dir.to_path_buf(),
-        source,
-    })?;
+    let out = stage(dir)?;
     let results = &convergence.results;
     let tolerance = convergence.summary.tolerance_mm;
     let path = out.path("converge.csv");
@@ -216,10 +210,7 @@ pub fn write_direct_verification(
     dir: &Path,
     verification: &DirectVerification,
 ) -> Result<(), WriteError> {
-    let out = OutputDir::stage(dir).map_err(|source| WriteError::Commit {
-        path: dir.to_path_buf(),
-        source,
-    })?;
+    let out = stage(dir)?;
     write_rows(&out.path("verify.csv"), &verification.comparison.rows)?;
     write_json(&out.path("verify.json"), &verification.summary)?;
     commit(out, dir)
@@ -232,10 +223,7 @@ pub fn write_direct_convergence(
     dir: &Path,
     convergence: &DirectConvergence,
 ) -> Result<(), WriteError> {
-    let out = OutputDir::stage(dir).map_err(|source| WriteError::Commit {
-        path: dir.to_path_buf(),
-        source,
-    })?;
+    let out = stage(dir)?;
     let tolerance = convergence.summary.tolerance_mm;
     let path = out.path("converge.csv");
     (|| -> csv::Result<()> {
@@ -317,6 +305,14 @@ fn write_blind_spots(path: &Path, spots: &[BlindSpot]) -> Result<(), WriteError>
         Ok(())
     })()
     .map_err(WriteError::at(path))
+}
+
+/// Stages `dir` for a verification's or a convergence study's files.
+fn stage(dir: &Path) -> Result<OutputDir, WriteError> {
+    OutputDir::stage(dir).map_err(|source| WriteError::Commit {
+        path: dir.to_path_buf(),
+        source,
+    })
 }
 
 /// Writes `value` as pretty JSON with a final newline.
