@@ -137,17 +137,7 @@ pub fn grid_around(bbox: &Bbox, knee: &KneeForm, angles: &[f64], pitch: f64) -> 
         }
     }
     let half = knee.thickness / 2.0;
-    let i_lo = ((bbox.min[0] - half) / pitch).floor() as i64;
-    let i_hi = ((bbox.max[0] + half) / pitch).ceil() as i64;
-    let j_lo = ((bbox.min[2] - zh) / pitch).floor() as i64;
-    let j_hi = ((bbox.max[2] - zl) / pitch).ceil() as i64;
-    GridSpec {
-        pitch,
-        i_origin: i_lo,
-        j_origin: j_lo,
-        nx: (i_hi - i_lo + 1) as usize,
-        nz: (j_hi - j_lo + 1) as usize,
-    }
+    GridSpec::reaching(bbox, (-half, half), (zl, zh), pitch)
 }
 
 /// Per grid row, the extreme (`pick`: `f64::min` or `f64::max`) of `row`

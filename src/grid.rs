@@ -97,10 +97,17 @@ impl GridSpec {
             fz_lo = fz_lo.min(zl);
             fz_hi = fz_hi.max(zh);
         }
-        let i_lo = ((bbox.min[0] - fx_hi) / pitch).floor() as i64;
-        let i_hi = ((bbox.max[0] - fx_lo) / pitch).ceil() as i64;
-        let j_lo = ((bbox.min[2] - fz_hi) / pitch).floor() as i64;
-        let j_hi = ((bbox.max[2] - fz_lo) / pitch).ceil() as i64;
+        GridSpec::reaching(bbox, (fx_lo, fx_hi), (fz_lo, fz_hi), pitch)
+    }
+
+    /// Every node from which a shape spanning `x` and `z` (mm, relative to
+    /// the node) can reach `bbox`'s xz extent, snapped outwards to
+    /// multiples of the pitch.
+    pub(crate) fn reaching(bbox: &Bbox, x: (f64, f64), z: (f64, f64), pitch: f64) -> GridSpec {
+        let i_lo = ((bbox.min[0] - x.1) / pitch).floor() as i64;
+        let i_hi = ((bbox.max[0] - x.0) / pitch).ceil() as i64;
+        let j_lo = ((bbox.min[2] - z.1) / pitch).floor() as i64;
+        let j_hi = ((bbox.max[2] - z.0) / pitch).ceil() as i64;
         GridSpec {
             pitch,
             i_origin: i_lo,
