@@ -343,6 +343,7 @@ fn fast_band_impl<const W: usize>(
         return 0;
     };
     let nx = padded.spec.nx as i64;
+    let layers: Vec<_> = band.iter().map(|&j0| layer.within(j0, nz)).collect();
     let mut carry = vec![f64::NEG_INFINITY; band.len()];
     let mut placed = 0;
     let mut block_end = hi;
@@ -368,7 +369,8 @@ fn fast_band_impl<const W: usize>(
                     placed += 1;
                 }
             }
-            let (after, layer_min) = slide_block(h, reach, &layer, base, level);
+            let layer = &layers[k];
+            let (after, layer_min) = slide_block(h, reach, layer, base, level);
             // Starts that are not placed continue the slide of the start on
             // their +x side, from +x to -x.
             let mut c = carry[k];
@@ -376,7 +378,7 @@ fn fast_band_impl<const W: usize>(
                 if level[w] != f64::NEG_INFINITY {
                     c = after[w];
                 } else if c != f64::NEG_INFINITY && layer_min[w] != f64::INFINITY {
-                    c = slide_carried(h, reach, &layer, base + w, c);
+                    c = slide_carried(h, reach, layer, base + w, c);
                 }
             }
             carry[k] = c;

@@ -32,22 +32,46 @@ use crate::padded::{PaddedGrid, fmax, fmin};
 pub struct LayerRows {
     offsets: Vec<isize>,
     groups: Vec<std::ops::Range<usize>>,
+    /// Each offset's footprint row `dj`.
+    dj: Vec<i32>,
 }
 
 impl LayerRows {
     /// Lays out `fp`'s first layer on `grid`.
     pub fn new(grid: &PaddedGrid, fp: &GridFootprint) -> LayerRows {
+        let rows = || fp.slide_order.iter().map(|&r| &fp.rows[r as usize]);
         LayerRows {
-            offsets: fp
-                .slide_order
-                .iter()
-                .map(|&r| {
-                    let row = &fp.rows[r as usize];
-                    grid.offset(row.dj, row.kf)
-                })
-                .collect(),
+            offsets: rows().map(|row| grid.offset(row.dj, row.kf)).collect(),
             groups: fp.groups.clone(),
+            dj: rows().map(|row| row.dj).collect(),
         }
+    }
+
+    /// The layer of a start in row `j0` of a grid of `nz` rows without the
+    /// nodes on the `+inf` padding rows: there a visit changes no level and
+    /// its reach is never judged, so skipping it changes nothing but the
+    /// time. Borrowed where every row is real.
+    pub fn within(&self, j0: usize, nz: usize) -> std::borrow::Cow<'_, LayerRows> {
+        let real = |dj: i32| (0..nz as i64).contains(&(j0 as i64 + i64::from(dj)));
+        if self.dj.iter().all(|&dj| real(dj)) {
+            return std::borrow::Cow::Borrowed(self);
+        }
+        let mut layer = LayerRows {
+            offsets: Vec::new(),
+            groups: Vec::new(),
+            dj: Vec::new(),
+        };
+        for g in &self.groups {
+            let start = layer.offsets.len();
+            for n in g.clone().filter(|&n| real(self.dj[n])) {
+                layer.offsets.push(self.offsets[n]);
+                layer.dj.push(self.dj[n]);
+            }
+            if layer.offsets.len() > start {
+                layer.groups.push(start..layer.offsets.len());
+            }
+        }
+        std::borrow::Cow::Owned(layer)
     }
 }
 
