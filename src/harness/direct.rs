@@ -43,6 +43,7 @@ use serde::{Deserialize, Serialize};
 use super::HarnessError;
 use super::compare::{StartSelection, choose_nodes, node_at};
 use super::converge::{Fit, fit_power_law};
+use super::metrics::{nearest_rank, sorted_abs};
 use super::verify::{check_selection, check_tolerance};
 use super::{ConvergeOptions, VerifyOptions};
 use crate::analysis::{Approach, Progress, Setup};
@@ -175,16 +176,14 @@ pub struct DirectStats {
 impl DirectStats {
     /// Statistics of the absolute values of `values`.
     pub fn of(values: &[f64]) -> DirectStats {
-        if values.is_empty() {
+        let v = sorted_abs(values);
+        if v.is_empty() {
             return DirectStats::default();
         }
-        let mut v: Vec<f64> = values.iter().map(|x| x.abs()).collect();
-        v.sort_by(f64::total_cmp);
-        let rank = |q: f64| v[((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
         DirectStats {
             max: v[v.len() - 1],
-            p95: rank(0.95),
-            median: rank(0.5),
+            p95: nearest_rank(&v, 0.95),
+            median: nearest_rank(&v, 0.5),
             mean: v.iter().sum::<f64>() / v.len() as f64,
             n: v.len(),
         }

@@ -59,19 +59,30 @@ pub struct Stats {
 impl Stats {
     /// Statistics of the absolute values of `values` (all zero when empty).
     pub fn of(values: &[f64]) -> Stats {
-        if values.is_empty() {
+        let v = sorted_abs(values);
+        if v.is_empty() {
             return Stats::default();
         }
-        let mut v: Vec<f64> = values.iter().map(|x| x.abs()).collect();
-        v.sort_by(f64::total_cmp);
-        let rank = ((0.95 * v.len() as f64).ceil() as usize).clamp(1, v.len());
         Stats {
             max: v[v.len() - 1],
-            p95: v[rank - 1],
+            p95: nearest_rank(&v, 0.95),
             mean: v.iter().sum::<f64>() / v.len() as f64,
             n: v.len(),
         }
     }
+}
+
+/// The absolute values of `values`, ascending.
+pub(crate) fn sorted_abs(values: &[f64]) -> Vec<f64> {
+    let mut v: Vec<f64> = values.iter().map(|x| x.abs()).collect();
+    v.sort_by(f64::total_cmp);
+    v
+}
+
+/// The `q` quantile of ascending, non-empty `sorted`, by nearest rank.
+pub(crate) fn nearest_rank(sorted: &[f64], q: f64) -> f64 {
+    let n = sorted.len();
+    sorted[((q * n as f64).ceil() as usize).clamp(1, n) - 1]
 }
 
 /// SPEC's tie band around the deflection threshold: an exact contact whose
