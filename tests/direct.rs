@@ -3,12 +3,12 @@
 //! approaches"; `src/direct.rs`), and on the pocket behind a ridge, the
 //! area it cannot reach and push-and-slide strikes.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use kneeform::direct::{DirectFootprint, contact_levels, direct_mask};
 use kneeform::{Analysis, Approach, HeightGrid, KneeForm, Setup, Side};
 
-use crate::util::{SEEDS, random_grid_quantised, row_start, triangle};
+use crate::util::{SEEDS, ok, random_grid_quantised, row_start, scenario_file, triangle};
 
 /// The definition, per position and per footprint node, with the test's
 /// own footprint geometry (`util::row_start`): `Y*` per position (`+inf`
@@ -109,10 +109,6 @@ fn fast_equals_brute_force_on_seeded_random_grids() {
     assert!(contacts > 1000 && placed > 10_000, "{contacts} {placed}");
 }
 
-fn scenario(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenarios/{name}.toml"))
-}
-
 /// The composite's nodes of `analysis` as points of the part (mm).
 fn composite_points(analysis: &Analysis) -> Vec<[f64; 3]> {
     let placement = analysis.placement();
@@ -148,7 +144,7 @@ fn the_direct_approach_cannot_reach_the_pocket_behind_the_ridge() {
             approach,
             ..Setup::default()
         };
-        let path = scenario("pocket-behind-ridge");
+        let path = scenario_file("pocket-behind-ridge");
         Analysis::of_file(&path, 1.0, Side::Left, &setup, &()).unwrap()
     };
     let (slide, direct) = (run(Approach::Slide), run(Approach::Direct));
@@ -195,19 +191,10 @@ fn kneeform_cli(dir: &Path, args: &[&str]) -> std::process::Output {
         .expect("the binary runs")
 }
 
-fn ok(out: std::process::Output, what: &str) -> std::process::Output {
-    assert!(
-        out.status.success(),
-        "{what}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
 #[test]
 fn the_report_compares_a_direct_run_with_a_slide_run_of_the_same_part() {
     let dir = crate::util::scratch_dir("direct-compare");
-    let scenario = scenario("pocket-behind-ridge");
+    let scenario = scenario_file("pocket-behind-ridge");
     let part = scenario.to_str().unwrap();
     let common = ["--pitch", "8", "--angles=-30,0,30"];
     for (approach, out) in [("slide", "slide"), ("direct", "direct")] {
@@ -278,7 +265,7 @@ fn the_right_side_of_a_mirrored_part_gives_the_mirrored_direct_result() {
     // the right side: the same analysis, so the same contacts with y
     // negated, in the part's own coordinates.
     use kneeform::{Part, PartFile};
-    let file = kneeform::scenario::load(&scenario("pocket-behind-ridge")).unwrap();
+    let file = kneeform::scenario::load(&scenario_file("pocket-behind-ridge")).unwrap();
     let left = file.triangulate(None);
     // (The winding kept: read for the right side, these are the left
     // part's triangles to the bit, so any difference is the mapping back.)
@@ -314,7 +301,7 @@ fn the_right_side_of_a_mirrored_part_gives_the_mirrored_direct_result() {
 #[test]
 fn verify_compares_the_direct_approach_with_its_exact_oracle() {
     let dir = crate::util::scratch_dir("direct-verify");
-    let part = scenario("pocket-behind-ridge");
+    let part = scenario_file("pocket-behind-ridge");
     let args = [
         "verify",
         part.to_str().unwrap(),

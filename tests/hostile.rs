@@ -10,15 +10,7 @@ use std::process::{Command, Output};
 use kneeform::output::DirLock;
 
 use crate::cli::kneeform;
-use crate::util::scratch_dir;
-
-fn scenario(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenarios")
-        .join(format!("{name}.toml"))
-        .display()
-        .to_string()
-}
+use crate::util::{scenario, scratch_dir};
 
 /// Everything in `dir` whose name says it is staged or set aside.
 fn leftovers(dir: &Path) -> Vec<String> {

@@ -10,7 +10,7 @@ use std::process::{Command, Output};
 
 use serde_json::Value;
 
-use crate::util::{Image, scratch_dir};
+use crate::util::{Image, ok, scratch_dir};
 
 /// Angles of the test runs: the paper's Figure 12 angles and two between.
 const ANGLES: &str = "--angles=-30,-15,0,15,30";
@@ -24,15 +24,6 @@ fn kneeform(dir: &Path, args: &[&str]) -> Output {
         .args(args)
         .output()
         .expect("the binary runs")
-}
-
-fn ok(out: Output, what: &str) -> Output {
-    assert!(
-        out.status.success(),
-        "{what}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
 }
 
 /// A scratch directory holding `part.stl` (the step scenario, mirrored in

@@ -1,14 +1,10 @@
 //! Blind spots: the grid must say where it cannot see the part (issue
 //! "show where the grid is blind"), and stay quiet on smooth parts.
 
-use std::path::{Path, PathBuf};
-
 use kneeform::blind::BlindSpot;
 use kneeform::{Analysis, Setup, Side};
 
-fn scenario(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenarios/{name}.toml"))
-}
+use crate::util::scenario_file;
 
 /// The blind spots of a scenario at `pitch`, angles -30, 0 and 30.
 fn blind_spots(name: &str, pitch: f64) -> Vec<BlindSpot> {
@@ -17,7 +13,7 @@ fn blind_spots(name: &str, pitch: f64) -> Vec<BlindSpot> {
         angles: vec![-30.0, 0.0, 30.0],
         ..Setup::default()
     };
-    Analysis::of_file(&scenario(name), 1.0, Side::Left, &setup, &())
+    Analysis::of_file(&scenario_file(name), 1.0, Side::Left, &setup, &())
         .unwrap()
         .blind_spots
 }
@@ -108,7 +104,7 @@ fn the_pitch_chosen_for_a_tolerance_passes_verify_there() {
     // (results/README.md); a 1 mm tolerance needs a pitch of 1 mm.
     let angles = vec![-30.0, 0.0, 30.0];
     for name in ["wave", "depression"] {
-        let input = kneeform::read_part(&scenario(name), 1.0, Side::Left).unwrap();
+        let input = kneeform::read_part(&scenario_file(name), 1.0, Side::Left).unwrap();
         let setup = Setup {
             angles: angles.clone(),
             ..Setup::default()
@@ -150,7 +146,7 @@ fn blind_spots_are_written_crossed_and_reported() {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_kneeform"))
         .current_dir(&dir)
         .args(["analyze"])
-        .arg(scenario("thin-rib"))
+        .arg(scenario_file("thin-rib"))
         .args([
             "--pitch",
             "4",

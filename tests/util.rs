@@ -4,6 +4,27 @@
 
 use kneeform::{GridSpec, HeightGrid, KneeForm};
 
+/// The bundled scenario file `scenarios/NAME.toml`.
+pub fn scenario_file(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenarios/{name}.toml"))
+}
+
+/// [`scenario_file`] as a command-line argument.
+pub fn scenario(name: &str) -> String {
+    scenario_file(name).display().to_string()
+}
+
+/// Asserts that a run of the binary succeeded, saying `what` and its
+/// stderr where it did not; returns its output.
+pub fn ok(out: std::process::Output, what: &str) -> std::process::Output {
+    assert!(
+        out.status.success(),
+        "{what}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// The fixed seeds of every randomised test, in one place.
 pub const SEEDS: [u64; 4] = [0x5eed_0001, 0x5eed_0002, 0xdead_beef, 42];
 
