@@ -16,6 +16,7 @@ use crate::kneeform::GridFootprint;
 use crate::padded::PaddedGrid;
 use crate::paper::{PaperCounts, PaperScratch, paper_row};
 use crate::push::{PushRows, WindowMin, push_block};
+use crate::ranked::{NEVER, OFF, Rank, RankedGrid};
 use crate::simd::dispatch;
 use crate::slide::{LayerRows, slide_block, slide_carried};
 use crate::strike::StrikeRule;
@@ -125,10 +126,14 @@ pub fn colliding_masks(
 ) -> Vec<AngleMask> {
     assert_same_pitch(grid, footprints);
     let padded = PaddedGrid::new(grid, footprints);
-    let table = match options.algorithm {
-        Algorithm::Fast => Some(WindowMin::new(&padded, WindowMin::max_width(footprints))),
+    let ranked = match options.algorithm {
+        Algorithm::Fast => Some(RankedGrid::new(&padded)),
         Algorithm::Paper => None,
     };
+    let max_width = WindowMin::max_width(footprints);
+    let fast = ranked
+        .as_ref()
+        .map(|ranked| Fast::new(&padded, ranked, max_width, &options.rule));
     let rows: Vec<usize> = match &options.start_rows {
         Some(rows) => rows.iter().copied().filter(|&j| j < grid.spec.nz).collect(),
         None => (0..grid.spec.nz).collect(),
@@ -140,8 +145,8 @@ pub fn colliding_masks(
     footprints
         .par_iter()
         .map(|fp| {
-            let run = |band: &[usize]| match &table {
-                Some(table) => fast_window(&padded, table, fp, band, options),
+            let run = |band: &[usize]| match &fast {
+                Some(fast) => fast_window(&padded, fast, fp, band, options),
                 None => {
                     let mut mask = vec![0u8; padded.h.len()];
                     let placed = paper_band(&padded, fp, band, &options.rule, &mut mask);
@@ -186,6 +191,31 @@ pub fn colliding_masks(
             }
         })
         .collect()
+}
+
+/// The fast path's tables, built once for every angle: the height ranks,
+/// the window minima of the push, and each node's strike threshold.
+struct Fast<'a> {
+    ranked: &'a RankedGrid,
+    table: WindowMin<'a>,
+    thresholds: Vec<Rank>,
+}
+
+impl<'a> Fast<'a> {
+    /// The tables of `padded` (ranked as `ranked`) for push windows up to
+    /// `max_width` nodes and strikes by `rule`.
+    fn new(
+        padded: &PaddedGrid,
+        ranked: &'a RankedGrid,
+        max_width: usize,
+        rule: &StrikeRule,
+    ) -> Fast<'a> {
+        Fast {
+            ranked,
+            table: WindowMin::new(padded, &ranked.ranks, max_width),
+            thresholds: ranked.thresholds(padded, rule),
+        }
+    }
 }
 
 /// What a band of start rows found: the strikes in a window of padded
@@ -242,7 +272,7 @@ impl AngleAcc {
 /// SPEC's strike rule over that window.
 fn fast_window(
     padded: &PaddedGrid,
-    table: &WindowMin,
+    fast: &Fast,
     fp: &GridFootprint,
     band: &[usize],
     options: &EngineOptions,
@@ -255,16 +285,13 @@ fn fast_window(
     let last_row = (j_last as i64 + i64::from(dj_hi) + padded.pad_rows as i64) as usize;
     let start = first_row * padded.stride;
     let end = (last_row + 1) * padded.stride;
-    let mut reach = vec![f64::NEG_INFINITY; end - start];
-    let placed = fast_band(padded, table, fp, band, start, &mut reach);
-    // The node behind the window's last is the next row's padding: `+inf`.
-    let strikes = strike_mask(
-        &padded.h[start..end],
-        &reach,
-        padded.spec.pitch,
-        &options.rule,
-    );
-    let probe_levels = probe_levels(padded, start, &reach, &options.probes);
+    let mut reach = vec![NEVER; end - start];
+    let placed = fast_band(padded, fast, fp, band, start, &mut reach);
+    let strikes = strike_mask(&fast.thresholds[start..end], &reach);
+    let probe_levels = probe_levels(padded, start, &reach, &options.probes)
+        .into_iter()
+        .map(|r| fast.ranked.height(r))
+        .collect();
     BandResult {
         first_row,
         strikes,
@@ -273,10 +300,10 @@ fn fast_window(
     }
 }
 
-/// Per probe, the highest face level that met one of its cell's corners
-/// in a band whose reach window begins at padded index `start` (`-inf`
-/// where none did).
-fn probe_levels(padded: &PaddedGrid, start: usize, reach: &[f64], probes: &[Probe]) -> Vec<f64> {
+/// Per probe, the highest face level (rank) that met one of its cell's
+/// corners in a band whose reach window begins at padded index `start`
+/// ([`NEVER`] where none did).
+fn probe_levels(padded: &PaddedGrid, start: usize, reach: &[Rank], probes: &[Probe]) -> Vec<Rank> {
     let nz = padded.spec.nz as i64;
     probes
         .iter()
@@ -289,7 +316,7 @@ fn probe_levels(padded: &PaddedGrid, start: usize, reach: &[f64], probes: &[Prob
                     let n = padded.index(jj, ii as i32).checked_sub(start)?;
                     reach.get(n).copied()
                 })
-                .fold(f64::NEG_INFINITY, f64::max)
+                .fold(NEVER, Rank::max)
         })
         .collect()
 }
@@ -313,20 +340,20 @@ dispatch! {
     /// node's reach (see [`crate::slide`]) in `reach`, whose first element
     /// is the padded node `window`, and returns the number of placed
     /// starts.
-    fn fast_band(padded: &PaddedGrid, table: &WindowMin, fp: &GridFootprint, band: &[usize], window: usize, reach: &mut [f64]) -> usize => fast_band_impl::<32, 16, 16>
+    fn fast_band(padded: &PaddedGrid, fast: &Fast, fp: &GridFootprint, band: &[usize], window: usize, reach: &mut [Rank]) -> usize => fast_band_impl::<64, 32, 32>
 }
 
 #[inline(always)]
 fn fast_band_impl<const W: usize>(
     padded: &PaddedGrid,
-    table: &WindowMin,
+    fast: &Fast,
     fp: &GridFootprint,
     band: &[usize],
     window: usize,
-    reach: &mut [f64],
+    reach: &mut [Rank],
 ) -> usize {
     let push_rows = PushRows::new(padded, fp);
-    let h = &padded.h[window..];
+    let h = &fast.ranked.ranks[window..];
     let nz = padded.spec.nz;
     let layer = LayerRows::new(padded, fp);
     let active: Vec<std::ops::Range<i64>> = band
@@ -344,7 +371,7 @@ fn fast_band_impl<const W: usize>(
     };
     let nx = padded.spec.nx as i64;
     let layers: Vec<_> = band.iter().map(|&j0| layer.within(j0, nz)).collect();
-    let mut carry = vec![f64::NEG_INFINITY; band.len()];
+    let mut carry = vec![NEVER; band.len()];
     let mut placed = 0;
     let mut block_end = hi;
     while block_end > lo {
@@ -358,13 +385,13 @@ fn fast_band_impl<const W: usize>(
             let base = padded
                 .index(j0 as i64, 0)
                 .wrapping_add_signed(block as isize);
-            let yr: [f64; W] = push_block(table, push_rows.within(j0, nz), base);
+            let yr: [Rank; W] = push_block(&fast.table, push_rows.within(j0, nz), base);
             let base = base - window;
             // Only real starts are placed.
-            let mut level = [f64::NEG_INFINITY; W];
+            let mut level = [NEVER; W];
             for w in 0..W {
                 let i0 = block + w as i64;
-                if (0..nx).contains(&i0) && yr[w].is_finite() {
+                if (0..nx).contains(&i0) && yr[w] != OFF {
                     level[w] = yr[w];
                     placed += 1;
                 }
@@ -375,9 +402,9 @@ fn fast_band_impl<const W: usize>(
             // their +x side, from +x to -x.
             let mut c = carry[k];
             for w in (0..W).rev() {
-                if level[w] != f64::NEG_INFINITY {
+                if level[w] != NEVER {
                     c = after[w];
-                } else if c != f64::NEG_INFINITY && layer_min[w] != f64::INFINITY {
+                } else if c != NEVER && layer_min[w] != OFF {
                     c = slide_carried(h, reach, layer, base + w, c);
                 }
             }
@@ -389,20 +416,17 @@ fn fast_band_impl<const W: usize>(
 }
 
 /// SPEC's strike rule applied once per node to its reach, the highest face
-/// level that met it (`-inf`: never met), over a window of whole padded
-/// rows (`h` its heights, `reach` its reaches). The rule is monotone in
-/// the level, so this is the union of the strikes of every slide that met
-/// the node. The node behind `n` is `n + 1`: the next column, or past a
-/// row's last real column the padding's `+inf`.
-fn strike_mask(h: &[f64], reach: &[f64], pitch: f64, rule: &StrikeRule) -> Vec<u8> {
-    let mut mask: Vec<u8> = h
-        .windows(2)
+/// level that met it ([`NEVER`]: never met), over a window of whole padded
+/// rows: a node is struck when its reach is at least its threshold
+/// ([`RankedGrid::thresholds`]), the lowest level the rule strikes it at.
+/// The rule is monotone in the level, so this is the union of the strikes
+/// of every slide that met the node.
+fn strike_mask(thresholds: &[Rank], reach: &[Rank]) -> Vec<u8> {
+    thresholds
+        .iter()
         .zip(reach)
-        .map(|(w, &r)| u8::from(rule.strikes(w[0], w[1], r, pitch)))
-        .collect();
-    // The window's last node is padding (`+inf`), never struck.
-    mask.push(0);
-    mask
+        .map(|(&t, &r)| u8::from(r >= t))
+        .collect()
 }
 
 /// The paper algorithm over a band of start rows.
@@ -426,19 +450,26 @@ fn paper_band(
 pub fn push_levels(grid: &HeightGrid, fp: &GridFootprint) -> Vec<f64> {
     assert_same_pitch(grid, std::slice::from_ref(fp));
     let padded = PaddedGrid::new(grid, std::slice::from_ref(fp));
-    let table = WindowMin::new(&padded, WindowMin::max_width(std::slice::from_ref(fp)));
+    let ranked = RankedGrid::new(&padded);
+    let table = WindowMin::new(
+        &padded,
+        &ranked.ranks,
+        WindowMin::max_width(std::slice::from_ref(fp)),
+    );
     let rows = PushRows::new(&padded, fp);
     let nx = grid.spec.nx;
     let mut yr = vec![f64::INFINITY; grid.spec.len()];
     for (j0, out) in yr.chunks_exact_mut(nx).enumerate() {
         for (block, out) in out.chunks_mut(LANES).enumerate() {
             // The padding's slack covers the lanes past the last column.
-            let levels: [f64; LANES] = push_block(
+            let levels: [Rank; LANES] = push_block(
                 &table,
                 rows.within(j0, grid.spec.nz),
                 padded.index(j0 as i64, 0) + block * LANES,
             );
-            out.copy_from_slice(&levels[..out.len()]);
+            for (y, &r) in out.iter_mut().zip(&levels) {
+                *y = ranked.height(r);
+            }
         }
     }
     yr
@@ -463,7 +494,7 @@ mod tests {
     use crate::kneeform::KneeForm;
 
     /// [`fast_band`]'s signature.
-    type BandFn = fn(&PaddedGrid, &WindowMin, &GridFootprint, &[usize], usize, &mut [f64]) -> usize;
+    type BandFn = fn(&PaddedGrid, &Fast, &GridFootprint, &[usize], usize, &mut [Rank]) -> usize;
 
     /// The block width is a tuning knob per instruction set: every width
     /// gives the same reach and placed count (the tests elsewhere run only
@@ -498,16 +529,18 @@ mod tests {
         for angle in [-30.0, 0.0, 17.0] {
             let fp = GridFootprint::new(&knee, angle, &spec);
             let padded = PaddedGrid::new(&grid, std::slice::from_ref(&fp));
-            let table = WindowMin::new(&padded, 512);
+            let ranked = RankedGrid::new(&padded);
+            let fast = Fast::new(&padded, &ranked, 512, &StrikeRule::default());
             let run = |f: BandFn| {
-                let mut reach = vec![f64::NEG_INFINITY; padded.h.len()];
-                let placed = f(&padded, &table, &fp, &rows, 0, &mut reach);
+                let mut reach = vec![NEVER; padded.h.len()];
+                let placed = f(&padded, &fast, &fp, &rows, 0, &mut reach);
                 (reach, placed)
             };
             let w16 = run(fast_band_impl::<16>);
             assert!(w16.1 > 0);
             assert!(run(fast_band_impl::<8>) == w16, "angle {angle}: 8 lanes");
             assert!(run(fast_band_impl::<32>) == w16, "angle {angle}: 32 lanes");
+            assert!(run(fast_band_impl::<64>) == w16, "angle {angle}: 64 lanes");
         }
     }
 
@@ -558,19 +591,20 @@ mod tests {
         };
         // The reference: one band of every start row, one whole-grid reach.
         let padded = PaddedGrid::new(&grid, &footprints);
-        let table = WindowMin::new(&padded, WindowMin::max_width(&footprints));
-        let rows: Vec<usize> = (0..spec.nz).collect();
         let rule = StrikeRule::default();
+        let ranked = RankedGrid::new(&padded);
+        let fast = Fast::new(&padded, &ranked, WindowMin::max_width(&footprints), &rule);
+        let rows: Vec<usize> = (0..spec.nz).collect();
         let expected: Vec<(Vec<u8>, usize, Vec<bool>)> = footprints
             .iter()
             .map(|fp| {
-                let mut reach = vec![f64::NEG_INFINITY; padded.h.len()];
-                let placed = fast_band(&padded, &table, fp, &rows, 0, &mut reach);
-                let mask = padded.unpad(&strike_mask(&padded.h, &reach, spec.pitch, &rule));
+                let mut reach = vec![NEVER; padded.h.len()];
+                let placed = fast_band(&padded, &fast, fp, &rows, 0, &mut reach);
+                let mask = padded.unpad(&strike_mask(&fast.thresholds, &reach));
                 let met = probe_levels(&padded, 0, &reach, &probes)
                     .iter()
                     .zip(&probes)
-                    .map(|(&level, probe)| probe.y < level - rule.e0)
+                    .map(|(&level, probe)| probe.y < ranked.height(level) - rule.e0)
                     .collect();
                 (mask, placed, met)
             })

@@ -57,6 +57,7 @@ pub mod output;
 pub mod padded;
 pub mod paper;
 pub mod push;
+pub mod ranked;
 pub mod report;
 pub mod sanity;
 pub mod scenario;

@@ -89,8 +89,12 @@ impl MemoryEstimate {
                 ("program", BASE_BYTES),
                 ("part", BYTES_PER_TRIANGLE * triangles as f64),
                 ("height grid", 8.0 * n + 8.0 * padded),
-                ("push table", 8.0 * (levels - 1.0) * real_rows),
-                ("bands running", tasks * (9.0 * window).max(padded)),
+                // The ranks, the strike thresholds and the distinct heights
+                // (at most one per node).
+                ("ranks", 4.0 * padded + 4.0 * padded + 8.0 * n),
+                ("push table", 4.0 * (levels - 1.0) * real_rows),
+                // A rank of reach and a strike byte per window node.
+                ("bands running", tasks * (5.0 * window).max(padded)),
                 ("angles in flight", angles_in_flight * n),
                 ("masks", MASK_BYTES_PER_NODE * angles * n + 2.0 * n),
                 ("writers", WRITE_BYTES_PER_NODE * n),

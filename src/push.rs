@@ -8,25 +8,29 @@
 //! of two overlapping power-of-two windows, so each (start, footprint row)
 //! costs two loads and two comparisons. [`push_block`] does a block of
 //! consecutive starts at once, their levels held in vector registers.
+//!
+//! Heights are taken as their ranks ([`crate::ranked`]): minima of ranks
+//! are the ranks of minima, exactly.
 
 use crate::kneeform::GridFootprint;
 use crate::padded::{PaddedGrid, fmin};
+use crate::ranked::{OFF, Rank};
 
 /// Row window minima of a padded height grid's real rows, for every
 /// power-of-two width.
 ///
-/// Level 0 is the grid's own heights (borrowed, not copied), and the
+/// Level 0 is the grid's own height ranks (borrowed, not copied), and the
 /// padding rows above and below the grid are left out: they hold only
 /// `+inf`, which never lowers a minimum, so [`PushRows::within`] skips the
 /// footprint rows that fall on them. That keeps the table at `levels - 1`
 /// copies of the real rows, the largest item of an analysis's memory.
 #[derive(Debug)]
 pub struct WindowMin<'a> {
-    /// The padded grid's real rows: level 0.
-    heights: &'a [f64],
-    /// `levels[l - 1][row * stride + x]` = min of `h` over `x .. x + 2^l`
-    /// in the real row `row` (`+inf` past its end).
-    levels: Vec<Vec<f64>>,
+    /// The padded grid's real rows' ranks: level 0.
+    heights: &'a [Rank],
+    /// `levels[l - 1][row * stride + x]` = min of the ranks over
+    /// `x .. x + 2^l` in the real row `row` ([`OFF`] past its end).
+    levels: Vec<Vec<Rank>>,
     /// Padded index of the first real row's first node.
     first: usize,
 }
@@ -49,20 +53,21 @@ impl<'a> WindowMin<'a> {
         max_width.max(1).ilog2() as usize + 1
     }
 
-    /// Builds the table for windows up to `max_width` nodes.
-    pub fn new(grid: &'a PaddedGrid, max_width: usize) -> WindowMin<'a> {
+    /// Builds the table for windows up to `max_width` nodes over `ranks`,
+    /// the ranks of `grid`'s heights ([`crate::ranked::RankedGrid`]).
+    pub fn new(grid: &PaddedGrid, ranks: &'a [Rank], max_width: usize) -> WindowMin<'a> {
         let stride = grid.stride;
         let first = grid.pad_rows * stride;
-        let heights = &grid.h[first..first + grid.spec.nz * stride];
-        let mut levels: Vec<Vec<f64>> = Vec::new();
+        let heights = &ranks[first..first + grid.spec.nz * stride];
+        let mut levels: Vec<Vec<Rank>> = Vec::new();
         let mut width = 1;
         for _ in 1..WindowMin::levels(max_width) {
             let prev = levels.last().map_or(heights, Vec::as_slice);
-            let mut next = vec![f64::INFINITY; prev.len()];
+            let mut next = vec![OFF; prev.len()];
             for (dst, src) in next.chunks_exact_mut(stride).zip(prev.chunks_exact(stride)) {
                 let n = stride - width;
                 for x in 0..n {
-                    dst[x] = fmin(src[x], src[x + width]);
+                    dst[x] = src[x].min(src[x + width]);
                 }
                 dst[n..].copy_from_slice(&src[n..]);
             }
@@ -78,7 +83,7 @@ impl<'a> WindowMin<'a> {
 
     /// Level `l`: minima over `2^l` nodes, indexed from the first real row.
     #[inline(always)]
-    fn level(&self, l: usize) -> &[f64] {
+    fn level(&self, l: usize) -> &[Rank] {
         if l == 0 {
             self.heights
         } else {
@@ -88,7 +93,10 @@ impl<'a> WindowMin<'a> {
 
     /// Memory held (bytes), level 0 aside (it is the grid's).
     pub fn bytes(&self) -> usize {
-        self.levels.iter().map(|l| l.len() * 8).sum()
+        self.levels
+            .iter()
+            .map(|l| l.len() * size_of::<Rank>())
+            .sum()
     }
 }
 
@@ -137,22 +145,22 @@ impl PushRows {
     }
 }
 
-/// Face levels of `W` consecutive starts whose node index (in the padded
-/// grid) begins at `base`: the minimum height over the nodes inside each
-/// footprint, `+inf` where none is finite. `rows` are the footprint's
-/// rows [`PushRows::within`] the grid for the starts' row.
+/// Face levels (ranks) of `W` consecutive starts whose node index (in the
+/// padded grid) begins at `base`: the minimum height over the nodes inside
+/// each footprint, [`OFF`] where none is finite. `rows` are the
+/// footprint's rows [`PushRows::within`] the grid for the starts' row.
 #[inline(always)]
-pub fn push_block<const W: usize>(table: &WindowMin, rows: &[PushRow], base: usize) -> [f64; W] {
-    let mut yr = [f64::INFINITY; W];
+pub fn push_block<const W: usize>(table: &WindowMin, rows: &[PushRow], base: usize) -> [Rank; W] {
+    let mut yr = [OFF; W];
     let base = base - table.first;
     for &(offset, level, second) in rows {
         let t = table.level(level as usize);
         let a = base.wrapping_add_signed(offset);
-        let first: &[f64; W] = t[a..a + W].try_into().expect("W values");
+        let first: &[Rank; W] = t[a..a + W].try_into().expect("W values");
         let b = a + second as usize;
-        let last: &[f64; W] = t[b..b + W].try_into().expect("W values");
+        let last: &[Rank; W] = t[b..b + W].try_into().expect("W values");
         for w in 0..W {
-            yr[w] = fmin(yr[w], fmin(first[w], last[w]));
+            yr[w] = yr[w].min(first[w].min(last[w]));
         }
     }
     yr

@@ -20,9 +20,13 @@
 //! ([`StrikeRule::strikes`](crate::strike::StrikeRule::strikes)) is
 //! monotone in the level, so applying it to the reach at the end gives the
 //! same mask with a `max` per visit instead of a compare-and-store.
+//!
+//! Heights and levels are taken as their ranks ([`crate::ranked`]), and
+//! the rule as each node's threshold rank: the same comparisons, exactly.
 
 use crate::kneeform::GridFootprint;
-use crate::padded::{PaddedGrid, fmax, fmin};
+use crate::padded::PaddedGrid;
+use crate::ranked::{OFF, Rank};
 
 /// The first layer of one footprint, ready for [`slide_block`]: the offset
 /// from a start's node to the first node in front in each footprint row, in
@@ -75,32 +79,33 @@ impl LayerRows {
     }
 }
 
-/// Slides `W` consecutive starts over their first layers. `base` is the
-/// padded node index of the first start, `level[w]` the level it enters
-/// with (`yr` if placed, `-inf` if not). Every node of the layer records in
-/// `reach` the highest face level that met it; whether it is struck is
-/// decided once at the end by SPEC's strike rule applied to that reach
-/// (the rule is monotone in the level). Returns the levels after
-/// the layer and the lowest height of each layer.
+/// Slides `W` consecutive starts over their first layers. `h` are the
+/// height ranks, `base` the padded node index of the first start,
+/// `level[w]` the level it enters with (`yr` if placed,
+/// [`NEVER`](crate::ranked::NEVER) if not). Every node of the layer
+/// records in `reach` the highest face level that met it; whether it is
+/// struck is decided once at the end by SPEC's strike rule applied to that
+/// reach (the rule is monotone in the level). Returns the levels after the
+/// layer and the lowest height of each layer.
 #[inline(always)]
 pub fn slide_block<const W: usize>(
-    h: &[f64],
-    reach: &mut [f64],
+    h: &[Rank],
+    reach: &mut [Rank],
     layer: &LayerRows,
     base: usize,
-    mut level: [f64; W],
-) -> ([f64; W], [f64; W]) {
-    let mut layer_min = [f64::INFINITY; W];
+    mut level: [Rank; W],
+) -> ([Rank; W], [Rank; W]) {
+    let mut layer_min = [OFF; W];
     for g in &layer.groups {
         let before = level;
         for &offset in &layer.offsets[g.clone()] {
             let a = base.wrapping_add_signed(offset);
-            let hv: &[f64; W] = h[a..a + W].try_into().expect("W values");
-            let r: &mut [f64; W] = (&mut reach[a..a + W]).try_into().expect("W values");
+            let hv: &[Rank; W] = h[a..a + W].try_into().expect("W values");
+            let r: &mut [Rank; W] = (&mut reach[a..a + W]).try_into().expect("W values");
             for w in 0..W {
-                r[w] = fmax(r[w], before[w]);
-                level[w] = fmin(level[w], hv[w]);
-                layer_min[w] = fmin(layer_min[w], hv[w]);
+                r[w] = r[w].max(before[w]);
+                level[w] = level[w].min(hv[w]);
+                layer_min[w] = layer_min[w].min(hv[w]);
             }
         }
     }
@@ -111,18 +116,18 @@ pub fn slide_block<const W: usize>(
 /// `carry` of the start on its +x side, over its first layer; returns the
 /// level it carries on.
 pub fn slide_carried(
-    h: &[f64],
-    reach: &mut [f64],
+    h: &[Rank],
+    reach: &mut [Rank],
     layer: &LayerRows,
     node: usize,
-    mut carry: f64,
-) -> f64 {
+    mut carry: Rank,
+) -> Rank {
     for g in &layer.groups {
         let before = carry;
         for &offset in &layer.offsets[g.clone()] {
             let a = node.wrapping_add_signed(offset);
-            reach[a] = fmax(reach[a], before);
-            carry = fmin(carry, h[a]);
+            reach[a] = reach[a].max(before);
+            carry = carry.min(h[a]);
         }
     }
     carry
