@@ -88,12 +88,8 @@ pub struct AngleMask {
     pub probes_met: Vec<bool>,
 }
 
-/// Starts per block of the fast path: four AVX-512 registers of levels
-/// (32 lanes), four AVX2 ones (16). A block is swept over every start row
-/// before the next, so the heights it reads (the footprint's rows at the
-/// block's columns) stay in cache from one start row to the next. Measured
-/// on the benchmark: AVX-512 6.8 s at 32 lanes against 8.0 s at 16; AVX2
-/// 9.4 s at 16 against 10.7 s at 32 (register spills).
+/// Starts per block of [`push_levels`]: two AVX2 registers of ranks. The
+/// analysis's blocks are wider, per instruction set ([`fast_band`]).
 const LANES: usize = 16;
 
 /// Start rows per band: the unit of work within an angle. A band's slides
@@ -102,8 +98,11 @@ const LANES: usize = 16;
 /// angle in flight holds a few MiB whatever the grid, and memory stays
 /// flat in the thread count. Deciding strikes per window costs one pass
 /// over `(BAND_ROWS + footprint rows) / BAND_ROWS` times the grid per
-/// angle, a few percent of the slides on the paper workload.
-pub const BAND_ROWS: usize = 64;
+/// angle. Within a band every block of starts is swept over all its start
+/// rows, so the footprint rows they share stay in cache: 128 rows measured
+/// a little faster than 64 on the benchmark (and than 256; within the
+/// machine's noise, about 10%).
+pub const BAND_ROWS: usize = 128;
 
 /// Runs push and slide for every footprint (one per angle) on `grid`.
 /// `on_angle` is called once per finished angle (for a progress bar).
@@ -334,13 +333,19 @@ pub(crate) fn assert_same_pitch(grid: &HeightGrid, footprints: &[GridFootprint])
 }
 
 dispatch! {
-    /// The fast path over a band of start rows: blocks of starts (32 with
-    /// AVX-512, else [`LANES`]) from +x to -x, each swept over every start row of the band, carrying
-    /// each row's slide level from one block into the next. Records each
-    /// node's reach (see [`crate::slide`]) in `reach`, whose first element
-    /// is the padded node `window`, and returns the number of placed
-    /// starts.
-    fn fast_band(padded: &PaddedGrid, fast: &Fast, fp: &GridFootprint, band: &[usize], window: usize, reach: &mut [Rank]) -> usize => fast_band_impl::<64, 32, 32>
+    /// The fast path over a band of start rows: blocks of starts from +x
+    /// to -x, each swept over every start row of the band, carrying each
+    /// row's slide level from one block into the next. Records each node's
+    /// reach (see [`crate::slide`]) in `reach`, whose first element is the
+    /// padded node `window`, and returns the number of placed starts.
+    ///
+    /// A block is 128 starts with AVX-512 (eight registers of ranks), 64
+    /// with AVX2 (eight), 16 without: wider blocks walk the footprint's
+    /// offsets fewer times. Measured on AVX2 (11 angles, one thread): 64
+    /// about 5% faster than 32 and level with 128 (the noise is about
+    /// 10%); 16 slower. [`LANE_SLACK`](crate::padded::LANE_SLACK) covers the
+    /// widest block.
+    fn fast_band(padded: &PaddedGrid, fast: &Fast, fp: &GridFootprint, band: &[usize], window: usize, reach: &mut [Rank]) -> usize => fast_band_impl::<128, 64, 16>
 }
 
 #[inline(always)]
@@ -397,14 +402,14 @@ fn fast_band_impl<const W: usize>(
                 }
             }
             let layer = &layers[k];
-            let (after, layer_min) = slide_block(h, reach, layer, base, level);
+            let after = slide_block(h, reach, layer, base, level);
             // Starts that are not placed continue the slide of the start on
             // their +x side, from +x to -x.
             let mut c = carry[k];
             for w in (0..W).rev() {
                 if level[w] != NEVER {
                     c = after[w];
-                } else if c != NEVER && layer_min[w] != OFF {
+                } else if c != NEVER {
                     c = slide_carried(h, reach, layer, base + w, c);
                 }
             }
@@ -541,6 +546,10 @@ mod tests {
             assert!(run(fast_band_impl::<8>) == w16, "angle {angle}: 8 lanes");
             assert!(run(fast_band_impl::<32>) == w16, "angle {angle}: 32 lanes");
             assert!(run(fast_band_impl::<64>) == w16, "angle {angle}: 64 lanes");
+            assert!(
+                run(fast_band_impl::<128>) == w16,
+                "angle {angle}: 128 lanes"
+            );
         }
     }
 

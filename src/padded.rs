@@ -10,7 +10,7 @@ use crate::kneeform::GridFootprint;
 
 /// Extra margin columns on each side, so that a whole block of starts may
 /// run past the active range without leaving the padding.
-pub const LANE_SLACK: usize = 64;
+pub const LANE_SLACK: usize = 128;
 
 /// A height grid with padded rows and columns.
 #[derive(Debug)]

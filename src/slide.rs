@@ -86,7 +86,7 @@ impl LayerRows {
 /// records in `reach` the highest face level that met it; whether it is
 /// struck is decided once at the end by SPEC's strike rule applied to that
 /// reach (the rule is monotone in the level). Returns the levels after the
-/// layer and the lowest height of each layer.
+/// layer.
 #[inline(always)]
 pub fn slide_block<const W: usize>(
     h: &[Rank],
@@ -94,8 +94,7 @@ pub fn slide_block<const W: usize>(
     layer: &LayerRows,
     base: usize,
     mut level: [Rank; W],
-) -> ([Rank; W], [Rank; W]) {
-    let mut layer_min = [OFF; W];
+) -> [Rank; W] {
     for g in &layer.groups {
         let before = level;
         for &offset in &layer.offsets[g.clone()] {
@@ -105,16 +104,16 @@ pub fn slide_block<const W: usize>(
             for w in 0..W {
                 r[w] = r[w].max(before[w]);
                 level[w] = level[w].min(hv[w]);
-                layer_min[w] = layer_min[w].min(hv[w]);
             }
         }
     }
-    (level, layer_min)
+    level
 }
 
 /// The scalar slide of one start that is not placed but carries the level
 /// `carry` of the start on its +x side, over its first layer; returns the
-/// level it carries on.
+/// level it carries on. A layer with no finite height (past the part's
+/// edge) is not slid over: no node of it exists to be met.
 pub fn slide_carried(
     h: &[Rank],
     reach: &mut [Rank],
@@ -122,10 +121,14 @@ pub fn slide_carried(
     node: usize,
     mut carry: Rank,
 ) -> Rank {
+    let at = |offset: &isize| node.wrapping_add_signed(*offset);
+    if layer.offsets.iter().all(|o| h[at(o)] == OFF) {
+        return carry;
+    }
     for g in &layer.groups {
         let before = carry;
-        for &offset in &layer.offsets[g.clone()] {
-            let a = node.wrapping_add_signed(offset);
+        for offset in &layer.offsets[g.clone()] {
+            let a = at(offset);
             reach[a] = reach[a].max(before);
             carry = carry.min(h[a]);
         }
