@@ -200,7 +200,7 @@ pub(crate) fn verify_with(
 }
 
 impl VerifySummary {
-    fn new(
+    pub(super) fn new(
         input: &PartFile,
         setup: &Setup,
         options: &VerifyOptions,

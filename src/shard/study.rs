@@ -1,0 +1,609 @@
+//! The files of a study's shard: `verify --shard K/N` and `converge
+//! --shard K/N` write one [`crate::harness::StudyPart`] as `shard.json`
+//! and `shard.bin`; [`merge_study`] reads N of them, checks that they are
+//! every shard of one study exactly once, and merges them
+//! ([`crate::harness::merge_verify`], [`crate::harness::merge_converge`]).
+//!
+//! * `shard.json` ([`StudyRecord`]): which shard of how many, the study's
+//!   start count and this shard's start indices, the options
+//!   ([`StudySettings`]), the study's `verify.json` or `converge.json` as
+//!   the shard knows it (`"study": {"kind": "verify", "summary": ...}`:
+//!   the part's SHA-256 and every parameter; statistics of no start),
+//!   its clock readings, and the SHA-256 of `shard.bin` and of its common
+//!   part;
+//! * `shard.bin`, little-endian: the common part (the grid the starts are
+//!   nodes of, the angles, every start of the study as f64 bits), then per
+//!   pitch its tie band and timings and, per start-angle pair of the
+//!   shard (angle-major), the pair's status, node, every metric value and
+//!   point its comparison holds, the grid's colliding nodes and the exact
+//!   strikes snapped to nodes: all a comparison is assembled from.
+//!
+//! Every value is stored as its bits, so a merge sees exactly what the
+//! shard computed.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::{Shard, ShardError, first_difference, hex_sha256};
+use crate::grid::GridSpec;
+use crate::harness::compare::{PairResult, STATUSES, row_of};
+use crate::harness::metrics::{StartComparison, StartPoints, TieBand};
+use crate::harness::sharded::PitchPart;
+use crate::harness::{
+    Convergence, StudyPart, StudySettings, StudySummary, Verification, merge_converge, merge_verify,
+};
+use crate::output::{OutputDir, WriteError};
+
+/// `shard.json` of a study's shard.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StudyRecord {
+    /// The format of the shard's files (1).
+    pub format: u32,
+    /// Which shard of how many.
+    pub shard: Shard,
+    /// The study's starts, all shards together.
+    pub starts: usize,
+    /// This shard's starts: indices into the study's.
+    pub start_indices: Vec<usize>,
+    /// The options every shard of the study shares.
+    pub settings: StudySettings,
+    /// The study's summary as the shard knows it, and its kind.
+    pub study: StudySummary,
+    /// Seconds sampling the grid.
+    pub sample_s: f64,
+    /// Seconds of the oracle on this shard's starts.
+    pub oracle_s: f64,
+    /// SHA-256 of `shard.bin` (hex).
+    pub data_sha256: String,
+    /// SHA-256 of `shard.bin`'s common part: grid, angles, starts.
+    pub common_sha256: String,
+}
+
+/// The format [`write_study_shard`] writes and [`merge_study`] reads.
+pub const FORMAT: u32 = 1;
+
+const MAGIC: &[u8; 16] = b"kneeform study 1";
+
+/// The largest `shard.bin` read (bytes): far beyond a study's (a few
+/// hundred bytes per start and angle), short of exhausting memory.
+const MAX_BIN_BYTES: u64 = 8 << 30;
+
+/// A study merged from its shards.
+#[derive(Debug)]
+pub enum MergedStudy {
+    /// `verify`'s.
+    Verify(Verification),
+    /// `converge`'s.
+    Converge(Convergence),
+}
+
+/// Writes `part` as its shard: `shard.json` and `shard.bin` in the staged
+/// directory `out`.
+pub fn write_study_shard(out: &OutputDir, part: &StudyPart) -> Result<(), WriteError> {
+    let mut bin = Vec::new();
+    bin.extend_from_slice(MAGIC);
+    let spec = part.spec;
+    put_u64(&mut bin, spec.nx as u64);
+    put_u64(&mut bin, spec.nz as u64);
+    put_u64(&mut bin, spec.i_origin as u64);
+    put_u64(&mut bin, spec.j_origin as u64);
+    put_f64(&mut bin, spec.pitch);
+    put_f64s(&mut bin, &part.angles_deg);
+    put_points(&mut bin, &part.starts);
+    let common_sha256 = hex_sha256(&bin);
+    put_u64(&mut bin, part.pitches.len() as u64);
+    for p in &part.pitches {
+        for v in [p.pitch, p.band.sigma, p.band.m, p.grid_s, p.seconds] {
+            put_f64(&mut bin, v);
+        }
+        put_u64(&mut bin, p.nodes as u64);
+        put_u64(&mut bin, p.pairs.len() as u64);
+        for pair in &p.pairs {
+            put_pair(&mut bin, pair);
+        }
+    }
+    let record = StudyRecord {
+        format: FORMAT,
+        shard: part.shard,
+        starts: part.starts.len(),
+        start_indices: part.shard.indices(part.starts.len()),
+        settings: part.settings.clone(),
+        study: part.summary.clone(),
+        sample_s: part.sample_s,
+        oracle_s: part.oracle_s,
+        data_sha256: hex_sha256(&bin),
+        common_sha256,
+    };
+    let path = out.path("shard.bin");
+    std::fs::write(&path, &bin).map_err(WriteError::at(&path))?;
+    let path = out.path("shard.json");
+    let text = serde_json::to_string_pretty(&record).map_err(WriteError::at(&path))? + "\n";
+    std::fs::write(&path, text).map_err(WriteError::at(&path))
+}
+
+/// What a shard directory holds, by its `shard.json`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShardKind {
+    /// An analysis's (`analyze --shard`).
+    Analysis,
+    /// A verification's (`verify --shard`).
+    Verify,
+    /// A convergence study's (`converge --shard`).
+    Converge,
+}
+
+impl std::fmt::Display for ShardKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ShardKind::Analysis => "an analysis (analyze --shard)",
+            ShardKind::Verify => "a verification (verify --shard)",
+            ShardKind::Converge => "a convergence study (converge --shard)",
+        })
+    }
+}
+
+/// The kind of the shard in `dir`, from its `shard.json`.
+pub fn shard_kind(dir: &Path) -> Result<ShardKind, ShardError> {
+    let path = dir.join("shard.json");
+    let text = crate::limits::read_bounded(&path, crate::limits::MAX_RUN_JSON_BYTES).map_err(
+        |source| ShardError::Io {
+            path: path.clone(),
+            source,
+        },
+    )?;
+    let value: serde_json::Value =
+        serde_json::from_slice(&text).map_err(|e| ShardError::Corrupt {
+            path: path.clone(),
+            reason: format!("not a kneeform shard.json: {e}"),
+        })?;
+    let kind = value.get("study").map(|s| s.get("kind"));
+    match kind {
+        None => Ok(ShardKind::Analysis),
+        Some(Some(k)) if k == "verify" => Ok(ShardKind::Verify),
+        Some(Some(k)) if k == "converge" => Ok(ShardKind::Converge),
+        Some(k) => Err(ShardError::Corrupt {
+            path,
+            reason: format!("a study of unknown kind {k:?}"),
+        }),
+    }
+}
+
+/// One study shard directory, read, checked and decoded.
+struct StudyFiles {
+    dir: PathBuf,
+    record: StudyRecord,
+    part: StudyPart,
+}
+
+/// Reads the study shard directories `dirs` (one per shard, in any
+/// order) and merges them into the whole study, as the unsharded command
+/// computes it (clock readings aside).
+pub fn merge_study(dirs: &[PathBuf]) -> Result<MergedStudy, ShardError> {
+    let shards = dirs
+        .iter()
+        .map(|d| read_study(d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let first = shards
+        .first()
+        .ok_or_else(|| ShardError::Mismatch("no shard directory given".into()))?;
+    let count = first.record.shard.count;
+    let identity = identity(&first.record);
+    let mut owner: Vec<Option<usize>> = vec![None; count];
+    for (k, s) in shards.iter().enumerate() {
+        let shard = s.record.shard;
+        if shard.count != count {
+            return Err(ShardError::Mismatch(format!(
+                "{} is shard {shard}, {} shard {}/{count}: shards of one study have one N",
+                s.dir.display(),
+                first.dir.display(),
+                first.record.shard.index
+            )));
+        }
+        if let Some(key) = first_difference(&identity, &self::identity(&s.record)) {
+            return Err(ShardError::Mismatch(format!(
+                "{} and {} are shards of different studies (their `{key}` differ)",
+                first.dir.display(),
+                s.dir.display()
+            )));
+        }
+        match owner[shard.index - 1] {
+            Some(other) => {
+                return Err(ShardError::Mismatch(format!(
+                    "shard {shard} is given twice: {} and {}",
+                    shards[other].dir.display(),
+                    s.dir.display()
+                )));
+            }
+            None => owner[shard.index - 1] = Some(k),
+        }
+    }
+    if let Some(missing) = owner.iter().position(Option::is_none) {
+        return Err(ShardError::Mismatch(format!(
+            "shard {}/{count} is missing: merge needs the directory of every shard",
+            missing + 1
+        )));
+    }
+    // In shard order: shard K's share is parts[K - 1].
+    let mut shards = shards;
+    shards.sort_by_key(|s| s.record.shard.index);
+    let parts: Vec<StudyPart> = shards.into_iter().map(|s| s.part).collect();
+    let merged = match parts[0].summary {
+        StudySummary::Verify(_) => merge_verify(&parts).map(MergedStudy::Verify),
+        StudySummary::Converge(_) => merge_converge(&parts).map(MergedStudy::Converge),
+    };
+    merged.ok_or_else(|| ShardError::Mismatch("the shards hold no study".into()))
+}
+
+/// What the shards of one study share: the record with its own counts,
+/// statistics, clocks and checksum of its data left out.
+fn identity(record: &StudyRecord) -> serde_json::Value {
+    let mut v = serde_json::to_value(record).unwrap_or_default();
+    let derived: &[&str] = match record.study {
+        StudySummary::Verify(_) => &[
+            "pass",
+            "area_distance_decided_mm",
+            "area_distance_mm",
+            "area_distance",
+            "metrics",
+            "area_iou",
+            "counts",
+            "worst_starts",
+            "timings",
+        ],
+        StudySummary::Converge(_) => &[
+            "fits",
+            "recommended_pitch_mm",
+            "predicted_full_time_s",
+            "seconds",
+        ],
+    };
+    let mut out = serde_json::Map::new();
+    if let Some(map) = v.as_object_mut() {
+        for key in [
+            "shard",
+            "start_indices",
+            "sample_s",
+            "oracle_s",
+            "data_sha256",
+        ] {
+            map.remove(key);
+        }
+        let study = map.remove("study").unwrap_or_default();
+        let mut summary = study.get("summary").cloned().unwrap_or_default();
+        if let Some(s) = summary.as_object_mut() {
+            for key in derived {
+                s.remove(*key);
+            }
+            // Keyed by the summary's own names, so that a mismatch names
+            // the option that differs.
+            out.extend(s.clone());
+        }
+        out.insert(
+            "kind".into(),
+            study.get("kind").cloned().unwrap_or_default(),
+        );
+        out.extend(map.clone());
+    }
+    serde_json::Value::Object(out)
+}
+
+fn read_study(dir: &Path) -> Result<StudyFiles, ShardError> {
+    let json_path = dir.join("shard.json");
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| ShardError::Io { path, source }
+    };
+    let text = crate::limits::read_bounded(&json_path, crate::limits::MAX_RUN_JSON_BYTES)
+        .map_err(io(&json_path))?;
+    let corrupt = |reason: String| ShardError::Corrupt {
+        path: json_path.clone(),
+        reason,
+    };
+    let record: StudyRecord = serde_json::from_slice(&text)
+        .map_err(|e| corrupt(format!("not a kneeform study shard.json: {e}")))?;
+    if record.format != FORMAT {
+        return Err(corrupt(format!(
+            "study shard format {}, this kneeform reads {FORMAT}",
+            record.format
+        )));
+    }
+    let shard = record.shard;
+    if shard.index == 0
+        || shard.index > shard.count
+        || shard.count > record.starts
+        || record.start_indices != shard.indices(record.starts)
+    {
+        return Err(corrupt(format!(
+            "shard {}/{} of {} starts does not hold starts {:?}",
+            shard.index, shard.count, record.starts, record.start_indices
+        )));
+    }
+    let bin_path = dir.join("shard.bin");
+    let bin = crate::limits::read_bounded(&bin_path, MAX_BIN_BYTES).map_err(io(&bin_path))?;
+    let bad_bin = |reason: String| ShardError::Corrupt {
+        path: bin_path.clone(),
+        reason,
+    };
+    if hex_sha256(&bin) != record.data_sha256 {
+        return Err(bad_bin(
+            "its SHA-256 is not the one shard.json records".into(),
+        ));
+    }
+    let part = decode(&bin, &record).map_err(bad_bin)?;
+    Ok(StudyFiles {
+        dir: dir.to_path_buf(),
+        record,
+        part,
+    })
+}
+
+/// The study part `bin` holds, checked against its `record`.
+fn decode(bin: &[u8], record: &StudyRecord) -> Result<StudyPart, String> {
+    let mut r = Reader { bin, at: 0 };
+    if r.take(16)? != MAGIC {
+        return Err("not a kneeform study shard.bin (its header)".into());
+    }
+    let (nx, nz) = (r.len()?, r.len()?);
+    let (i_origin, j_origin) = (r.u64()? as i64, r.u64()? as i64);
+    let pitch = r.f64()?;
+    let spec = GridSpec {
+        pitch,
+        i_origin,
+        j_origin,
+        nx,
+        nz,
+    };
+    let angles_deg = r.f64s()?;
+    let starts = r.points()?;
+    if hex_sha256(&bin[..r.at]) != record.common_sha256 {
+        return Err("its common part's SHA-256 is not the one shard.json records".into());
+    }
+    let (summary_angles, summary_pitches) = match &record.study {
+        StudySummary::Verify(s) => (&s.angles_deg, vec![s.pitch_mm]),
+        StudySummary::Converge(s) => (&s.angles_deg, s.pitches_mm.clone()),
+    };
+    let same = |a: &[f64], b: &[f64]| {
+        a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+    };
+    if starts.len() != record.starts
+        || !same(&angles_deg, summary_angles)
+        || !same(&summary_pitches, &record.settings.pitches_mm)
+        || summary_pitches.first().map(|p| p.to_bits()) != Some(pitch.to_bits())
+    {
+        return Err("its grid, angles or starts are not the ones shard.json describes".into());
+    }
+    let share = record.start_indices.len();
+    let expected_pairs = share * angles_deg.len();
+    let pitch_count = r.len()?;
+    if pitch_count != summary_pitches.len() {
+        return Err(format!(
+            "{pitch_count} pitches where shard.json names {}",
+            summary_pitches.len()
+        ));
+    }
+    let mut pitches = Vec::with_capacity(pitch_count);
+    for &expected in &summary_pitches {
+        let p = r.f64()?;
+        let band = TieBand {
+            sigma: r.f64()?,
+            m: r.f64()?,
+        };
+        let (grid_s, seconds) = (r.f64()?, r.f64()?);
+        let nodes = r.len()?;
+        let count = r.len()?;
+        if p.to_bits() != expected.to_bits() || count != expected_pairs {
+            return Err(format!(
+                "pitch {p} mm holds {count} start-angle pairs where shard.json says {expected} mm and {expected_pairs}"
+            ));
+        }
+        let mut pairs = Vec::with_capacity(count);
+        for k in 0..count {
+            pairs.push(r.pair(angles_deg[k / share.max(1)])?);
+        }
+        pitches.push(PitchPart {
+            pitch: p,
+            pairs,
+            band,
+            grid_s,
+            seconds,
+            nodes,
+        });
+    }
+    if r.at != bin.len() {
+        return Err("it holds more than its header says".into());
+    }
+    Ok(StudyPart {
+        shard: record.shard,
+        spec,
+        starts,
+        angles_deg,
+        pitches,
+        settings: record.settings.clone(),
+        summary: record.study.clone(),
+        sample_s: record.sample_s,
+        oracle_s: record.oracle_s,
+    })
+}
+
+fn put_u64(out: &mut Vec<u8>, v: u64) {
+    out.extend_from_slice(&v.to_le_bytes());
+}
+
+fn put_f64(out: &mut Vec<u8>, v: f64) {
+    put_u64(out, v.to_bits());
+}
+
+fn put_f64s(out: &mut Vec<u8>, v: &[f64]) {
+    put_u64(out, v.len() as u64);
+    for &x in v {
+        put_f64(out, x);
+    }
+}
+
+fn put_opt(out: &mut Vec<u8>, v: Option<f64>) {
+    out.push(u8::from(v.is_some()));
+    put_f64(out, v.unwrap_or(0.0));
+}
+
+fn put_points(out: &mut Vec<u8>, v: &[[f64; 2]]) {
+    put_u64(out, v.len() as u64);
+    for p in v {
+        put_f64(out, p[0]);
+        put_f64(out, p[1]);
+    }
+}
+
+fn put_nodes(out: &mut Vec<u8>, v: &[(usize, usize)]) {
+    put_u64(out, v.len() as u64);
+    for &(i, j) in v {
+        put_u64(out, i as u64);
+        put_u64(out, j as u64);
+    }
+}
+
+/// One pair: status, node, then its comparison's values and points, the
+/// grid's nodes and the snapped exact strikes (the row is rebuilt from
+/// them by [`row_of`], as the comparison builds it).
+fn put_pair(out: &mut Vec<u8>, pair: &PairResult) {
+    let status = STATUSES
+        .iter()
+        .position(|s| *s == pair.row.status)
+        .unwrap_or(STATUSES.len());
+    out.push(status as u8);
+    put_u64(out, pair.row.i as u64);
+    put_u64(out, pair.row.j as u64);
+    let c = &pair.cmp;
+    for v in [
+        c.push_error,
+        c.first_contact_error,
+        c.first_contact_error_decided,
+    ] {
+        put_opt(out, v);
+    }
+    for v in [
+        &c.miss,
+        &c.miss_decided,
+        &c.false_alarm,
+        &c.false_alarm_decided,
+        &c.unmatched_deflection,
+        &c.unmatched_deflection_decided,
+    ] {
+        put_f64s(out, v);
+    }
+    put_u64(out, c.exact_strikes as u64);
+    put_u64(out, c.undecided as u64);
+    let p = &c.points;
+    for v in [&p.grid, &p.strikes, &p.decided, &p.possible, &p.push] {
+        put_points(out, v);
+    }
+    put_nodes(out, &pair.grid_nodes);
+    put_nodes(out, &pair.snapped);
+}
+
+/// Reads `shard.bin`; every read checks the bytes left, and a length
+/// never exceeds them (a damaged length cannot make a huge allocation).
+struct Reader<'a> {
+    bin: &'a [u8],
+    at: usize,
+}
+
+impl Reader<'_> {
+    fn take(&mut self, n: usize) -> Result<&[u8], String> {
+        let end = self
+            .at
+            .checked_add(n)
+            .filter(|&e| e <= self.bin.len())
+            .ok_or("it ends early")?;
+        let bytes = &self.bin[self.at..end];
+        self.at = end;
+        Ok(bytes)
+    }
+
+    fn u8(&mut self) -> Result<u8, String> {
+        Ok(self.take(1)?[0])
+    }
+
+    fn u64(&mut self) -> Result<u64, String> {
+        let b = self.take(8)?;
+        Ok(u64::from_le_bytes(b.try_into().map_err(|_| "8 bytes")?))
+    }
+
+    fn f64(&mut self) -> Result<f64, String> {
+        Ok(f64::from_bits(self.u64()?))
+    }
+
+    /// A count of items of at least `size` bytes each still to come.
+    fn count(&mut self, size: usize) -> Result<usize, String> {
+        let n = self.u64()?;
+        let left = (self.bin.len() - self.at) / size.max(1);
+        usize::try_from(n)
+            .ok()
+            .filter(|&n| n <= left)
+            .ok_or_else(|| format!("a count of {n} where {left} at most fit"))
+    }
+
+    fn len(&mut self) -> Result<usize, String> {
+        usize::try_from(self.u64()?).map_err(|_| "a length beyond memory".to_string())
+    }
+
+    fn f64s(&mut self) -> Result<Vec<f64>, String> {
+        let n = self.count(8)?;
+        (0..n).map(|_| self.f64()).collect()
+    }
+
+    fn opt(&mut self) -> Result<Option<f64>, String> {
+        let some = match self.u8()? {
+            0 => false,
+            1 => true,
+            b => return Err(format!("an option flag {b}")),
+        };
+        let v = self.f64()?;
+        Ok(some.then_some(v))
+    }
+
+    fn points(&mut self) -> Result<Vec<[f64; 2]>, String> {
+        let n = self.count(16)?;
+        (0..n).map(|_| Ok([self.f64()?, self.f64()?])).collect()
+    }
+
+    fn nodes(&mut self) -> Result<Vec<(usize, usize)>, String> {
+        let n = self.count(16)?;
+        (0..n).map(|_| Ok((self.len()?, self.len()?))).collect()
+    }
+
+    fn pair(&mut self, angle_deg: f64) -> Result<PairResult, String> {
+        let status = *STATUSES
+            .get(usize::from(self.u8()?))
+            .ok_or("a start-angle pair of unknown status")?;
+        let (i, j) = (self.len()?, self.len()?);
+        let (push_error, first_contact_error, first_contact_error_decided) =
+            (self.opt()?, self.opt()?, self.opt()?);
+        let cmp = StartComparison {
+            push_error,
+            first_contact_error,
+            first_contact_error_decided,
+            miss: self.f64s()?,
+            miss_decided: self.f64s()?,
+            false_alarm: self.f64s()?,
+            false_alarm_decided: self.f64s()?,
+            unmatched_deflection: self.f64s()?,
+            unmatched_deflection_decided: self.f64s()?,
+            exact_strikes: self.len()?,
+            undecided: self.len()?,
+            points: StartPoints {
+                grid: self.points()?,
+                strikes: self.points()?,
+                decided: self.points()?,
+                possible: self.points()?,
+                push: self.points()?,
+            },
+        };
+        Ok(PairResult {
+            row: row_of(i, j, angle_deg, status, &cmp),
+            cmp,
+            grid_nodes: self.nodes()?,
+            snapped: self.nodes()?,
+        })
+    }
+}
