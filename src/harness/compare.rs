@@ -501,7 +501,11 @@ pub fn assemble(
         if row.status == "compared" || row.status == "grid_not_placed" {
             grid_set.extend(grid_nodes.iter().map(|&n| (a, n)));
             exact_set.extend(snapped.iter().map(|&n| (a, n)));
-            area_points[a].extend(&cmp.points);
+            // (A count of pairs that is no multiple of the angles' is a
+            // caller's mistake; its extra pairs join no angle's area.)
+            if let Some(points) = area_points.get_mut(a) {
+                points.extend(&cmp.points);
+            }
         }
     }
     let union = grid_set.union(&exact_set).count();
