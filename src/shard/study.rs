@@ -73,9 +73,9 @@ const MAX_BIN_BYTES: u64 = 8 << 30;
 #[derive(Debug)]
 pub enum MergedStudy {
     /// `verify`'s.
-    Verify(Verification),
+    Verify(Box<Verification>),
     /// `converge`'s.
-    Converge(Convergence),
+    Converge(Box<Convergence>),
 }
 
 /// Writes `part` as its shard: `shard.json` and `shard.bin` in the staged
@@ -229,8 +229,10 @@ pub fn merge_study(dirs: &[PathBuf]) -> Result<MergedStudy, ShardError> {
     shards.sort_by_key(|s| s.record.shard.index);
     let parts: Vec<StudyPart> = shards.into_iter().map(|s| s.part).collect();
     let merged = match parts[0].summary {
-        StudySummary::Verify(_) => merge_verify(&parts).map(MergedStudy::Verify),
-        StudySummary::Converge(_) => merge_converge(&parts).map(MergedStudy::Converge),
+        StudySummary::Verify(_) => merge_verify(&parts).map(|v| MergedStudy::Verify(Box::new(v))),
+        StudySummary::Converge(_) => {
+            merge_converge(&parts).map(|c| MergedStudy::Converge(Box::new(c)))
+        }
     };
     merged.ok_or_else(|| ShardError::Mismatch("the shards hold no study".into()))
 }
