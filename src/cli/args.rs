@@ -232,7 +232,8 @@ pub struct AnalyzeArgs {
     #[arg(long, default_value = "kneeform-out", value_name = "DIR")]
     pub out: PathBuf,
     /// Replace an existing --out directory of an earlier run (one holding
-    /// summary.json, or empty) with this run's results, whole.
+    /// summary.json, a study's verify.json or converge.json, or a shard's
+    /// shard.json; or empty) with this run's results, whole.
     #[arg(long)]
     pub force: bool,
     /// Also write the evidence report, `report.html`, into the output
@@ -279,8 +280,8 @@ pub struct MergeArgs {
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// Replace an existing --out directory of an earlier run (one holding
-    /// summary.json, verify.json or converge.json, or empty) with the
-    /// merged results, whole.
+    /// summary.json, a study's verify.json or converge.json, or a shard's
+    /// shard.json; or empty) with the merged results, whole.
     #[arg(long)]
     pub force: bool,
     /// Also write colliding_points.csv (as `analyze --points-csv`; an

@@ -155,7 +155,8 @@ pub fn set_threads(threads: Option<usize>) -> anyhow::Result<()> {
 
 /// Checks `out` before any work and stages the run's files beside it. An
 /// existing directory is replaced only with `force`, and only when it is
-/// an earlier run's (it holds `summary.json`) or empty: --force must not
+/// an earlier run's (it holds `summary.json`; a study's or a shard's
+/// files) or empty: --force must not
 /// remove a directory of someone else's files. Staging creates a directory
 /// beside `out`, so an unwritable place fails here.
 pub fn stage_output(out: &Path, force: bool) -> anyhow::Result<OutputDir> {
@@ -180,7 +181,7 @@ pub fn stage_output(out: &Path, force: bool) -> anyhow::Result<OutputDir> {
                 .is_none();
             ensure!(
                 is_run || is_empty,
-                "--out {} is not a kneeform run directory (no summary.json), so --force will not replace it: choose another --out",
+                "--out {} is not a kneeform run directory (no summary.json, verify.json, converge.json or shard.json), so --force will not replace it: choose another --out",
                 out.display()
             );
         }

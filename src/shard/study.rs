@@ -609,3 +609,81 @@ impl Reader<'_> {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pair() -> PairResult {
+        let cmp = StartComparison {
+            push_error: Some(-0.25),
+            first_contact_error: None,
+            first_contact_error_decided: Some(f64::MIN_POSITIVE),
+            miss: vec![1.5, f64::INFINITY],
+            miss_decided: vec![f64::INFINITY],
+            false_alarm: vec![0.1 + 0.2],
+            false_alarm_decided: Vec::new(),
+            unmatched_deflection: vec![3.0],
+            unmatched_deflection_decided: vec![-0.0],
+            exact_strikes: 2,
+            undecided: 1,
+            points: StartPoints {
+                grid: vec![[1.0, 2.0]],
+                strikes: vec![[3.0, 4.0], [5.0, 6.0]],
+                decided: vec![[5.0, 6.0]],
+                possible: Vec::new(),
+                push: vec![[-7.5, 8.25]],
+            },
+        };
+        PairResult {
+            row: row_of(4, 9, -30.0, "grid_not_placed", &cmp),
+            cmp,
+            grid_nodes: vec![(1, 2), (3, 4)],
+            snapped: vec![(5, 6)],
+        }
+    }
+
+    #[test]
+    fn a_pair_reads_back_bit_for_bit() {
+        let p = pair();
+        let mut bin = Vec::new();
+        put_pair(&mut bin, &p);
+        let mut r = Reader { bin: &bin, at: 0 };
+        let back = r.pair(-30.0).unwrap();
+        assert_eq!(r.at, bin.len());
+        // PartialEq on f64 would take -0.0 for 0.0: compare the bits too.
+        assert_eq!(back, p);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(
+            bits(&back.cmp.unmatched_deflection_decided),
+            bits(&p.cmp.unmatched_deflection_decided)
+        );
+    }
+
+    #[test]
+    fn a_cut_or_damaged_pair_is_an_error_not_a_panic() {
+        let mut bin = Vec::new();
+        put_pair(&mut bin, &pair());
+        for end in 0..bin.len() {
+            let mut r = Reader {
+                bin: &bin[..end],
+                at: 0,
+            };
+            assert!(r.pair(0.0).is_err(), "cut at {end}");
+        }
+        // A count far beyond the bytes left allocates nothing.
+        let mut huge = vec![0u8];
+        put_u64(&mut huge, 0);
+        put_u64(&mut huge, 0);
+        for _ in 0..3 {
+            put_opt(&mut huge, None);
+        }
+        put_u64(&mut huge, u64::MAX);
+        let mut r = Reader { bin: &huge, at: 0 };
+        assert!(r.pair(0.0).is_err());
+        // An unknown status.
+        let mut bad = bin.clone();
+        bad[0] = STATUSES.len() as u8;
+        assert!(Reader { bin: &bad, at: 0 }.pair(0.0).is_err());
+    }
+}
