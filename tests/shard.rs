@@ -309,6 +309,11 @@ fn four_verify_shards_merged_are_the_unsharded_verification_byte_for_byte() {
             serde_json::from_slice(&std::fs::read(shards[1].join("shard.json")).unwrap()).unwrap();
         assert_eq!(record["shard"], serde_json::json!({"index": 2, "count": 4}));
         assert_eq!(record["study"]["kind"], "verify");
+        // The part and every setting; no verdict of a part of the starts.
+        let summary = &record["study"]["summary"];
+        assert_eq!(summary["input_sha256"].as_str().unwrap().len(), 64);
+        assert_eq!(summary["tolerance_mm"].as_f64(), tolerance.parse().ok());
+        assert!(summary.get("pass").is_none() && summary.get("metrics").is_none());
         let starts = record["starts"].as_u64().unwrap() as usize;
         let mine: Vec<usize> = (1..starts).step_by(4).collect();
         assert_eq!(record["start_indices"], serde_json::json!(mine));

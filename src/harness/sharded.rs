@@ -52,9 +52,9 @@ pub struct PitchPart {
 }
 
 /// A shard's summary: `verify.json` or `converge.json` as the shard knows
-/// it: the part's identity and every setting, with the statistics of no
-/// start (the merge computes them from every shard's pairs; a shard's own
-/// could be infinite, which JSON cannot hold).
+/// it: the part's identity, every setting and the shard's own timings,
+/// with the statistics of no start (the merge computes them from every
+/// shard's pairs; `shard.json` leaves them out).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(tag = "kind", content = "summary", rename_all = "lowercase")]
 pub enum StudySummary {
@@ -174,7 +174,8 @@ pub fn verify_shard(
     // The study's identity and settings; its statistics are the merge's
     // (a shard's own could be infinite, which JSON cannot say).
     let none = assemble(Vec::new(), &setup.angles, band, 0.0);
-    let summary = VerifySummary::new(input, setup, options, &spec, &none, sample_s, oracle_s);
+    let mut summary = VerifySummary::new(input, setup, options, &spec, &none, sample_s, oracle_s);
+    summary.timings.grid_s = grid_s;
     Ok(StudyPart {
         shard,
         spec,

@@ -8,7 +8,8 @@
 //!   start count and this shard's start indices, the options
 //!   ([`StudySettings`]), the study's `verify.json` or `converge.json` as
 //!   the shard knows it (`"study": {"kind": "verify", "summary": ...}`:
-//!   the part's SHA-256 and every parameter; statistics of no start),
+//!   the part's SHA-256, every parameter and the shard's own timings; no
+//!   statistics, fits or verdict, which are the merge's),
 //!   its clock readings, and the SHA-256 of `shard.bin` and of its common
 //!   part;
 //! * `shard.bin`, little-endian: the common part (the grid the starts are
@@ -118,7 +119,8 @@ pub fn write_study_shard(out: &OutputDir, part: &StudyPart) -> Result<(), WriteE
     let path = out.path("shard.bin");
     std::fs::write(&path, &bin).map_err(WriteError::at(&path))?;
     let path = out.path("shard.json");
-    let text = serde_json::to_string_pretty(&record).map_err(WriteError::at(&path))? + "\n";
+    let text =
+        serde_json::to_string_pretty(&to_json(&record)).map_err(WriteError::at(&path))? + "\n";
     std::fs::write(&path, text).map_err(WriteError::at(&path))
 }
 
@@ -237,11 +239,12 @@ pub fn merge_study(dirs: &[PathBuf]) -> Result<MergedStudy, ShardError> {
     merged.ok_or_else(|| ShardError::Mismatch("the shards hold no study".into()))
 }
 
-/// What the shards of one study share: the record with its own counts,
-/// statistics, clocks and checksum of its data left out.
-fn identity(record: &StudyRecord) -> serde_json::Value {
-    let mut v = serde_json::to_value(record).unwrap_or_default();
-    let derived: &[&str] = match record.study {
+/// The fields of a study's summary that a merge computes from every
+/// shard's pairs (statistics, fits, the verdict): a shard's `shard.json`
+/// leaves them out, since a shard's own would describe a part of the
+/// starts only (and could be infinite, which JSON cannot hold).
+fn merged_keys(study: &StudySummary) -> &'static [&'static str] {
+    match study {
         StudySummary::Verify(_) => &[
             "pass",
             "area_distance_decided_mm",
@@ -251,7 +254,6 @@ fn identity(record: &StudyRecord) -> serde_json::Value {
             "area_iou",
             "counts",
             "worst_starts",
-            "timings",
         ],
         StudySummary::Converge(_) => &[
             "fits",
@@ -259,7 +261,67 @@ fn identity(record: &StudyRecord) -> serde_json::Value {
             "predicted_full_time_s",
             "seconds",
         ],
+    }
+}
+
+/// `record` as `shard.json` holds it: without [`merged_keys`].
+fn to_json(record: &StudyRecord) -> serde_json::Value {
+    let mut v = serde_json::to_value(record).unwrap_or_default();
+    if let Some(summary) = v
+        .pointer_mut("/study/summary")
+        .and_then(|s| s.as_object_mut())
+    {
+        for key in merged_keys(&record.study) {
+            summary.remove(*key);
+        }
+    }
+    v
+}
+
+/// `shard.json`'s record, its [`merged_keys`] set to those of a study of
+/// no start (the merge sets them from every shard's pairs).
+fn from_json(text: &[u8]) -> Result<StudyRecord, String> {
+    let mut v: serde_json::Value = serde_json::from_slice(text).map_err(|e| e.to_string())?;
+    let kind = v.pointer("/study/kind").and_then(|k| k.as_str());
+    let neutral = match kind {
+        Some("verify") => serde_json::json!({
+            "pass": false,
+            "area_distance_decided_mm": null,
+            "area_distance_mm": null,
+            "area_distance": [],
+            "metrics": {},
+            "area_iou": 0.0,
+            "counts": crate::harness::Counts::default(),
+            "worst_starts": [],
+        }),
+        Some("converge") => serde_json::json!({
+            "fits": {},
+            "recommended_pitch_mm": null,
+            "predicted_full_time_s": null,
+            "seconds": [],
+        }),
+        _ => serde_json::json!({}),
     };
+    if let (Some(summary), Some(neutral)) = (
+        v.pointer_mut("/study/summary")
+            .and_then(|s| s.as_object_mut()),
+        neutral.as_object(),
+    ) {
+        for (key, value) in neutral {
+            summary.entry(key.clone()).or_insert(value.clone());
+        }
+    }
+    serde_json::from_value(v).map_err(|e| e.to_string())
+}
+
+/// What the shards of one study share: the record with its own counts,
+/// statistics, clocks and checksum of its data left out.
+fn identity(record: &StudyRecord) -> serde_json::Value {
+    let mut v = serde_json::to_value(record).unwrap_or_default();
+    let mut derived = merged_keys(&record.study).to_vec();
+    if let StudySummary::Verify(_) = record.study {
+        derived.push("timings");
+    }
     let mut out = serde_json::Map::new();
     if let Some(map) = v.as_object_mut() {
         for key in [
@@ -274,7 +336,7 @@ fn identity(record: &StudyRecord) -> serde_json::Value {
         let study = map.remove("study").unwrap_or_default();
         let mut summary = study.get("summary").cloned().unwrap_or_default();
         if let Some(s) = summary.as_object_mut() {
-            for key in derived {
+            for key in &derived {
                 s.remove(*key);
             }
             // Keyed by the summary's own names, so that a mismatch names
@@ -302,8 +364,8 @@ fn read_study(dir: &Path) -> Result<StudyFiles, ShardError> {
         path: json_path.clone(),
         reason,
     };
-    let record: StudyRecord = serde_json::from_slice(&text)
-        .map_err(|e| corrupt(format!("not a kneeform study shard.json: {e}")))?;
+    let record =
+        from_json(&text).map_err(|e| corrupt(format!("not a kneeform study shard.json: {e}")))?;
     if record.format != FORMAT {
         return Err(corrupt(format!(
             "study shard format {}, this kneeform reads {FORMAT}",
