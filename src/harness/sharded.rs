@@ -124,12 +124,7 @@ pub(super) fn share(all: &[[f64; 2]], shard: Option<Shard>) -> Result<Vec<[f64; 
 }
 
 fn settings(selection: &StartSelection, tie_band_per_mm: f64) -> StudySettings {
-    let (starts, seed) = match *selection {
-        StartSelection::All => ("all".to_string(), 0),
-        StartSelection::Sample { count, seed } => (count.to_string(), seed),
-        StartSelection::Strip { z } => (format!("strip:{}:{}", z[0], z[1]), 0),
-        StartSelection::At(ref starts) => (format!("{} given", starts.len()), 0),
-    };
+    let (starts, seed) = super::verify::selection_words(selection);
     StudySettings {
         starts,
         seed,
@@ -270,12 +265,12 @@ fn pitch_result(part: &PitchPart, pairs: Vec<PairResult>, angles: &[f64]) -> Pit
 fn unsharded_pairs(parts: &[StudyPart], k: usize) -> Vec<PairResult> {
     let first = &parts[0];
     let (n, total) = (parts.len(), first.starts.len());
+    let shares: Vec<usize> = parts.iter().map(|p| p.shard.indices(total).len()).collect();
     let mut out = Vec::with_capacity(total * first.angles_deg.len());
     for a in 0..first.angles_deg.len() {
         for s in 0..total {
-            let part = &parts[s % n];
-            let per_angle = part.shard.indices(total).len();
-            out.push(part.pitches[k].pairs[a * per_angle + s / n].clone());
+            let pairs = &parts[s % n].pitches[k].pairs;
+            out.push(pairs[a * shares[s % n] + s / n].clone());
         }
     }
     out

@@ -209,7 +209,7 @@ impl VerifySummary {
         sample_s: f64,
         oracle_s: f64,
     ) -> VerifySummary {
-        let selection = &options.selection;
+        let (starts, seed) = selection_words(&options.selection);
         let mut summary = VerifySummary {
             kneeform_version: env!("CARGO_PKG_VERSION").into(),
             input_file: input.path.display().to_string(),
@@ -235,16 +235,8 @@ impl VerifySummary {
             area_distance_decided_mm: None,
             area_distance_mm: None,
             area_distance: Vec::new(),
-            starts: match selection {
-                StartSelection::All => "all".into(),
-                StartSelection::Sample { count, .. } => count.to_string(),
-                StartSelection::Strip { z } => format!("strip:{}:{}", z[0], z[1]),
-                StartSelection::At(starts) => format!("{} given", starts.len()),
-            },
-            seed: match *selection {
-                StartSelection::Sample { seed, .. } => seed,
-                _ => 0,
-            },
+            starts,
+            seed,
             metrics: std::collections::BTreeMap::new(),
             area_iou: 0.0,
             counts: Counts::default(),
@@ -298,6 +290,17 @@ impl VerifySummary {
             })
             .collect();
         self.timings.grid_s = comparison.grid_s;
+    }
+}
+
+/// `selection` as `verify.json` says it: `all`, the sample size,
+/// `strip:Z0:Z1` or `N given`; and the sample's seed (0 for no sample).
+pub(super) fn selection_words(selection: &StartSelection) -> (String, u64) {
+    match *selection {
+        StartSelection::All => ("all".into(), 0),
+        StartSelection::Sample { count, seed } => (count.to_string(), seed),
+        StartSelection::Strip { z } => (format!("strip:{}:{}", z[0], z[1]), 0),
+        StartSelection::At(ref starts) => (format!("{} given", starts.len()), 0),
     }
 }
 
