@@ -46,6 +46,7 @@ use crate::kneeform::GridFootprint;
 use crate::output::{OutputDir, RunResults, WriteError};
 use crate::summary::{AngleSummary, Summary};
 
+mod codec;
 pub mod study;
 
 /// One shard of a run's angles: the `index`-th (1-based) of `count`.
