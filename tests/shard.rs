@@ -1,6 +1,7 @@
-//! Fan-out: `analyze --shard K/N` and `kneeform merge` give the unsharded
-//! run's files byte for byte; `kneeform batch` resumes a killed batch
-//! without redoing finished items.
+//! Fan-out: `analyze --shard K/N`, `verify --shard K/N` and `converge
+//! --shard K/N` with `kneeform merge` give the unsharded command's files
+//! byte for byte (clock readings aside); `kneeform batch` resumes a killed
+//! batch without redoing finished items.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -21,8 +22,41 @@ fn refused(out: &Output, needle: &str, what: &str) {
 /// machine (as `.ci/same-outputs` sets them aside).
 const CLOCK_KEYS: [&str; 4] = ["timings", "run_unix_time", "peak_rss_mib", "threads"];
 
+/// The clock readings of a result file set aside: `summary.json`'s
+/// [`CLOCK_KEYS`], `verify.json`'s timings, `converge.json`'s engine
+/// seconds and the time predicted from them, `converge.csv`'s `seconds`
+/// column; `None` for a file that is a clock reading as a whole (the
+/// plot of the engine's time against the pitch). Other files as they are.
+fn without_clocks(name: &str, bytes: &[u8]) -> Option<Vec<u8>> {
+    let json_keys: &[&str] = match name {
+        "summary.json" => &CLOCK_KEYS,
+        "verify.json" => &["timings"],
+        "converge.json" => &["seconds", "predicted_full_time_s"],
+        "time_vs_pitch.png" => return None,
+        "converge.csv" => {
+            let text = String::from_utf8(bytes.to_vec()).unwrap();
+            let mut lines = text.lines();
+            let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+            let col = header.iter().position(|h| *h == "seconds").unwrap();
+            let rows = lines.map(|l| {
+                let mut cells: Vec<&str> = l.split(',').collect();
+                cells[col] = "";
+                cells.join(",")
+            });
+            let out: Vec<String> = std::iter::once(header.join(",")).chain(rows).collect();
+            return Some(out.join("\n").into_bytes());
+        }
+        _ => return Some(bytes.to_vec()),
+    };
+    let mut v: serde_json::Value = serde_json::from_slice(bytes).unwrap();
+    for key in json_keys {
+        v.as_object_mut().unwrap().remove(*key);
+    }
+    Some(serde_json::to_vec(&v).unwrap())
+}
+
 /// Asserts that the directories `a` and `b` hold the same files, byte for
-/// byte, `summary.json`'s clock readings aside; returns how many.
+/// byte, clock readings aside ([`without_clocks`]); returns how many.
 fn assert_same_files(a: &Path, b: &Path) -> usize {
     let names = |d: &Path| {
         let mut v: Vec<String> = std::fs::read_dir(d)
@@ -38,23 +72,12 @@ fn assert_same_files(a: &Path, b: &Path) -> usize {
             std::fs::read(a.join(&name)).unwrap(),
             std::fs::read(b.join(&name)).unwrap(),
         );
-        if name == "summary.json" {
-            let strip = |bytes: &[u8]| {
-                let mut v: serde_json::Value = serde_json::from_slice(bytes).unwrap();
-                for key in CLOCK_KEYS {
-                    v.as_object_mut().unwrap().remove(key);
-                }
-                v
-            };
-            assert_eq!(strip(&x), strip(&y), "{name} differs");
-        } else {
-            assert!(
-                x == y,
-                "{name} differs between {} and {}",
-                a.display(),
-                b.display()
-            );
-        }
+        assert!(
+            without_clocks(&name, &x) == without_clocks(&name, &y),
+            "{name} differs between {} and {}",
+            a.display(),
+            b.display()
+        );
     }
     names(a).len()
 }
@@ -217,6 +240,246 @@ fn merge_refuses_a_missing_a_repeated_or_a_foreign_shard() {
         ]);
         refused(&result, needle, bad);
         assert!(!dir.join("bad").exists());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The flags of the study tests: a coarse pitch, three angles, a small
+/// start sample (seconds in a debug build).
+const STUDY: [&str; 3] = ["--angles=-30,0,30", "--starts", "16"];
+
+/// Runs `command` (`verify` or `converge`) on `part` with [`STUDY`] and
+/// `extra` into `out`, `--shard K/N` when `shard` is given.
+fn study(
+    command: &str,
+    part: &str,
+    out: &Path,
+    shard: Option<(usize, usize)>,
+    extra: &[&str],
+) -> Output {
+    let spec = shard.map(|(k, n)| format!("{k}/{n}"));
+    let mut args = vec![command, part];
+    args.extend_from_slice(&STUDY);
+    args.extend_from_slice(extra);
+    if let Some(spec) = &spec {
+        args.extend(["--shard", spec.as_str()]);
+    }
+    args.extend(["--out", out.to_str().unwrap()]);
+    kneeform(&args)
+}
+
+/// Shards 1 to `n` of a study into `dir/shard-K`.
+fn study_shards(command: &str, part: &str, dir: &Path, n: usize, extra: &[&str]) -> Vec<PathBuf> {
+    (1..=n)
+        .map(|k| {
+            let out = dir.join(format!("shard-{k}"));
+            ok(study(command, part, &out, Some((k, n)), extra), "a shard");
+            out
+        })
+        .collect()
+}
+
+fn merge_study(shards: &[&Path], out: &Path) -> Output {
+    let mut args = vec!["merge".to_string()];
+    args.extend(shards.iter().map(|s| s.display().to_string()));
+    args.extend(["--out".into(), out.display().to_string()]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    kneeform(&args)
+}
+
+#[test]
+fn four_verify_shards_merged_are_the_unsharded_verification_byte_for_byte() {
+    // A bump, failing a tight tolerance; the thin rib, whose exact strikes
+    // the grid misses (infinite distances, unmatched deflections); the
+    // wave, which passes.
+    let mut codes = Vec::new();
+    for (name, tolerance) in [("bump", "1"), ("thin-rib", "1"), ("wave", "1")] {
+        let dir = scratch_dir(&format!("verify-shards-{name}"));
+        let part = scenario(name);
+        let extra = ["--pitch", "4", "--tolerance", tolerance];
+        let whole = study("verify", &part, &dir.join("whole"), None, &extra);
+        let code = whole.status.code();
+        assert!(
+            matches!(code, Some(0 | 1)),
+            "{name}: {}",
+            String::from_utf8_lossy(&whole.stderr)
+        );
+        let shards = study_shards("verify", &part, &dir, 4, &extra);
+        let record: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(shards[1].join("shard.json")).unwrap()).unwrap();
+        assert_eq!(record["shard"], serde_json::json!({"index": 2, "count": 4}));
+        assert_eq!(record["study"]["kind"], "verify");
+        // The part and every setting; no verdict of a part of the starts.
+        let summary = &record["study"]["summary"];
+        assert_eq!(summary["input_sha256"].as_str().unwrap().len(), 64);
+        assert_eq!(summary["tolerance_mm"].as_f64(), tolerance.parse().ok());
+        assert!(summary.get("pass").is_none() && summary.get("metrics").is_none());
+        let starts = record["starts"].as_u64().unwrap() as usize;
+        let mine: Vec<usize> = (1..starts).step_by(4).collect();
+        assert_eq!(record["start_indices"], serde_json::json!(mine));
+        let merged = dir.join("merged");
+        let order: Vec<&Path> = [2, 0, 3, 1].iter().map(|&k| shards[k].as_path()).collect();
+        let result = merge_study(&order, &merged);
+        // The merge's verdict is verify's.
+        assert_eq!(
+            result.status.code(),
+            code,
+            "{name}: {}",
+            String::from_utf8_lossy(&result.stderr)
+        );
+        assert_eq!(assert_same_files(&dir.join("whole"), &merged), 2, "{name}");
+        let rows = std::fs::read_to_string(merged.join("verify.csv")).unwrap();
+        assert_eq!(
+            rows.lines().count(),
+            1 + 3 * starts,
+            "{name}: a row per start and angle"
+        );
+        if name != "wave" {
+            let summary: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(merged.join("verify.json")).unwrap())
+                    .unwrap();
+            assert!(
+                summary["counts"]["exact_strikes"].as_u64().unwrap() > 0,
+                "{name}: nothing struck"
+            );
+        }
+        codes.push(code);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+    assert!(
+        codes.contains(&Some(0)) && codes.contains(&Some(1)),
+        "{codes:?}"
+    );
+}
+
+#[test]
+fn four_converge_shards_merged_are_the_unsharded_study_byte_for_byte() {
+    let dir = scratch_dir("converge-shards");
+    let part = scenario("bump");
+    let extra = ["--pitches", "8,4", "--tolerance", "3"];
+    ok(
+        study("converge", &part, &dir.join("whole"), None, &extra),
+        "the unsharded study",
+    );
+    let shards = study_shards("converge", &part, &dir, 4, &extra);
+    let merged = dir.join("merged");
+    let order: Vec<&Path> = [3, 1, 0, 2].iter().map(|&k| shards[k].as_path()).collect();
+    ok(merge_study(&order, &merged), "merge");
+    // converge.csv and .json, a verify_<pitch>mm.csv per pitch, two plots.
+    assert_eq!(assert_same_files(&dir.join("whole"), &merged), 6);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn merge_refuses_a_study_s_missing_repeated_foreign_or_damaged_shard() {
+    let dir = scratch_dir("study-refusals");
+    let wave = scenario("wave");
+    let extra = ["--pitch", "4"];
+    let shards = study_shards("verify", &wave, &dir, 3, &extra);
+    let s: Vec<&Path> = shards.iter().map(PathBuf::as_path).collect();
+    let other = dir.join("other");
+    std::fs::create_dir(&other).unwrap();
+    // Another part; another seed (the same part, other starts); another
+    // tie band (the same starts); another kind of shard.
+    let foreign = study_shards("verify", &scenario("bump"), &other, 3, &extra);
+    let seed = dir.join("seed");
+    ok(
+        study(
+            "verify",
+            &wave,
+            &seed,
+            Some((2, 3)),
+            &["--pitch", "4", "--seed", "4"],
+        ),
+        "seed",
+    );
+    let band = dir.join("band");
+    ok(
+        study(
+            "verify",
+            &wave,
+            &band,
+            Some((2, 3)),
+            &["--pitch", "4", "--tie-band", "2"],
+        ),
+        "tie band",
+    );
+    let converge = dir.join("converge");
+    ok(
+        study(
+            "converge",
+            &wave,
+            &converge,
+            Some((2, 3)),
+            &["--pitches", "8,4"],
+        ),
+        "a converge shard",
+    );
+    let analysis_dir = dir.join("analysis");
+    std::fs::create_dir(&analysis_dir).unwrap();
+    let analysis = shard(&wave, &analysis_dir, 2, 3, &[]);
+    let out = dir.join("merged");
+    for (given, needle, what) in [
+        (vec![s[0], s[2]], "shard 2/3 is missing", "missing"),
+        (
+            vec![s[0], s[1], s[1], s[2]],
+            "shard 2/3 is given twice",
+            "twice",
+        ),
+        (
+            vec![s[0], &foreign[1], s[2]],
+            "shards of different studies",
+            "foreign",
+        ),
+        (
+            vec![s[0], &seed, s[2]],
+            "shards of different studies",
+            "seed",
+        ),
+        (vec![s[0], &converge, s[2]], "convergence study", "converge"),
+        (vec![s[0], &analysis, s[2]], "an analysis", "analysis"),
+    ] {
+        refused(&merge_study(&given, &out), needle, what);
+        assert!(!out.exists(), "{what}: output left behind");
+    }
+    let four = dir.join("four");
+    ok(study("verify", &wave, &four, Some((1, 4)), &extra), "N = 4");
+    refused(
+        &merge_study(&[&four, s[1], s[2]], &out),
+        "one N",
+        "another N",
+    );
+    let bin = shards[0].join("shard.bin");
+    let mut bytes = std::fs::read(&bin).unwrap();
+    let last = bytes.len() - 1;
+    bytes[last] ^= 1;
+    std::fs::write(&bin, bytes).unwrap();
+    refused(&merge_study(&s, &out), "SHA-256", "damaged");
+    assert!(!out.exists());
+    // Flags a study's shard cannot take.
+    for (bad, needle, extra) in [
+        ("0/3", "--shard", &extra[..]),
+        ("x", "--shard", &extra[..]),
+        ("1/999", "999 shards of 16 starts", &extra[..]),
+        (
+            "1/2",
+            "--approach direct",
+            &["--pitch", "4", "--approach", "direct"][..],
+        ),
+    ] {
+        let bad_out = dir.join("bad");
+        refused(
+            &study(
+                "verify",
+                &wave,
+                &bad_out,
+                None,
+                &[extra, &["--shard", bad]].concat(),
+            ),
+            needle,
+            bad,
+        );
+        assert!(!bad_out.exists());
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -39,9 +39,11 @@ pub enum Command {
     /// Compare grid and oracle at several pitches: errors, fitted orders of
     /// convergence, and the coarsest pitch meeting --tolerance.
     Converge(ConvergeArgs),
-    /// Merge the shards of one analysis (`analyze --shard K/N`, one
-    /// directory each) into the run's results, byte for byte those of the
-    /// unsharded run (clock readings aside).
+    /// Merge the shards of one analysis, verification or convergence study
+    /// (`analyze`, `verify` or `converge --shard K/N`, one directory each)
+    /// into its results, byte for byte those of the unsharded command
+    /// (clock readings aside). A verification's merge exits as `verify`
+    /// does: 0 when it passes, 1 when it fails, 2 on error.
     Merge(MergeArgs),
     /// Run the analyses a manifest lists (parts, variants), one after the
     /// other, skipping those whose output directory holds a complete run
@@ -230,7 +232,8 @@ pub struct AnalyzeArgs {
     #[arg(long, default_value = "kneeform-out", value_name = "DIR")]
     pub out: PathBuf,
     /// Replace an existing --out directory of an earlier run (one holding
-    /// summary.json, or empty) with this run's results, whole.
+    /// summary.json, a study's verify.json or converge.json, or a shard's
+    /// shard.json; or empty) with this run's results, whole.
     #[arg(long)]
     pub force: bool,
     /// Also write the evidence report, `report.html`, into the output
@@ -267,8 +270,9 @@ pub struct AnalyzeArgs {
 /// `kneeform merge`.
 #[derive(Debug, Args)]
 pub struct MergeArgs {
-    /// The shards' directories (`analyze --shard K/N --out DIR`), one per
-    /// shard, in any order; every K from 1 to N exactly once.
+    /// The shards' directories (`analyze`, `verify` or `converge --shard
+    /// K/N --out DIR`), one per shard, in any order; every K from 1 to N
+    /// exactly once, all of one run or study.
     #[arg(required = true, value_name = "SHARD_DIR")]
     pub shards: Vec<PathBuf>,
     /// Output directory of the merged run (created; it appears whole or
@@ -276,10 +280,12 @@ pub struct MergeArgs {
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// Replace an existing --out directory of an earlier run (one holding
-    /// summary.json, or empty) with the merged results, whole.
+    /// summary.json, a study's verify.json or converge.json, or a shard's
+    /// shard.json; or empty) with the merged results, whole.
     #[arg(long)]
     pub force: bool,
-    /// Also write colliding_points.csv (as `analyze --points-csv`).
+    /// Also write colliding_points.csv (as `analyze --points-csv`; an
+    /// analysis's shards only).
     #[arg(long)]
     pub points_csv: bool,
 }
@@ -386,6 +392,15 @@ pub struct StudyArgs {
     pub setup: SetupArgs,
     #[command(flatten)]
     pub starts: StartArgs,
+    /// Compare one shard of the starts and write it as a partial result
+    /// (shard.json, shard.bin) for `kneeform merge`: shard K of N takes
+    /// the study's starts s (0-based, in the order the study compares them,
+    /// after --starts sampling) with s % N == K - 1, and runs the exact
+    /// oracle on those alone. 1 <= K <= N <= the number of starts. A
+    /// shard exits 0 once written: pass or fail is the merge's. Not with
+    /// --approach direct. Default: every start.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
 }
 
 /// `kneeform verify`.

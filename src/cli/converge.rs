@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use kneeform::Approach;
-use kneeform::harness::{self, ConvergeOptions, DECIDED_METRICS};
+use kneeform::harness::{self, ConvergeOptions};
 use kneeform::output;
 
 use super::args::ConvergeArgs;
@@ -35,9 +35,18 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
         tie_band_per_mm: args.study.starts.tie_band,
         tolerance: args.tolerance,
     };
+    let shard = super::study_shard(&args.study)?;
     let (input, setup) = super::study_inputs(&args.study, options.validate())?;
     if setup.approach == Approach::Direct {
+        if shard.is_some() {
+            return Err(super::refuse_direct_shard());
+        }
         return run_direct(args, &input, &setup, &options);
+    }
+    if let Some(shard) = shard {
+        let part = harness::converge_shard(&input, &setup, &options, shard, &Bars::default())
+            .map_err(super::harness_error)?;
+        return super::write_study_shard(&args.out, &part);
     }
     let study = harness::converge(&input, &setup, &options, &Bars::default())
         .map_err(super::harness_error)?;
@@ -48,45 +57,7 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
         study.oracle_s
     );
     output::write_convergence(&args.out, &study)?;
-    let results = &study.results;
-    let fitted = &study.fits;
-    for r in results {
-        let maxes: Vec<String> = r
-            .comparison
-            .stats
-            .iter()
-            .filter(|(m, _)| DECIDED_METRICS.contains(&m.as_str()))
-            .map(|(m, s)| format!("{m} {:.3}", s.max))
-            .collect();
-        eprintln!(
-            "p = {:>6} mm: {} | all strikes: area_distance {:.3} | IoU {:.3} | {} undecided | {:.2} s",
-            r.pitch,
-            maxes.join(", "),
-            r.comparison.stat("area_distance").max,
-            r.comparison.area_iou,
-            r.comparison.counts.exact_undecided,
-            r.seconds
-        );
-    }
-    for (m, f) in fitted {
-        if !DECIDED_METRICS.contains(&m.as_str()) {
-            continue;
-        }
-        match f {
-            Some(f) => eprintln!("{m:>22}: error ~ {:.3} p^{:.2}", f.c, f.alpha),
-            None => eprintln!("{m:>22}: no fit (zero or too few errors)"),
-        }
-    }
-    match (args.tolerance, study.recommended()) {
-        (Some(t), Some(r)) => eprintln!(
-            "kneeform: the coarsest pitch within {t} mm is {} mm; a full 61-angle analysis at it takes about {:.1} s",
-            r.pitch,
-            study.summary.predicted_full_time_s.unwrap_or(f64::NAN)
-        ),
-        (Some(t), None) => eprintln!("kneeform: no pitch tried is within {t} mm"),
-        _ => {}
-    }
-    eprintln!("kneeform: results in {}", args.out.display());
+    super::study::print_convergence(&study, &args.out);
     Ok(ExitCode::SUCCESS)
 }
 

@@ -1,15 +1,61 @@
 //! `kneeform merge`: the shards of one analysis (`analyze --shard K/N`)
-//! into the run's result directory, as the unsharded `analyze` writes it.
+//! into the run's result directory, as the unsharded `analyze` writes it;
+//! or the shards of one verification or convergence study (`verify` or
+//! `converge --shard K/N`) into the study's, as the unsharded command
+//! writes it, printing and exiting as it does.
 
 use std::process::ExitCode;
 
-use anyhow::Context;
-use kneeform::output::WriteOptions;
+use anyhow::{Context, ensure};
+use kneeform::output::{self, OutputDir, WriteOptions};
+use kneeform::shard::study::{MergedStudy, ShardKind, shard_kind};
 
 use super::args::MergeArgs;
 
 pub fn run(args: &MergeArgs) -> anyhow::Result<ExitCode> {
+    let kinds = args
+        .shards
+        .iter()
+        .map(|d| shard_kind(d))
+        .collect::<Result<Vec<_>, _>>()
+        .context("cannot merge the shards")?;
+    let kind = kinds[0];
+    if let Some(k) = kinds.iter().position(|&k| k != kind) {
+        anyhow::bail!(
+            "cannot merge the shards: {} is a shard of {}, {} of {}",
+            args.shards[0].display(),
+            kind,
+            args.shards[k].display(),
+            kinds[k]
+        );
+    }
+    ensure!(
+        kind == ShardKind::Analysis || !args.points_csv,
+        "--points-csv is for an analysis's shards: a study writes no colliding points"
+    );
     let out = super::stage_output(&args.out, args.force)?;
+    if kind == ShardKind::Analysis {
+        return merge_analysis(args, out);
+    }
+    let merged =
+        kneeform::shard::study::merge_study(&args.shards).context("cannot merge the shards")?;
+    match &merged {
+        MergedStudy::Verify(v) => output::write_verification_files(&out, v)?,
+        MergedStudy::Converge(c) => output::write_convergence_files(&out, c)?,
+    }
+    out.commit()
+        .with_context(|| format!("cannot move results into {}", args.out.display()))?;
+    eprintln!("kneeform: merged {} shards of {kind}", args.shards.len());
+    Ok(match &merged {
+        MergedStudy::Verify(v) => super::study::print_verification(v, &args.out),
+        MergedStudy::Converge(c) => {
+            super::study::print_convergence(c, &args.out);
+            ExitCode::SUCCESS
+        }
+    })
+}
+
+fn merge_analysis(args: &MergeArgs, out: OutputDir) -> anyhow::Result<ExitCode> {
     let merged = kneeform::shard::merge(&args.shards).context("cannot merge the shards")?;
     let options = WriteOptions {
         points_csv: args.points_csv,

@@ -9,14 +9,18 @@ pub mod merge;
 pub mod progress;
 pub mod report;
 pub mod scenario;
+pub mod study;
 pub mod verify;
 
 use std::path::Path;
 
 use anyhow::Context;
-use kneeform::harness::HarnessError;
+use std::process::ExitCode;
+
+use kneeform::harness::{HarnessError, StudyPart};
 use kneeform::output::OutputDir;
 use kneeform::report::ReportOptions;
+use kneeform::shard::Shard;
 use kneeform::{PartFile, Setup};
 
 use args::StudyArgs;
@@ -61,6 +65,44 @@ pub fn study_inputs(
     Ok((input, setup))
 }
 
+/// `--shard K/N` of a study, parsed; `None` without one.
+pub fn study_shard(study: &StudyArgs) -> anyhow::Result<Option<Shard>> {
+    study
+        .shard
+        .as_deref()
+        .map(Shard::parse)
+        .transpose()
+        .context("--shard")
+}
+
+/// Writes a study's shard into `out` (staged: it appears whole or not at
+/// all) and says so.
+pub fn write_study_shard(out: &Path, part: &StudyPart) -> anyhow::Result<ExitCode> {
+    let staged = OutputDir::stage(out)
+        .with_context(|| format!("cannot write the shard to {}", out.display()))?;
+    kneeform::shard::study::write_study_shard(&staged, part)?;
+    staged
+        .commit()
+        .with_context(|| format!("cannot move the shard into {}", out.display()))?;
+    let shard = part.shard;
+    eprintln!(
+        "kneeform: shard {shard}: {} of {} starts written to {}; `kneeform merge` puts the {} shards together",
+        shard.indices(part.starts.len()).len(),
+        part.starts.len(),
+        out.display(),
+        shard.count
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `--shard` with `--approach direct`: not built (the direct approach's
+/// positions are not a study's starts).
+pub fn refuse_direct_shard() -> anyhow::Error {
+    anyhow::anyhow!(
+        "--shard is not built for --approach direct yet: run the direct approach's study unsharded"
+    )
+}
+
 /// A harness error with the flag it concerns in front, where one does.
 pub fn harness_error(err: HarnessError) -> anyhow::Error {
     let flag = match &err {
@@ -70,6 +112,7 @@ pub fn harness_error(err: HarnessError) -> anyhow::Error {
         HarnessError::Pitches(_) => Some("--pitches".into()),
         HarnessError::EmptySample | HarnessError::Strip(_) => Some("--starts".into()),
         HarnessError::DirectApproach => Some("--approach".into()),
+        HarnessError::TooManyShards { .. } => Some("--shard".into()),
         _ => None,
     };
     match flag {
@@ -112,7 +155,8 @@ pub fn set_threads(threads: Option<usize>) -> anyhow::Result<()> {
 
 /// Checks `out` before any work and stages the run's files beside it. An
 /// existing directory is replaced only with `force`, and only when it is
-/// an earlier run's (it holds `summary.json`) or empty: --force must not
+/// an earlier run's (it holds `summary.json`; a study's or a shard's
+/// files) or empty: --force must not
 /// remove a directory of someone else's files. Staging creates a directory
 /// beside `out`, so an unwritable place fails here.
 pub fn stage_output(out: &Path, force: bool) -> anyhow::Result<OutputDir> {
@@ -127,15 +171,17 @@ pub fn stage_output(out: &Path, force: bool) -> anyhow::Result<OutputDir> {
                 "--out {} already exists: pass --force to replace it, or choose another --out",
                 out.display()
             );
-            // A run's directory, or a shard's.
-            let is_run = out.join("summary.json").is_file() || out.join("shard.json").is_file();
+            // A run's directory, a study's, or a shard's.
+            let is_run = ["summary.json", "shard.json", "verify.json", "converge.json"]
+                .iter()
+                .any(|f| out.join(f).is_file());
             let is_empty = std::fs::read_dir(out)
                 .with_context(|| format!("cannot read --out {}", out.display()))?
                 .next()
                 .is_none();
             ensure!(
                 is_run || is_empty,
-                "--out {} is not a kneeform run directory (no summary.json), so --force will not replace it: choose another --out",
+                "--out {} is not a kneeform run directory (no summary.json, verify.json, converge.json or shard.json), so --force will not replace it: choose another --out",
                 out.display()
             );
         }

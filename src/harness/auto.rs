@@ -138,6 +138,7 @@ pub fn choose_pitch(
             seed: 1,
         },
         TieBand::DEFAULT_PER_MM,
+        None,
         progress,
     )?;
     let scale = setup.angles.len() as f64 / angles.len() as f64;

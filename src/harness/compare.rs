@@ -278,14 +278,63 @@ pub struct Comparison {
     pub grid_s: f64,
 }
 
-/// One start-angle pair: its row, its comparison, the grid's colliding
-/// nodes and the exact strikes snapped to nodes.
-type PairResult = (
-    VerifyRow,
-    StartComparison,
-    Vec<(usize, usize)>,
-    Vec<(usize, usize)>,
-);
+/// One start-angle pair compared: its row, its comparison, the grid's
+/// colliding nodes and the exact strikes snapped to nodes. A comparison
+/// is assembled from these alone ([`assemble`]), so a shard of a study
+/// (`verify --shard K/N`) keeps them and a merge assembles the whole.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PairResult {
+    /// The row of `verify.csv`.
+    pub row: VerifyRow,
+    /// The metrics of the pair.
+    pub cmp: StartComparison,
+    /// The grid's colliding nodes `(i, j)`.
+    pub grid_nodes: Vec<(usize, usize)>,
+    /// The exact strikes snapped to their nearest nodes `(i, j)`.
+    pub snapped: Vec<(usize, usize)>,
+}
+
+/// The statuses of a row, in the order a shard's file numbers them.
+pub const STATUSES: [&str; 5] = [
+    "compared",
+    "grid_not_placed",
+    "oracle_not_placed",
+    "not_placed",
+    "oracle_failed",
+];
+
+/// The row of `verify.csv` of the pair at node `(i, j)` and `angle_deg`
+/// whose status is `status` (one of [`STATUSES`]) and comparison `cmp`.
+pub fn row_of(
+    i: usize,
+    j: usize,
+    angle_deg: f64,
+    status: &str,
+    cmp: &StartComparison,
+) -> VerifyRow {
+    let worst = |v: &[f64]| v.iter().copied().reduce(f64::max).filter(|v| v.is_finite());
+    let worst_at = cmp.worst_decided_point().map(|(p, _)| p);
+    VerifyRow {
+        i,
+        j,
+        angle_deg,
+        status: status.into(),
+        push_error: cmp.push_error,
+        first_contact_error: cmp.first_contact_error,
+        miss_distance: worst(&cmp.miss),
+        false_alarm_distance: worst(&cmp.false_alarm),
+        unmatched_deflection: worst(&cmp.unmatched_deflection),
+        first_contact_error_decided: cmp.first_contact_error_decided,
+        miss_distance_decided: worst(&cmp.miss_decided),
+        false_alarm_distance_decided: worst(&cmp.false_alarm_decided),
+        unmatched_deflection_decided: worst(&cmp.unmatched_deflection_decided),
+        exact_strikes: cmp.exact_strikes,
+        exact_undecided: cmp.undecided,
+        grid_colliding: cmp.false_alarm.len(),
+        worst_x: worst_at.map(|p| p[0]),
+        worst_z: worst_at.map(|p| p[1]),
+    }
+}
 
 /// Compares `grid` with `traces` (angle-major over `starts`, positions in
 /// mm that must be nodes of `grid`).
@@ -309,6 +358,25 @@ pub(crate) fn compare_grid_with(
     options: &CompareOptions,
     fault: Option<Fault>,
 ) -> Result<Comparison, HarnessError> {
+    let t = Instant::now();
+    let results = pair_results(grid, footprints, starts, traces, options, fault)?;
+    let grid_s = t.elapsed().as_secs_f64();
+    let band = TieBand::new(options.rule.sigma, grid.spec.pitch, options.tie_band_per_mm);
+    let angles: Vec<f64> = footprints.iter().map(|fp| fp.angle_deg).collect();
+    Ok(assemble(results, &angles, band, grid_s))
+}
+
+/// Every start-angle pair of `starts` (positions in mm, nodes of `grid`)
+/// at `footprints` compared with `traces` (angle-major), in angle-major
+/// order: the per-pair work of a comparison.
+pub(crate) fn pair_results(
+    grid: &HeightGrid,
+    footprints: &[GridFootprint],
+    starts: &[[f64; 2]],
+    traces: &[StartTrace],
+    options: &CompareOptions,
+    fault: Option<Fault>,
+) -> Result<Vec<PairResult>, HarnessError> {
     crate::engine::assert_same_pitch(grid, footprints);
     let spec = grid.spec;
     let band = TieBand::new(options.rule.sigma, spec.pitch, options.tie_band_per_mm);
@@ -327,11 +395,10 @@ pub(crate) fn compare_grid_with(
             expected: footprints.len() * nodes.len(),
         });
     }
-    let t = Instant::now();
     let pairs: Vec<(usize, usize)> = (0..footprints.len())
         .flat_map(|a| (0..nodes.len()).map(move |s| (a, s)))
         .collect();
-    let results: Vec<PairResult> = pairs
+    Ok(pairs
         .par_iter()
         .map(|&(a, s)| {
             let (i, j) = nodes[s];
@@ -347,48 +414,49 @@ pub(crate) fn compare_grid_with(
                 (StartStatus::NotPlaced, true) => "oracle_not_placed",
                 (StartStatus::NotPlaced, false) => "not_placed",
             };
-            let worst = |v: &[f64]| v.iter().copied().reduce(f64::max).filter(|v| v.is_finite());
             let snapped: Vec<(usize, usize)> = cmp
                 .points
                 .strikes
                 .iter()
                 .filter_map(|p| node_of(p[0], p[1]))
                 .collect();
-            let worst_at = cmp.worst_decided_point().map(|(p, _)| p);
-            let row = VerifyRow {
-                i,
-                j,
-                angle_deg: fp.angle_deg,
-                status: status.into(),
-                push_error: cmp.push_error,
-                first_contact_error: cmp.first_contact_error,
-                miss_distance: worst(&cmp.miss),
-                false_alarm_distance: worst(&cmp.false_alarm),
-                unmatched_deflection: worst(&cmp.unmatched_deflection),
-                first_contact_error_decided: cmp.first_contact_error_decided,
-                miss_distance_decided: worst(&cmp.miss_decided),
-                false_alarm_distance_decided: worst(&cmp.false_alarm_decided),
-                unmatched_deflection_decided: worst(&cmp.unmatched_deflection_decided),
-                exact_strikes: cmp.exact_strikes,
-                exact_undecided: cmp.undecided,
-                grid_colliding: cmp.false_alarm.len(),
-                worst_x: worst_at.map(|p| p[0]),
-                worst_z: worst_at.map(|p| p[1]),
-            };
-            let grid_nodes = g.colliding.iter().map(|c| c.node).collect();
-            (row, cmp, grid_nodes, snapped)
+            PairResult {
+                row: row_of(i, j, fp.angle_deg, status, &cmp),
+                grid_nodes: g.colliding.iter().map(|c| c.node).collect(),
+                snapped,
+                cmp,
+            }
         })
-        .collect();
-    let grid_s = t.elapsed().as_secs_f64();
+        .collect())
+}
 
+/// The comparison of `results`: every start-angle pair at the angles
+/// `angles_deg` (degrees), angle-major over the same starts, with the tie
+/// band `band` and `grid_s` seconds spent on the grid side. Its
+/// statistics, counts and area distances depend on the pairs and their
+/// order alone.
+pub fn assemble(
+    results: Vec<PairResult>,
+    angles_deg: &[f64],
+    band: TieBand,
+    grid_s: f64,
+) -> Comparison {
+    let per_angle = results.len() / angles_deg.len().max(1);
     let mut counts = Counts {
         pairs: results.len(),
         ..Counts::default()
     };
     let mut values: Vec<Vec<f64>> = vec![Vec::new(); METRICS.len()];
     let (mut grid_set, mut exact_set) = (HashSet::new(), HashSet::new());
-    let mut area_points: Vec<StartPoints> = vec![StartPoints::default(); footprints.len()];
-    for ((row, cmp, grid_nodes, snapped), &(a, _)) in results.iter().zip(&pairs) {
+    let mut area_points: Vec<StartPoints> = vec![StartPoints::default(); angles_deg.len()];
+    for (k, pair) in results.iter().enumerate() {
+        let a = k / per_angle.max(1);
+        let PairResult {
+            row,
+            cmp,
+            grid_nodes,
+            snapped,
+        } = pair;
         match row.status.as_str() {
             "compared" => counts.compared += 1,
             "grid_not_placed" => counts.grid_not_placed += 1,
@@ -433,7 +501,11 @@ pub(crate) fn compare_grid_with(
         if row.status == "compared" || row.status == "grid_not_placed" {
             grid_set.extend(grid_nodes.iter().map(|&n| (a, n)));
             exact_set.extend(snapped.iter().map(|&n| (a, n)));
-            area_points[a].extend(&cmp.points);
+            // (A count of pairs that is no multiple of the angles' is a
+            // caller's mistake; its extra pairs join no angle's area.)
+            if let Some(points) = area_points.get_mut(a) {
+                points.extend(&cmp.points);
+            }
         }
     }
     let union = grid_set.union(&exact_set).count();
@@ -444,16 +516,16 @@ pub(crate) fn compare_grid_with(
     };
     let area: Vec<AreaDistance> = area_points
         .into_par_iter()
-        .zip(footprints)
-        .map(|(pts, fp)| area_distance(fp.angle_deg, pts))
+        .zip(angles_deg)
+        .map(|(pts, &angle)| area_distance(angle, pts))
         .collect();
     for a in &area {
         values[metric_index("area_distance")].push(a.miss.max(a.false_alarm));
         values[metric_index("area_distance_decided")]
             .push(a.miss_decided.max(a.false_alarm_decided));
     }
-    Ok(Comparison {
-        rows: results.into_iter().map(|r| r.0).collect(),
+    Comparison {
+        rows: results.into_iter().map(|r| r.row).collect(),
         stats: METRICS
             .iter()
             .zip(&values)
@@ -464,7 +536,7 @@ pub(crate) fn compare_grid_with(
         band,
         counts,
         grid_s,
-    })
+    }
 }
 
 /// The area distance of one angle's unions of points (see

@@ -8,8 +8,9 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use super::HarnessError;
-use super::compare::{CompareOptions, Comparison, StartSelection, compare_grid};
-use super::metrics::METRICS;
+use super::compare::{CompareOptions, Comparison, StartSelection, assemble, pair_results};
+use super::metrics::{METRICS, TieBand};
+use super::sharded::PitchPart;
 use super::verify::{
     check_selection, check_tie_band, check_tolerance, oracle_options, run_oracle, start_positions,
     tie_band_rule,
@@ -18,6 +19,7 @@ use crate::analysis::{Progress, Setup};
 use crate::engine::{AngleMask, EngineOptions, colliding_masks};
 use crate::grid::{GridSpec, HeightGrid};
 use crate::mesh::{PartFile, Triangle};
+use crate::shard::Shard;
 use kneeform_oracle::StartTrace;
 
 /// One pitch of a convergence study.
@@ -160,8 +162,11 @@ pub(super) struct Ladder<'a> {
     /// The study's setup at the coarsest pitch.
     setup: Setup,
     coarse: GridSpec,
-    /// The starts (mm), nodes of every grid of the ladder.
+    /// The starts (mm), nodes of every grid of the ladder: a shard's
+    /// share of `all_starts`, or all of them.
     pub starts: Vec<[f64; 2]>,
+    /// Every start of the study (mm), in its order.
+    pub all_starts: Vec<[f64; 2]>,
     traces: Vec<StartTrace>,
     /// Seconds the oracle took.
     pub oracle_s: f64,
@@ -170,22 +175,25 @@ pub(super) struct Ladder<'a> {
 
 impl<'a> Ladder<'a> {
     /// The coarsest grid of `setup` (its pitch) on `input`, the starts of
-    /// `selection` on it, and their exact traces at `setup`'s angles with
-    /// the oracle resolving `finest` (mm).
+    /// `selection` on it (`shard`'s share of them when given), and their
+    /// exact traces at `setup`'s angles with the oracle resolving `finest`
+    /// (mm).
     pub(super) fn new(
         input: &'a PartFile,
         setup: &Setup,
         finest: f64,
         selection: &StartSelection,
         tie_band_per_mm: f64,
+        shard: Option<Shard>,
         progress: &dyn Progress,
     ) -> Result<Ladder<'a>, HarnessError> {
         setup.validate()?;
         let triangles = &input.part.triangles;
         let coarse = setup.grid_spec(&input.part)?;
         let coarse_grid = HeightGrid::sample(triangles, coarse);
-        let starts = start_positions(&coarse_grid, &setup.footprints(&coarse), selection)?;
+        let all_starts = start_positions(&coarse_grid, &setup.footprints(&coarse), selection)?;
         drop(coarse_grid);
+        let starts = super::sharded::share(&all_starts, shard)?;
         let oracle = oracle_options(&setup.knee, finest, coarse.x(0));
         let (traces, oracle_s) = run_oracle(triangles, &starts, &setup.angles, &oracle, progress)?;
         Ok(Ladder {
@@ -193,6 +201,7 @@ impl<'a> Ladder<'a> {
             setup: setup.clone(),
             coarse,
             starts,
+            all_starts,
             traces,
             oracle_s,
             compare: CompareOptions {
@@ -211,6 +220,11 @@ impl<'a> Ladder<'a> {
         GridSpec::explicit(c.x(0), c.z(0), (c.nx - 1) * r + 1, (c.nz - 1) * r + 1, p)
     }
 
+    /// The coarsest grid (mm, analysis frame).
+    pub(super) fn coarse(&self) -> GridSpec {
+        self.coarse
+    }
+
     /// The grid at pitch `p` sampled, the engine timed over the ladder's
     /// angles, and the comparison on the ladder's starts; with the masks
     /// and the grid.
@@ -219,6 +233,23 @@ impl<'a> Ladder<'a> {
         p: f64,
         progress: &dyn Progress,
     ) -> Result<(PitchResult, Vec<AngleMask>, HeightGrid), HarnessError> {
+        let (pitch, masks, grid) = self.measure_pairs(p, progress)?;
+        let result = PitchResult {
+            pitch: p,
+            comparison: assemble(pitch.pairs, &self.setup.angles, pitch.band, pitch.grid_s),
+            seconds: pitch.seconds,
+            nodes: pitch.nodes,
+        };
+        Ok((result, masks, grid))
+    }
+
+    /// [`Ladder::measure`] with the comparison's start-angle pairs as they
+    /// are, not yet assembled: a shard's share of one pitch.
+    pub(super) fn measure_pairs(
+        &self,
+        p: f64,
+        progress: &dyn Progress,
+    ) -> Result<(PitchPart, Vec<AngleMask>, HeightGrid), HarnessError> {
         let spec = self.spec_at(p);
         progress.begin(
             &format!("pitch {p} mm: {} x {} grid", spec.nx, spec.nz),
@@ -237,21 +268,26 @@ impl<'a> Ladder<'a> {
             &|| {},
         );
         let seconds = t.elapsed().as_secs_f64();
-        let comparison = compare_grid(
+        let t = Instant::now();
+        let pairs = pair_results(
             &grid,
             &footprints,
             &self.starts,
             &self.traces,
             &self.compare,
+            None,
         );
+        let grid_s = t.elapsed().as_secs_f64();
         progress.end();
-        let result = PitchResult {
+        let part = PitchPart {
             pitch: p,
-            comparison: comparison?,
+            pairs: pairs?,
+            band: TieBand::new(self.compare.rule.sigma, p, self.compare.tie_band_per_mm),
+            grid_s,
             seconds,
             nodes: spec.len(),
         };
-        Ok((result, masks, grid))
+        Ok((part, masks, grid))
     }
 }
 
@@ -349,6 +385,7 @@ pub fn converge(
         pitches[pitches.len() - 1],
         &options.selection,
         options.tie_band_per_mm,
+        None,
         progress,
     )?;
     for &p in pitches {
@@ -358,47 +395,73 @@ pub fn converge(
     for &pitch in pitches {
         results.push(ladder.measure(pitch, progress)?.0);
     }
-    let (starts, oracle_s) = (&ladder.starts, ladder.oracle_s);
     let fits = fits(&results);
-    let recommended = options
-        .tolerance
-        .and_then(|t| recommended_pitch(&results, t));
-    let full_angles = 61.0 / setup.angles.len() as f64;
-    let summary = ConvergeSummary {
-        kneeform_version: env!("CARGO_PKG_VERSION").into(),
-        input_file: input.path.display().to_string(),
-        input_sha256: input.sha256.clone(),
-        scale: input.scale,
-        side: input.side,
-        frame: input.frame.record(),
-        knee_form_mm: [
-            setup.knee.triangle_side,
-            setup.knee.radius,
-            setup.knee.thickness,
-        ],
-        sigma: setup.rule.sigma,
-        rate: setup.rule.rate.name().into(),
-        pitches_mm: pitches.clone(),
-        fits: fits
-            .iter()
-            .filter_map(|(m, f)| f.map(|f| (m.clone(), f)))
-            .collect(),
-        tolerance_mm: options.tolerance,
-        recommended_pitch_mm: recommended.map(|r| r.pitch),
-        predicted_full_time_s: recommended.map(|r| r.seconds * full_angles),
-        angles_deg: setup.angles.clone(),
-        deflection_deg: setup.rule.deflection_deg(),
-        e0_mm: setup.rule.e0,
-        tie_band_rule: tie_band_rule(options.tie_band_per_mm),
-        starts: starts.len(),
-        seconds: results.iter().map(|r| r.seconds).collect(),
-    };
+    let summary = ConvergeSummary::new(input, setup, options, ladder.all_starts.len(), &results);
     Ok(Convergence {
         results,
         fits,
         summary,
-        oracle_s,
+        oracle_s: ladder.oracle_s,
     })
+}
+
+impl ConvergeSummary {
+    /// `converge.json` of a study of `starts` starts on `input` whose
+    /// pitches gave `results`.
+    pub(super) fn new(
+        input: &PartFile,
+        setup: &Setup,
+        options: &ConvergeOptions,
+        starts: usize,
+        results: &[PitchResult],
+    ) -> ConvergeSummary {
+        let mut summary = ConvergeSummary {
+            kneeform_version: env!("CARGO_PKG_VERSION").into(),
+            input_file: input.path.display().to_string(),
+            input_sha256: input.sha256.clone(),
+            scale: input.scale,
+            side: input.side,
+            frame: input.frame.record(),
+            knee_form_mm: [
+                setup.knee.triangle_side,
+                setup.knee.radius,
+                setup.knee.thickness,
+            ],
+            sigma: setup.rule.sigma,
+            rate: setup.rule.rate.name().into(),
+            pitches_mm: options.pitches.clone(),
+            fits: Default::default(),
+            tolerance_mm: options.tolerance,
+            recommended_pitch_mm: None,
+            predicted_full_time_s: None,
+            angles_deg: setup.angles.clone(),
+            deflection_deg: setup.rule.deflection_deg(),
+            e0_mm: setup.rule.e0,
+            tie_band_rule: tie_band_rule(options.tie_band_per_mm),
+            starts,
+            seconds: Vec::new(),
+        };
+        summary.set_results(results);
+        summary
+    }
+
+    /// Sets what the summary says of `results` (every pitch's comparison,
+    /// coarsest first): the fits, the pitch recommended at the summary's
+    /// tolerance and its predicted time, the engine's seconds. A merge of
+    /// shards sets them from the merged comparisons this way.
+    pub fn set_results(&mut self, results: &[PitchResult]) {
+        let recommended = self
+            .tolerance_mm
+            .and_then(|t| recommended_pitch(results, t));
+        let full_angles = 61.0 / self.angles_deg.len() as f64;
+        self.fits = fits(results)
+            .into_iter()
+            .filter_map(|(m, f)| f.map(|f| (m, f)))
+            .collect();
+        self.recommended_pitch_mm = recommended.map(|r| r.pitch);
+        self.predicted_full_time_s = recommended.map(|r| r.seconds * full_angles);
+        self.seconds = results.iter().map(|r| r.seconds).collect();
+    }
 }
 
 #[cfg(test)]

@@ -13,7 +13,9 @@
 //!   each colliding node;
 //! * [`metrics`]: push, first-contact, miss and false-alarm errors, the
 //!   tie band, the area distance;
-//! * [`nearest`]: a 2-d tree for the area distance's nearest points.
+//! * [`nearest`]: a 2-d tree for the area distance's nearest points;
+//! * [`sharded`]: a study's starts fanned out over shards
+//!   (`verify --shard K/N`) and merged back.
 //!
 //! **Invariant:** the harness reads the engine's grid and the oracle's
 //! traces and computes neither side's geometry, with one exception stated
@@ -28,6 +30,7 @@ pub mod converge;
 pub mod direct;
 pub mod metrics;
 pub mod nearest;
+pub mod sharded;
 pub mod trace;
 pub mod verify;
 
@@ -36,8 +39,8 @@ mod fault_tests;
 
 pub use auto::{AutoPitch, PitchChoice, PitchStudyRow, choose_pitch};
 pub use compare::{
-    AreaDistance, CompareOptions, Comparison, Counts, StartSelection, VerifyRow, compare_grid,
-    exact_traces, select_starts,
+    AreaDistance, CompareOptions, Comparison, Counts, PairResult, StartSelection, VerifyRow,
+    assemble, compare_grid, exact_traces, select_starts,
 };
 pub use converge::{ConvergeOptions, ConvergeSummary, Convergence, PitchResult, converge};
 pub use direct::{
@@ -45,6 +48,10 @@ pub use direct::{
     DirectVerification, converge_direct, verify_direct,
 };
 pub use metrics::{DECIDED_METRICS, METRICS, Stats, TieBand};
+pub use sharded::{
+    StudyPart, StudySettings, StudySummary, converge_shard, merge_converge, merge_verify,
+    verify_shard,
+};
 pub use trace::{GridContact, GridTrace};
 pub use verify::{
     Verification, VerifyOptions, VerifySummary, VerifyTimings, WorstStart, oracle_options,
@@ -142,6 +149,14 @@ pub enum HarnessError {
         finest: f64,
         /// The study, in words.
         studied: String,
+    },
+    /// More shards than starts: some shard would have nothing to compare.
+    #[error("{shards} shards of {starts} starts: at most one shard per start")]
+    TooManyShards {
+        /// N.
+        shards: usize,
+        /// The study's starts.
+        starts: usize,
     },
     /// A strip of start rows whose bounds are not finite and ordered.
     #[error("a strip of starts needs finite z bounds Z0 <= Z1 (mm), got {0:?}")]

@@ -200,7 +200,7 @@ pub(crate) fn verify_with(
 }
 
 impl VerifySummary {
-    fn new(
+    pub(super) fn new(
         input: &PartFile,
         setup: &Setup,
         options: &VerifyOptions,
@@ -209,8 +209,8 @@ impl VerifySummary {
         sample_s: f64,
         oracle_s: f64,
     ) -> VerifySummary {
-        let selection = &options.selection;
-        VerifySummary {
+        let (starts, seed) = selection_words(&options.selection);
+        let mut summary = VerifySummary {
             kneeform_version: env!("CARGO_PKG_VERSION").into(),
             input_file: input.path.display().to_string(),
             input_sha256: input.sha256.clone(),
@@ -219,7 +219,7 @@ impl VerifySummary {
             frame: input.frame.record(),
             pitch_mm: setup.pitch,
             tolerance_mm: options.tolerance,
-            pass: comparison.passes(options.tolerance),
+            pass: false,
             angles_deg: setup.angles.clone(),
             knee_form_mm: [
                 setup.knee.triangle_side,
@@ -232,54 +232,75 @@ impl VerifySummary {
             rate: setup.rule.rate.name().into(),
             tie_band: comparison.band,
             tie_band_rule: tie_band_rule(options.tie_band_per_mm),
-            area_distance_decided_mm: Some(comparison.stat("area_distance_decided").max).filter(
-                |_| {
-                    comparison
-                        .area
-                        .iter()
-                        .all(|a| a.miss_decided.is_finite() && a.false_alarm_decided.is_finite())
-                },
-            ),
-            area_distance_mm: Some(comparison.stat("area_distance").max).filter(|_| {
-                comparison
-                    .area
-                    .iter()
-                    .all(|a| a.miss.is_finite() && a.false_alarm.is_finite())
-            }),
-            area_distance: comparison.area.clone(),
-            starts: match selection {
-                StartSelection::All => "all".into(),
-                StartSelection::Sample { count, .. } => count.to_string(),
-                StartSelection::Strip { z } => format!("strip:{}:{}", z[0], z[1]),
-                StartSelection::At(starts) => format!("{} given", starts.len()),
-            },
-            seed: match *selection {
-                StartSelection::Sample { seed, .. } => seed,
-                _ => 0,
-            },
-            metrics: comparison.stats.iter().cloned().collect(),
-            area_iou: comparison.area_iou,
-            counts: comparison.counts,
-            worst_starts: comparison
-                .worst(10)
-                .into_iter()
-                .map(|(row, metric, value)| WorstStart {
-                    i: row.i,
-                    j: row.j,
-                    x: spec.x(row.i),
-                    z: spec.z(row.j),
-                    angle_deg: row.angle_deg,
-                    metric,
-                    value,
-                    at: row.worst_x.zip(row.worst_z).map(|(x, z)| [x, z]),
-                })
-                .collect(),
+            area_distance_decided_mm: None,
+            area_distance_mm: None,
+            area_distance: Vec::new(),
+            starts,
+            seed,
+            metrics: std::collections::BTreeMap::new(),
+            area_iou: 0.0,
+            counts: Counts::default(),
+            worst_starts: Vec::new(),
             timings: VerifyTimings {
                 sample_s,
                 grid_s: comparison.grid_s,
                 oracle_s,
             },
-        }
+        };
+        summary.set_comparison(comparison, spec);
+        summary
+    }
+
+    /// Sets what the summary says of `comparison` (on the grid `spec`):
+    /// pass or fail at the summary's tolerance, the area distances, the
+    /// statistics, counts and worst starts, and the grid side's seconds.
+    /// A merge of shards sets them from the merged comparison this way.
+    pub fn set_comparison(&mut self, comparison: &Comparison, spec: &GridSpec) {
+        self.pass = comparison.passes(self.tolerance_mm);
+        self.tie_band = comparison.band;
+        self.area_distance_decided_mm =
+            Some(comparison.stat("area_distance_decided").max).filter(|_| {
+                comparison
+                    .area
+                    .iter()
+                    .all(|a| a.miss_decided.is_finite() && a.false_alarm_decided.is_finite())
+            });
+        self.area_distance_mm = Some(comparison.stat("area_distance").max).filter(|_| {
+            comparison
+                .area
+                .iter()
+                .all(|a| a.miss.is_finite() && a.false_alarm.is_finite())
+        });
+        self.area_distance = comparison.area.clone();
+        self.metrics = comparison.stats.iter().cloned().collect();
+        self.area_iou = comparison.area_iou;
+        self.counts = comparison.counts;
+        self.worst_starts = comparison
+            .worst(10)
+            .into_iter()
+            .map(|(row, metric, value)| WorstStart {
+                i: row.i,
+                j: row.j,
+                x: spec.x(row.i),
+                z: spec.z(row.j),
+                angle_deg: row.angle_deg,
+                metric,
+                value,
+                at: row.worst_x.zip(row.worst_z).map(|(x, z)| [x, z]),
+            })
+            .collect();
+        self.timings.grid_s = comparison.grid_s;
+    }
+}
+
+/// `selection` as `verify.json` says it: `all`, the sample size,
+/// `strip:Z0:Z1` or `N given`; and the sample's seed (0 for no sample).
+pub(super) fn selection_words(selection: &StartSelection) -> (String, u64) {
+    match *selection {
+        StartSelection::All => ("all".into(), 0),
+        StartSelection::Sample { count, seed } => (count.to_string(), seed),
+        StartSelection::Strip { z } => (format!("strip:{}:{}", z[0], z[1]), 0),
+        StartSelection::At(ref starts) => (format!("{} given", starts.len()), 0),
     }
 }
 

@@ -42,8 +42,9 @@ pub use self::png::{
     crop_window, depth_bar_ends, view_line, write_composite_png, write_depth_png,
 };
 pub use self::results::{
-    RunResults, WriteOptions, write_analysis, write_convergence, write_direct_convergence,
-    write_direct_verification, write_results, write_verification,
+    RunResults, WriteOptions, write_analysis, write_convergence, write_convergence_files,
+    write_direct_convergence, write_direct_verification, write_results, write_verification,
+    write_verification_files,
 };
 pub(crate) use self::stl::to_stl_triangle;
 pub use self::stl::write_colliding_area;

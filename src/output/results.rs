@@ -1,7 +1,8 @@
 //! Each command's result files, from the library's results: an analysis
 //! ([`write_analysis`], or [`write_results`] from its results merged from
 //! shards), a verification ([`write_verification`]), a convergence study
-//! ([`write_convergence`]), and the same two for the direct approach
+//! ([`write_convergence`]; both also into a staged directory, for a merge
+//! of their shards), and the same two for the direct approach
 //! ([`write_direct_verification`], [`write_direct_convergence`]).
 
 use std::io::{BufWriter, Write};
@@ -152,9 +153,18 @@ pub fn write_results(
 /// into `dir`, which appears with both or is left as it was.
 pub fn write_verification(dir: &Path, verification: &Verification) -> Result<(), WriteError> {
     let out = stage(dir)?;
-    write_rows(&out.path("verify.csv"), &verification.comparison.rows)?;
-    write_json(&out.path("verify.json"), &verification.summary)?;
+    write_verification_files(&out, verification)?;
     commit(out, dir)
+}
+
+/// Writes [`write_verification`]'s files into the staged directory `out`
+/// (`kneeform merge` of a verification's shards).
+pub fn write_verification_files(
+    out: &OutputDir,
+    verification: &Verification,
+) -> Result<(), WriteError> {
+    write_rows(&out.path("verify.csv"), &verification.comparison.rows)?;
+    write_json(&out.path("verify.json"), &verification.summary)
 }
 
 /// Writes a convergence study into `dir`: `converge.csv` (every metric at
@@ -163,6 +173,16 @@ pub fn write_verification(dir: &Path, verification: &Verification) -> Result<(),
 /// left as it was.
 pub fn write_convergence(dir: &Path, convergence: &Convergence) -> Result<(), WriteError> {
     let out = stage(dir)?;
+    write_convergence_files(&out, convergence)?;
+    commit(out, dir)
+}
+
+/// Writes [`write_convergence`]'s files into the staged directory `out`
+/// (`kneeform merge` of a convergence study's shards).
+pub fn write_convergence_files(
+    out: &OutputDir,
+    convergence: &Convergence,
+) -> Result<(), WriteError> {
     let results = &convergence.results;
     let tolerance = convergence.summary.tolerance_mm;
     let path = out.path("converge.csv");
@@ -200,8 +220,7 @@ pub fn write_convergence(dir: &Path, convergence: &Convergence) -> Result<(), Wr
         )?;
     }
     write_json(&out.path("converge.json"), &convergence.summary)?;
-    super::write_plots(out.path(".").as_path(), results, &convergence.fits)?;
-    commit(out, dir)
+    super::write_plots(out.path(".").as_path(), results, &convergence.fits)
 }
 
 /// Writes a direct verification into `dir`: `verify.csv` (one row per

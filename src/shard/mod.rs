@@ -26,6 +26,11 @@
 //! **Invariant:** a merged result is computed from the shards' masks by
 //! the same functions an analysis uses (the composite, the blind spots
 //! met, the warnings, the summary's counts), so it is the unsharded run's.
+//!
+//! A verification or a convergence study fans out over its starts
+//! instead (`verify --shard K/N`, `converge --shard K/N`): [`study`]
+//! writes and merges those shards, which `kneeform merge` tells from an
+//! analysis's by their `shard.json` ([`study::shard_kind`]).
 
 use std::path::{Path, PathBuf};
 
@@ -40,6 +45,9 @@ use crate::grid::{GridSpec, HeightGrid};
 use crate::kneeform::GridFootprint;
 use crate::output::{OutputDir, RunResults, WriteError};
 use crate::summary::{AngleSummary, Summary};
+
+mod codec;
+pub mod study;
 
 /// One shard of a run's angles: the `index`-th (1-based) of `count`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -66,7 +74,14 @@ impl Shard {
     /// The indices, among `angles` angles, of this shard's: `a` with
     /// `a % count == index - 1`, in increasing order.
     pub fn angle_indices(&self, angles: usize) -> Vec<usize> {
-        (self.index - 1..angles).step_by(self.count).collect()
+        self.indices(angles)
+    }
+
+    /// The indices, among `items` (a run's angles, a study's starts), of
+    /// this shard's: `k` with `k % count == index - 1`, in increasing
+    /// order.
+    pub fn indices(&self, items: usize) -> Vec<usize> {
+        (self.index - 1..items).step_by(self.count).collect()
     }
 }
 

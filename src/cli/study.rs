@@ -1,0 +1,156 @@
+//! What `verify` and `converge` print of their results, and `kneeform
+//! merge` of their shards alike: the statistics, the verdict and
+//! `verify`'s exit status.
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use kneeform::harness::{Convergence, DECIDED_METRICS, Verification};
+
+/// What would resolve a failure, in words: the pitch a first-order error
+/// (`error ~ C p`, what the evidence in `results/` shows for push, miss and
+/// first contact on smooth parts) would need; a disagreement where the grid
+/// strikes nothing, or one that is not first order, may need more, which
+/// `kneeform converge` measures.
+fn resolving_pitch(pitch: f64, tolerance: f64, metric: &str, value: f64) -> String {
+    if !(value.is_finite() && value > tolerance) {
+        return String::new();
+    }
+    let what = if metric.starts_with("unmatched_deflection") {
+        "the grid strikes nothing where the exact knee-form is deflected: a feature narrower than the pitch (a rib, an edge, a boss) that no node samples; "
+    } else {
+        ""
+    };
+    let mut p = pitch;
+    while p * value / pitch > tolerance && p > pitch / 8.0 {
+        p /= 2.0;
+    }
+    if p * value / pitch > tolerance {
+        // More than a factor 8 in pitch: not a sampling error a finer grid
+        // removes at a usable cost.
+        return format!(
+            "; {what}{value:.1} mm is no sampling error: at first order it would need a pitch below {:.3} mm; see results/README.md (thin features, grazing flanks, crests crossed nearly level) and `kneeform converge` on this part",
+            pitch * tolerance / value
+        );
+    }
+    format!(
+        "; {what}if the error is first order in the pitch, {p} mm would bring it within {tolerance} mm (`kneeform converge --pitches {pitch},{p}` measures it)"
+    )
+}
+
+/// Prints a verification's statistics, counts and verdict (its results
+/// are in `out`) and returns `verify`'s exit status: 0 when it passes, 1
+/// when it fails.
+pub fn print_verification(result: &Verification, out: &Path) -> ExitCode {
+    let s = &result.summary;
+    for name in kneeform::harness::METRICS {
+        let stats = &s.metrics[name];
+        eprintln!(
+            "{name:>29}: max {:.4}  p95 {:.4}  mean {:.4} mm  (n = {})",
+            stats.max, stats.p95, stats.mean, stats.n
+        );
+    }
+    let c = &s.counts;
+    eprintln!(
+        "{:>29}: {:.3}; {} start-angle pairs compared, {} oracle failures",
+        "area IoU", s.area_iou, c.compared, c.oracle_failed
+    );
+    eprintln!(
+        "{:>29}: {} exact strikes, {} contacts undecided (deflection rate in [{:.3}, {:.3}] deg); {} exact strikes with no grid strike in their start ({} decided); {} grid strikes with no exact one ({} decided)",
+        "strikes",
+        c.exact_strikes,
+        c.exact_undecided,
+        s.tie_band.bounds().0.atan().to_degrees(),
+        s.tie_band.bounds().1.atan().to_degrees(),
+        c.unmatched_exact,
+        c.unmatched_exact_decided,
+        c.unmatched_grid,
+        c.unmatched_grid_decided
+    );
+    if c.exact_strikes == 0 && result.comparison.rows.iter().all(|r| r.grid_colliding == 0) {
+        eprintln!(
+            "kneeform: warning: neither the grid nor the exact knee-form strikes anything on these starts: a pass here proves only that (a part smaller than the knee-form, or its surface on the other side: see --scale and --side)"
+        );
+    }
+    let mm = |v: Option<f64>| v.map_or("infinite".to_string(), |v| format!("{v:.3} mm"));
+    eprintln!(
+        "{:>29}: decided {} (all strikes, undecided included: {})",
+        "area distance",
+        mm(s.area_distance_decided_mm),
+        mm(s.area_distance_mm)
+    );
+    if s.pass {
+        eprintln!(
+            "kneeform: PASS at tolerance {} mm; results in {}",
+            s.tolerance_mm,
+            out.display()
+        );
+        ExitCode::SUCCESS
+    } else {
+        let worst = s.worst_starts.first().map_or(String::new(), |w| {
+            let at = w.at.map_or(String::new(), |[x, z]| {
+                format!(" (the disagreement lies at x = {x:.1}, z = {z:.1} mm)")
+            });
+            format!(
+                "; worst: {} = {:.3} mm, start ({}, {}) angle {}{at}{}",
+                w.metric,
+                w.value,
+                w.x,
+                w.z,
+                w.angle_deg,
+                resolving_pitch(s.pitch_mm, s.tolerance_mm, &w.metric, w.value)
+            )
+        });
+        eprintln!(
+            "kneeform: FAIL at tolerance {} mm ({}){worst}; results in {}",
+            s.tolerance_mm,
+            result.comparison.failures(s.tolerance_mm).join("; "),
+            out.display()
+        );
+        ExitCode::from(1)
+    }
+}
+
+/// Prints a convergence study's errors per pitch, fitted orders and the
+/// pitch it recommends (its results are in `out`).
+pub fn print_convergence(study: &Convergence, out: &Path) {
+    let results = &study.results;
+    let fitted = &study.fits;
+    for r in results {
+        let maxes: Vec<String> = r
+            .comparison
+            .stats
+            .iter()
+            .filter(|(m, _)| DECIDED_METRICS.contains(&m.as_str()))
+            .map(|(m, s)| format!("{m} {:.3}", s.max))
+            .collect();
+        eprintln!(
+            "p = {:>6} mm: {} | all strikes: area_distance {:.3} | IoU {:.3} | {} undecided | {:.2} s",
+            r.pitch,
+            maxes.join(", "),
+            r.comparison.stat("area_distance").max,
+            r.comparison.area_iou,
+            r.comparison.counts.exact_undecided,
+            r.seconds
+        );
+    }
+    for (m, f) in fitted {
+        if !DECIDED_METRICS.contains(&m.as_str()) {
+            continue;
+        }
+        match f {
+            Some(f) => eprintln!("{m:>22}: error ~ {:.3} p^{:.2}", f.c, f.alpha),
+            None => eprintln!("{m:>22}: no fit (zero or too few errors)"),
+        }
+    }
+    match (study.summary.tolerance_mm, study.recommended()) {
+        (Some(t), Some(r)) => eprintln!(
+            "kneeform: the coarsest pitch within {t} mm is {} mm; a full 61-angle analysis at it takes about {:.1} s",
+            r.pitch,
+            study.summary.predicted_full_time_s.unwrap_or(f64::NAN)
+        ),
+        (Some(t), None) => eprintln!("kneeform: no pitch tried is within {t} mm"),
+        _ => {}
+    }
+    eprintln!("kneeform: results in {}", out.display());
+}

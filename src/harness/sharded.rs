@@ -1,0 +1,332 @@
+//! A study fanned out over its starts: `verify --shard K/N` and
+//! `converge --shard K/N` compare only the starts `s` (0-based, in the
+//! study's order, after sampling) with `s % N == K - 1`, since the exact
+//! oracle of each start and angle is the expensive part; [`merge_verify`]
+//! and [`merge_converge`] put the N shares back together into the study
+//! the unsharded command computes.
+//!
+//! A share ([`StudyPart`]) keeps every start-angle pair it compared as a
+//! [`PairResult`]: a comparison's statistics, counts, area distances and
+//! worst starts are computed from those alone ([`assemble`]), so a merge
+//! that puts the pairs back in the unsharded order computes them exactly
+//! as the unsharded run does. The file format of a share is
+//! [`crate::shard::study`]'s.
+//!
+//! **Invariant:** a merged comparison is [`assemble`]d from the pairs in
+//! the unsharded run's order (angle-major, then the study's start order),
+//! and its summary is set by the same function as the unsharded run's
+//! ([`VerifySummary::set_comparison`], [`ConvergeSummary::set_results`]);
+//! only clock readings differ.
+
+use std::time::Instant;
+
+use super::HarnessError;
+use super::compare::{CompareOptions, PairResult, StartSelection, assemble, pair_results};
+use super::converge::{ConvergeOptions, ConvergeSummary, Convergence, Ladder, PitchResult};
+use super::metrics::TieBand;
+use super::verify::{
+    Verification, VerifyOptions, VerifySummary, oracle_options, run_oracle, start_positions,
+};
+use crate::analysis::{Progress, Setup};
+use crate::grid::{GridSpec, HeightGrid};
+use crate::mesh::PartFile;
+use crate::shard::Shard;
+
+/// One pitch of a share: its start-angle pairs, angle-major over the
+/// share's starts, and what was timed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PitchPart {
+    /// The pitch (mm).
+    pub pitch: f64,
+    /// The pairs compared, angle-major over the share's starts.
+    pub pairs: Vec<PairResult>,
+    /// The tie band at this pitch.
+    pub band: TieBand,
+    /// Seconds on the grid side of the comparison.
+    pub grid_s: f64,
+    /// Seconds of the engine's full push and slide at this pitch (a
+    /// convergence study times it; a verification does not: 0).
+    pub seconds: f64,
+    /// Grid nodes at this pitch.
+    pub nodes: usize,
+}
+
+/// A shard's summary: `verify.json` or `converge.json` as the shard knows
+/// it: the part's identity, every setting and the shard's own timings,
+/// with the statistics of no start (the merge computes them from every
+/// shard's pairs; `shard.json` leaves them out).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", content = "summary", rename_all = "lowercase")]
+pub enum StudySummary {
+    /// A verification's.
+    Verify(VerifySummary),
+    /// A convergence study's.
+    Converge(ConvergeSummary),
+}
+
+/// The options of a sharded study as given, beyond its summary: what
+/// every shard of one study shares.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct StudySettings {
+    /// `--starts` as given: `all`, a sample size, `strip:Z0:Z1`.
+    pub starts: String,
+    /// `--seed` of a sample (0 otherwise).
+    pub seed: u64,
+    /// `--tie-band` (per mm).
+    pub tie_band_per_mm: f64,
+    /// `--tolerance` (mm).
+    pub tolerance_mm: Option<f64>,
+    /// The pitches, coarsest first (mm): verify's one, converge's ladder.
+    pub pitches_mm: Vec<f64>,
+}
+
+/// One shard's share of a verification or a convergence study.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StudyPart {
+    /// Which shard of how many.
+    pub shard: Shard,
+    /// The grid the starts are nodes of (the coarsest of a study).
+    pub spec: GridSpec,
+    /// Every start of the study (mm, analysis frame), in its order; the
+    /// share's are those of [`Shard::indices`].
+    pub starts: Vec<[f64; 2]>,
+    /// The study's angles (degrees).
+    pub angles_deg: Vec<f64>,
+    /// Per pitch, coarsest first.
+    pub pitches: Vec<PitchPart>,
+    /// The options.
+    pub settings: StudySettings,
+    /// The study's summary as the shard knows it ([`StudySummary`]).
+    pub summary: StudySummary,
+    /// Seconds sampling the grid.
+    pub sample_s: f64,
+    /// Seconds of the oracle on the share's starts.
+    pub oracle_s: f64,
+}
+
+/// `shard`'s share of `all` (all of it without a shard); an error when a
+/// shard would have no start.
+pub(super) fn share(all: &[[f64; 2]], shard: Option<Shard>) -> Result<Vec<[f64; 2]>, HarnessError> {
+    let Some(shard) = shard else {
+        return Ok(all.to_vec());
+    };
+    if shard.count > all.len() {
+        return Err(HarnessError::TooManyShards {
+            shards: shard.count,
+            starts: all.len(),
+        });
+    }
+    Ok(shard
+        .indices(all.len())
+        .into_iter()
+        .map(|s| all[s])
+        .collect())
+}
+
+fn settings(selection: &StartSelection, tie_band_per_mm: f64) -> StudySettings {
+    let (starts, seed) = super::verify::selection_words(selection);
+    StudySettings {
+        starts,
+        seed,
+        tie_band_per_mm,
+        tolerance_mm: None,
+        pitches_mm: Vec::new(),
+    }
+}
+
+/// [`super::verify()`] of `shard`'s share of the starts only.
+pub fn verify_shard(
+    input: &PartFile,
+    setup: &Setup,
+    options: &VerifyOptions,
+    shard: Shard,
+    progress: &dyn Progress,
+) -> Result<StudyPart, HarnessError> {
+    setup.validate()?;
+    if setup.approach == crate::analysis::Approach::Direct {
+        return Err(HarnessError::DirectApproach);
+    }
+    options.validate()?;
+    let t = Instant::now();
+    let triangles = &input.part.triangles;
+    let spec = setup.grid_spec(&input.part)?;
+    let grid = HeightGrid::sample(triangles, spec);
+    let footprints = setup.footprints(&spec);
+    let sample_s = t.elapsed().as_secs_f64();
+    let all = start_positions(&grid, &footprints, &options.selection)?;
+    let starts = share(&all, Some(shard))?;
+    let oracle = oracle_options(&setup.knee, setup.pitch, spec.x(0));
+    let (traces, oracle_s) = run_oracle(triangles, &starts, &setup.angles, &oracle, progress)?;
+    let compare = CompareOptions {
+        knee: setup.knee,
+        rule: setup.rule,
+        tie_band_per_mm: options.tie_band_per_mm,
+    };
+    let t = Instant::now();
+    let pairs = pair_results(&grid, &footprints, &starts, &traces, &compare, None)?;
+    let grid_s = t.elapsed().as_secs_f64();
+    let band = TieBand::new(setup.rule.sigma, spec.pitch, options.tie_band_per_mm);
+    // The study's identity and settings; its statistics are the merge's
+    // (a shard's own could be infinite, which JSON cannot say).
+    let none = assemble(Vec::new(), &setup.angles, band, 0.0);
+    let mut summary = VerifySummary::new(input, setup, options, &spec, &none, sample_s, oracle_s);
+    summary.timings.grid_s = grid_s;
+    Ok(StudyPart {
+        shard,
+        spec,
+        starts: all,
+        angles_deg: setup.angles.clone(),
+        pitches: vec![PitchPart {
+            pitch: spec.pitch,
+            pairs,
+            band,
+            grid_s,
+            seconds: 0.0,
+            nodes: spec.len(),
+        }],
+        settings: StudySettings {
+            tolerance_mm: Some(options.tolerance),
+            pitches_mm: vec![setup.pitch],
+            ..settings(&options.selection, options.tie_band_per_mm)
+        },
+        summary: StudySummary::Verify(summary),
+        sample_s,
+        oracle_s,
+    })
+}
+
+/// [`super::converge()`] of `shard`'s share of the starts only: the
+/// oracle on the share, every pitch's grid sampled and its engine timed
+/// as the unsharded study does, the share's pairs compared.
+pub fn converge_shard(
+    input: &PartFile,
+    setup: &Setup,
+    options: &ConvergeOptions,
+    shard: Shard,
+    progress: &dyn Progress,
+) -> Result<StudyPart, HarnessError> {
+    if setup.approach == crate::analysis::Approach::Direct {
+        return Err(HarnessError::DirectApproach);
+    }
+    options.validate()?;
+    let pitches = &options.pitches;
+    let t = Instant::now();
+    let ladder = Ladder::new(
+        input,
+        &Setup {
+            pitch: pitches[0],
+            ..setup.clone()
+        },
+        pitches[pitches.len() - 1],
+        &options.selection,
+        options.tie_band_per_mm,
+        Some(shard),
+        progress,
+    )?;
+    let sample_s = (t.elapsed().as_secs_f64() - ladder.oracle_s).max(0.0);
+    for &p in pitches {
+        setup.check_memory(&ladder.spec_at(p), input.part.triangles.len())?;
+    }
+    let mut parts = Vec::new();
+    for &p in pitches {
+        parts.push(ladder.measure_pairs(p, progress)?.0);
+    }
+    // The study's identity and settings; its fits are the merge's.
+    let summary = ConvergeSummary::new(input, setup, options, ladder.all_starts.len(), &[]);
+    Ok(StudyPart {
+        shard,
+        spec: ladder.coarse(),
+        starts: ladder.all_starts.clone(),
+        angles_deg: setup.angles.clone(),
+        pitches: parts,
+        settings: StudySettings {
+            tolerance_mm: options.tolerance,
+            pitches_mm: pitches.clone(),
+            ..settings(&options.selection, options.tie_band_per_mm)
+        },
+        summary: StudySummary::Converge(summary),
+        sample_s,
+        oracle_s: ladder.oracle_s,
+    })
+}
+
+fn pitch_result(part: &PitchPart, pairs: Vec<PairResult>, angles: &[f64]) -> PitchResult {
+    PitchResult {
+        pitch: part.pitch,
+        comparison: assemble(pairs, angles, part.band, part.grid_s),
+        seconds: part.seconds,
+        nodes: part.nodes,
+    }
+}
+
+/// The pairs of pitch `k` of `parts` (every shard of one study exactly
+/// once, in shard order: `parts[K - 1]` is shard K's) in the unsharded
+/// order: angle-major, then the study's start order.
+fn unsharded_pairs(parts: &[StudyPart], k: usize) -> Vec<PairResult> {
+    let first = &parts[0];
+    let (n, total) = (parts.len(), first.starts.len());
+    let shares: Vec<usize> = parts.iter().map(|p| p.shard.indices(total).len()).collect();
+    let mut out = Vec::with_capacity(total * first.angles_deg.len());
+    for a in 0..first.angles_deg.len() {
+        for s in 0..total {
+            let pairs = &parts[s % n].pitches[k].pairs;
+            out.push(pairs[a * shares[s % n] + s / n].clone());
+        }
+    }
+    out
+}
+
+/// Pitch `k` of the study `parts` merged: its pairs in the unsharded
+/// order, assembled; grid seconds summed over the shards, the engine's
+/// seconds (which every shard measures alike) their longest.
+fn merged_pitch(parts: &[StudyPart], k: usize) -> PitchResult {
+    let first = &parts[0].pitches[k];
+    let merged = PitchPart {
+        grid_s: parts.iter().map(|p| p.pitches[k].grid_s).sum(),
+        seconds: parts
+            .iter()
+            .map(|p| p.pitches[k].seconds)
+            .fold(0.0, f64::max),
+        ..first.clone()
+    };
+    pitch_result(&merged, unsharded_pairs(parts, k), &parts[0].angles_deg)
+}
+
+/// The verification of the shares `parts`: every shard of one study
+/// exactly once, in shard order (as [`crate::shard::study`] checks), each
+/// holding every pair of its starts.
+pub fn merge_verify(parts: &[StudyPart]) -> Option<Verification> {
+    let first = parts.first()?;
+    let StudySummary::Verify(summary) = &first.summary else {
+        return None;
+    };
+    let result = merged_pitch(parts, 0);
+    let mut summary = summary.clone();
+    summary.set_comparison(&result.comparison, &first.spec);
+    let t = &mut summary.timings;
+    t.sample_s = parts.iter().map(|p| p.sample_s).fold(0.0, f64::max);
+    t.oracle_s = parts.iter().map(|p| p.oracle_s).sum();
+    Some(Verification {
+        comparison: result.comparison,
+        summary,
+    })
+}
+
+/// The convergence study of the shares `parts` (as [`merge_verify`]).
+pub fn merge_converge(parts: &[StudyPart]) -> Option<Convergence> {
+    let first = parts.first()?;
+    let StudySummary::Converge(summary) = &first.summary else {
+        return None;
+    };
+    let results: Vec<PitchResult> = (0..first.pitches.len())
+        .map(|k| merged_pitch(parts, k))
+        .collect();
+    let mut summary = summary.clone();
+    summary.set_results(&results);
+    Some(Convergence {
+        fits: super::converge::fits(&results),
+        results,
+        summary,
+        oracle_s: parts.iter().map(|p| p.oracle_s).sum(),
+    })
+}

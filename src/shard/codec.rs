@@ -1,0 +1,278 @@
+//! The little-endian encoding of a study shard's `shard.bin`
+//! ([`super::study`]): lengths and counts as u64, every f64 as its bits
+//! (infinities, NaN and -0.0 read back as written), and a start-angle
+//! pair as its status, node, metric values and points ([`put_pair`],
+//! [`Reader::pair`]).
+//!
+//! **Invariant:** reading is bounds-checked: a cut or damaged file is an
+//! error, never a panic, and a count larger than the bytes left allocates
+//! nothing.
+
+use crate::harness::compare::{PairResult, STATUSES, row_of};
+use crate::harness::metrics::{StartComparison, StartPoints};
+
+pub(super) fn put_u64(out: &mut Vec<u8>, v: u64) {
+    out.extend_from_slice(&v.to_le_bytes());
+}
+
+pub(super) fn put_f64(out: &mut Vec<u8>, v: f64) {
+    put_u64(out, v.to_bits());
+}
+
+pub(super) fn put_f64s(out: &mut Vec<u8>, v: &[f64]) {
+    put_u64(out, v.len() as u64);
+    for &x in v {
+        put_f64(out, x);
+    }
+}
+
+pub(super) fn put_opt(out: &mut Vec<u8>, v: Option<f64>) {
+    out.push(u8::from(v.is_some()));
+    put_f64(out, v.unwrap_or(0.0));
+}
+
+pub(super) fn put_points(out: &mut Vec<u8>, v: &[[f64; 2]]) {
+    put_u64(out, v.len() as u64);
+    for p in v {
+        put_f64(out, p[0]);
+        put_f64(out, p[1]);
+    }
+}
+
+pub(super) fn put_nodes(out: &mut Vec<u8>, v: &[(usize, usize)]) {
+    put_u64(out, v.len() as u64);
+    for &(i, j) in v {
+        put_u64(out, i as u64);
+        put_u64(out, j as u64);
+    }
+}
+
+/// One pair: status, node, then its comparison's values and points, the
+/// grid's nodes and the snapped exact strikes (the row is rebuilt from
+/// them by [`row_of`], as the comparison builds it).
+pub(super) fn put_pair(out: &mut Vec<u8>, pair: &PairResult) {
+    let status = STATUSES
+        .iter()
+        .position(|s| *s == pair.row.status)
+        .unwrap_or(STATUSES.len());
+    out.push(status as u8);
+    put_u64(out, pair.row.i as u64);
+    put_u64(out, pair.row.j as u64);
+    let c = &pair.cmp;
+    for v in [
+        c.push_error,
+        c.first_contact_error,
+        c.first_contact_error_decided,
+    ] {
+        put_opt(out, v);
+    }
+    for v in [
+        &c.miss,
+        &c.miss_decided,
+        &c.false_alarm,
+        &c.false_alarm_decided,
+        &c.unmatched_deflection,
+        &c.unmatched_deflection_decided,
+    ] {
+        put_f64s(out, v);
+    }
+    put_u64(out, c.exact_strikes as u64);
+    put_u64(out, c.undecided as u64);
+    let p = &c.points;
+    for v in [&p.grid, &p.strikes, &p.decided, &p.possible, &p.push] {
+        put_points(out, v);
+    }
+    put_nodes(out, &pair.grid_nodes);
+    put_nodes(out, &pair.snapped);
+}
+
+/// Reads `shard.bin`; every read checks the bytes left, and a length
+/// never exceeds them (a damaged length cannot make a huge allocation).
+pub(super) struct Reader<'a> {
+    bin: &'a [u8],
+    /// Bytes read so far.
+    pub(super) at: usize,
+}
+
+impl<'a> Reader<'a> {
+    /// A reader of `bin` from its start.
+    pub(super) fn new(bin: &'a [u8]) -> Reader<'a> {
+        Reader { bin, at: 0 }
+    }
+
+    pub(super) fn take(&mut self, n: usize) -> Result<&[u8], String> {
+        let end = self
+            .at
+            .checked_add(n)
+            .filter(|&e| e <= self.bin.len())
+            .ok_or("it ends early")?;
+        let bytes = &self.bin[self.at..end];
+        self.at = end;
+        Ok(bytes)
+    }
+
+    pub(super) fn u8(&mut self) -> Result<u8, String> {
+        Ok(self.take(1)?[0])
+    }
+
+    pub(super) fn u64(&mut self) -> Result<u64, String> {
+        let b = self.take(8)?;
+        Ok(u64::from_le_bytes(b.try_into().map_err(|_| "8 bytes")?))
+    }
+
+    pub(super) fn f64(&mut self) -> Result<f64, String> {
+        Ok(f64::from_bits(self.u64()?))
+    }
+
+    /// A count of items of at least `size` bytes each still to come.
+    pub(super) fn count(&mut self, size: usize) -> Result<usize, String> {
+        let n = self.u64()?;
+        let left = (self.bin.len() - self.at) / size.max(1);
+        usize::try_from(n)
+            .ok()
+            .filter(|&n| n <= left)
+            .ok_or_else(|| format!("a count of {n} where {left} at most fit"))
+    }
+
+    pub(super) fn len(&mut self) -> Result<usize, String> {
+        usize::try_from(self.u64()?).map_err(|_| "a length beyond memory".to_string())
+    }
+
+    pub(super) fn f64s(&mut self) -> Result<Vec<f64>, String> {
+        let n = self.count(8)?;
+        (0..n).map(|_| self.f64()).collect()
+    }
+
+    pub(super) fn opt(&mut self) -> Result<Option<f64>, String> {
+        let some = match self.u8()? {
+            0 => false,
+            1 => true,
+            b => return Err(format!("an option flag {b}")),
+        };
+        let v = self.f64()?;
+        Ok(some.then_some(v))
+    }
+
+    pub(super) fn points(&mut self) -> Result<Vec<[f64; 2]>, String> {
+        let n = self.count(16)?;
+        (0..n).map(|_| Ok([self.f64()?, self.f64()?])).collect()
+    }
+
+    pub(super) fn nodes(&mut self) -> Result<Vec<(usize, usize)>, String> {
+        let n = self.count(16)?;
+        (0..n).map(|_| Ok((self.len()?, self.len()?))).collect()
+    }
+
+    pub(super) fn pair(&mut self, angle_deg: f64) -> Result<PairResult, String> {
+        let status = *STATUSES
+            .get(usize::from(self.u8()?))
+            .ok_or("a start-angle pair of unknown status")?;
+        let (i, j) = (self.len()?, self.len()?);
+        let (push_error, first_contact_error, first_contact_error_decided) =
+            (self.opt()?, self.opt()?, self.opt()?);
+        let cmp = StartComparison {
+            push_error,
+            first_contact_error,
+            first_contact_error_decided,
+            miss: self.f64s()?,
+            miss_decided: self.f64s()?,
+            false_alarm: self.f64s()?,
+            false_alarm_decided: self.f64s()?,
+            unmatched_deflection: self.f64s()?,
+            unmatched_deflection_decided: self.f64s()?,
+            exact_strikes: self.len()?,
+            undecided: self.len()?,
+            points: StartPoints {
+                grid: self.points()?,
+                strikes: self.points()?,
+                decided: self.points()?,
+                possible: self.points()?,
+                push: self.points()?,
+            },
+        };
+        Ok(PairResult {
+            row: row_of(i, j, angle_deg, status, &cmp),
+            cmp,
+            grid_nodes: self.nodes()?,
+            snapped: self.nodes()?,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    pub(super) fn pair() -> PairResult {
+        let cmp = StartComparison {
+            push_error: Some(-0.25),
+            first_contact_error: None,
+            first_contact_error_decided: Some(f64::MIN_POSITIVE),
+            miss: vec![1.5, f64::INFINITY],
+            miss_decided: vec![f64::INFINITY],
+            false_alarm: vec![0.1 + 0.2],
+            false_alarm_decided: Vec::new(),
+            unmatched_deflection: vec![3.0],
+            unmatched_deflection_decided: vec![-0.0],
+            exact_strikes: 2,
+            undecided: 1,
+            points: StartPoints {
+                grid: vec![[1.0, 2.0]],
+                strikes: vec![[3.0, 4.0], [5.0, 6.0]],
+                decided: vec![[5.0, 6.0]],
+                possible: Vec::new(),
+                push: vec![[-7.5, 8.25]],
+            },
+        };
+        PairResult {
+            row: row_of(4, 9, -30.0, "grid_not_placed", &cmp),
+            cmp,
+            grid_nodes: vec![(1, 2), (3, 4)],
+            snapped: vec![(5, 6)],
+        }
+    }
+
+    #[test]
+    fn a_pair_reads_back_bit_for_bit() {
+        let p = pair();
+        let mut bin = Vec::new();
+        put_pair(&mut bin, &p);
+        let mut r = Reader { bin: &bin, at: 0 };
+        let back = r.pair(-30.0).unwrap();
+        assert_eq!(r.at, bin.len());
+        // PartialEq on f64 would take -0.0 for 0.0: compare the bits too.
+        assert_eq!(back, p);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(
+            bits(&back.cmp.unmatched_deflection_decided),
+            bits(&p.cmp.unmatched_deflection_decided)
+        );
+    }
+
+    #[test]
+    fn a_cut_or_damaged_pair_is_an_error_not_a_panic() {
+        let mut bin = Vec::new();
+        put_pair(&mut bin, &pair());
+        for end in 0..bin.len() {
+            let mut r = Reader {
+                bin: &bin[..end],
+                at: 0,
+            };
+            assert!(r.pair(0.0).is_err(), "cut at {end}");
+        }
+        // A count far beyond the bytes left allocates nothing.
+        let mut huge = vec![0u8];
+        put_u64(&mut huge, 0);
+        put_u64(&mut huge, 0);
+        for _ in 0..3 {
+            put_opt(&mut huge, None);
+        }
+        put_u64(&mut huge, u64::MAX);
+        let mut r = Reader { bin: &huge, at: 0 };
+        assert!(r.pair(0.0).is_err());
+        // An unknown status.
+        let mut bad = bin.clone();
+        bad[0] = STATUSES.len() as u8;
+        assert!(Reader { bin: &bad, at: 0 }.pair(0.0).is_err());
+    }
+}

@@ -1,0 +1,491 @@
+//! The files of a study's shard: `verify --shard K/N` and `converge
+//! --shard K/N` write one [`crate::harness::StudyPart`] as `shard.json`
+//! and `shard.bin`; [`merge_study`] reads N of them, checks that they are
+//! every shard of one study exactly once, and merges them
+//! ([`crate::harness::merge_verify`], [`crate::harness::merge_converge`]).
+//!
+//! * `shard.json` ([`StudyRecord`]): which shard of how many, the study's
+//!   start count and this shard's start indices, the options
+//!   ([`StudySettings`]), the study's `verify.json` or `converge.json` as
+//!   the shard knows it (`"study": {"kind": "verify", "summary": ...}`:
+//!   the part's SHA-256, every parameter and the shard's own timings; no
+//!   statistics, fits or verdict, which are the merge's),
+//!   its clock readings, and the SHA-256 of `shard.bin` and of its common
+//!   part;
+//! * `shard.bin`, little-endian: the common part (the grid the starts are
+//!   nodes of, the angles, every start of the study as f64 bits), then per
+//!   pitch its tie band and timings and, per start-angle pair of the
+//!   shard (angle-major), the pair's status, node, every metric value and
+//!   point its comparison holds, the grid's colliding nodes and the exact
+//!   strikes snapped to nodes: all a comparison is assembled from.
+//!
+//! Every value is stored as its bits, so a merge sees exactly what the
+//! shard computed.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::codec::{Reader, put_f64, put_f64s, put_pair, put_points, put_u64};
+use super::{Shard, ShardError, first_difference, hex_sha256};
+use crate::grid::GridSpec;
+use crate::harness::metrics::TieBand;
+use crate::harness::sharded::PitchPart;
+use crate::harness::{
+    Convergence, StudyPart, StudySettings, StudySummary, Verification, merge_converge, merge_verify,
+};
+use crate::output::{OutputDir, WriteError};
+
+/// `shard.json` of a study's shard.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StudyRecord {
+    /// The format of the shard's files (1).
+    pub format: u32,
+    /// Which shard of how many.
+    pub shard: Shard,
+    /// The study's starts, all shards together.
+    pub starts: usize,
+    /// This shard's starts: indices into the study's.
+    pub start_indices: Vec<usize>,
+    /// The options every shard of the study shares.
+    pub settings: StudySettings,
+    /// The study's summary as the shard knows it, and its kind.
+    pub study: StudySummary,
+    /// Seconds sampling the grid.
+    pub sample_s: f64,
+    /// Seconds of the oracle on this shard's starts.
+    pub oracle_s: f64,
+    /// SHA-256 of `shard.bin` (hex).
+    pub data_sha256: String,
+    /// SHA-256 of `shard.bin`'s common part: grid, angles, starts.
+    pub common_sha256: String,
+}
+
+/// The format [`write_study_shard`] writes and [`merge_study`] reads.
+pub const FORMAT: u32 = 1;
+
+const MAGIC: &[u8; 16] = b"kneeform study 1";
+
+/// The largest `shard.bin` read (bytes): far beyond a study's (a few
+/// hundred bytes per start and angle), short of exhausting memory.
+const MAX_BIN_BYTES: u64 = 8 << 30;
+
+/// A study merged from its shards.
+#[derive(Debug)]
+pub enum MergedStudy {
+    /// `verify`'s.
+    Verify(Box<Verification>),
+    /// `converge`'s.
+    Converge(Box<Convergence>),
+}
+
+/// Writes `part` as its shard: `shard.json` and `shard.bin` in the staged
+/// directory `out`.
+pub fn write_study_shard(out: &OutputDir, part: &StudyPart) -> Result<(), WriteError> {
+    let mut bin = Vec::new();
+    bin.extend_from_slice(MAGIC);
+    let spec = part.spec;
+    put_u64(&mut bin, spec.nx as u64);
+    put_u64(&mut bin, spec.nz as u64);
+    put_u64(&mut bin, spec.i_origin as u64);
+    put_u64(&mut bin, spec.j_origin as u64);
+    put_f64(&mut bin, spec.pitch);
+    put_f64s(&mut bin, &part.angles_deg);
+    put_points(&mut bin, &part.starts);
+    let common_sha256 = hex_sha256(&bin);
+    put_u64(&mut bin, part.pitches.len() as u64);
+    for p in &part.pitches {
+        for v in [p.pitch, p.band.sigma, p.band.m, p.grid_s, p.seconds] {
+            put_f64(&mut bin, v);
+        }
+        put_u64(&mut bin, p.nodes as u64);
+        put_u64(&mut bin, p.pairs.len() as u64);
+        for pair in &p.pairs {
+            put_pair(&mut bin, pair);
+        }
+    }
+    let record = StudyRecord {
+        format: FORMAT,
+        shard: part.shard,
+        starts: part.starts.len(),
+        start_indices: part.shard.indices(part.starts.len()),
+        settings: part.settings.clone(),
+        study: part.summary.clone(),
+        sample_s: part.sample_s,
+        oracle_s: part.oracle_s,
+        data_sha256: hex_sha256(&bin),
+        common_sha256,
+    };
+    let path = out.path("shard.bin");
+    std::fs::write(&path, &bin).map_err(WriteError::at(&path))?;
+    let path = out.path("shard.json");
+    let text =
+        serde_json::to_string_pretty(&to_json(&record)).map_err(WriteError::at(&path))? + "\n";
+    std::fs::write(&path, text).map_err(WriteError::at(&path))
+}
+
+/// What a shard directory holds, by its `shard.json`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShardKind {
+    /// An analysis's (`analyze --shard`).
+    Analysis,
+    /// A verification's (`verify --shard`).
+    Verify,
+    /// A convergence study's (`converge --shard`).
+    Converge,
+}
+
+impl std::fmt::Display for ShardKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ShardKind::Analysis => "an analysis (analyze --shard)",
+            ShardKind::Verify => "a verification (verify --shard)",
+            ShardKind::Converge => "a convergence study (converge --shard)",
+        })
+    }
+}
+
+/// The kind of the shard in `dir`, from its `shard.json`.
+pub fn shard_kind(dir: &Path) -> Result<ShardKind, ShardError> {
+    let path = dir.join("shard.json");
+    let text = crate::limits::read_bounded(&path, crate::limits::MAX_RUN_JSON_BYTES).map_err(
+        |source| ShardError::Io {
+            path: path.clone(),
+            source,
+        },
+    )?;
+    let value: serde_json::Value =
+        serde_json::from_slice(&text).map_err(|e| ShardError::Corrupt {
+            path: path.clone(),
+            reason: format!("not a kneeform shard.json: {e}"),
+        })?;
+    let kind = value.get("study").map(|s| s.get("kind"));
+    match kind {
+        None => Ok(ShardKind::Analysis),
+        Some(Some(k)) if k == "verify" => Ok(ShardKind::Verify),
+        Some(Some(k)) if k == "converge" => Ok(ShardKind::Converge),
+        Some(k) => Err(ShardError::Corrupt {
+            path,
+            reason: format!("a study of unknown kind {k:?}"),
+        }),
+    }
+}
+
+/// One study shard directory, read, checked and decoded.
+struct StudyFiles {
+    dir: PathBuf,
+    record: StudyRecord,
+    part: StudyPart,
+}
+
+/// Reads the study shard directories `dirs` (one per shard, in any
+/// order) and merges them into the whole study, as the unsharded command
+/// computes it (clock readings aside).
+pub fn merge_study(dirs: &[PathBuf]) -> Result<MergedStudy, ShardError> {
+    let shards = dirs
+        .iter()
+        .map(|d| read_study(d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let first = shards
+        .first()
+        .ok_or_else(|| ShardError::Mismatch("no shard directory given".into()))?;
+    let count = first.record.shard.count;
+    let identity = identity(&first.record);
+    let mut owner: Vec<Option<usize>> = vec![None; count];
+    for (k, s) in shards.iter().enumerate() {
+        let shard = s.record.shard;
+        if shard.count != count {
+            return Err(ShardError::Mismatch(format!(
+                "{} is shard {shard}, {} shard {}/{count}: shards of one study have one N",
+                s.dir.display(),
+                first.dir.display(),
+                first.record.shard.index
+            )));
+        }
+        if let Some(key) = first_difference(&identity, &self::identity(&s.record)) {
+            return Err(ShardError::Mismatch(format!(
+                "{} and {} are shards of different studies (their `{key}` differ)",
+                first.dir.display(),
+                s.dir.display()
+            )));
+        }
+        match owner[shard.index - 1] {
+            Some(other) => {
+                return Err(ShardError::Mismatch(format!(
+                    "shard {shard} is given twice: {} and {}",
+                    shards[other].dir.display(),
+                    s.dir.display()
+                )));
+            }
+            None => owner[shard.index - 1] = Some(k),
+        }
+    }
+    if let Some(missing) = owner.iter().position(Option::is_none) {
+        return Err(ShardError::Mismatch(format!(
+            "shard {}/{count} is missing: merge needs the directory of every shard",
+            missing + 1
+        )));
+    }
+    // In shard order: shard K's share is parts[K - 1].
+    let mut shards = shards;
+    shards.sort_by_key(|s| s.record.shard.index);
+    let parts: Vec<StudyPart> = shards.into_iter().map(|s| s.part).collect();
+    let merged = match parts[0].summary {
+        StudySummary::Verify(_) => merge_verify(&parts).map(|v| MergedStudy::Verify(Box::new(v))),
+        StudySummary::Converge(_) => {
+            merge_converge(&parts).map(|c| MergedStudy::Converge(Box::new(c)))
+        }
+    };
+    merged.ok_or_else(|| ShardError::Mismatch("the shards hold no study".into()))
+}
+
+/// The fields of a study's summary that a merge computes from every
+/// shard's pairs (statistics, fits, the verdict): a shard's `shard.json`
+/// leaves them out, since a shard's own would describe a part of the
+/// starts only (and could be infinite, which JSON cannot hold).
+fn merged_keys(study: &StudySummary) -> &'static [&'static str] {
+    match study {
+        StudySummary::Verify(_) => &[
+            "pass",
+            "area_distance_decided_mm",
+            "area_distance_mm",
+            "area_distance",
+            "metrics",
+            "area_iou",
+            "counts",
+            "worst_starts",
+        ],
+        StudySummary::Converge(_) => &[
+            "fits",
+            "recommended_pitch_mm",
+            "predicted_full_time_s",
+            "seconds",
+        ],
+    }
+}
+
+/// `record` as `shard.json` holds it: without [`merged_keys`].
+fn to_json(record: &StudyRecord) -> serde_json::Value {
+    let mut v = serde_json::to_value(record).unwrap_or_default();
+    if let Some(summary) = v
+        .pointer_mut("/study/summary")
+        .and_then(|s| s.as_object_mut())
+    {
+        for key in merged_keys(&record.study) {
+            summary.remove(*key);
+        }
+    }
+    v
+}
+
+/// `shard.json`'s record, its [`merged_keys`] set to those of a study of
+/// no start (the merge sets them from every shard's pairs).
+fn from_json(text: &[u8]) -> Result<StudyRecord, String> {
+    let mut v: serde_json::Value = serde_json::from_slice(text).map_err(|e| e.to_string())?;
+    let kind = v.pointer("/study/kind").and_then(|k| k.as_str());
+    let neutral = match kind {
+        Some("verify") => serde_json::json!({
+            "pass": false,
+            "area_distance_decided_mm": null,
+            "area_distance_mm": null,
+            "area_distance": [],
+            "metrics": {},
+            "area_iou": 0.0,
+            "counts": crate::harness::Counts::default(),
+            "worst_starts": [],
+        }),
+        Some("converge") => serde_json::json!({
+            "fits": {},
+            "recommended_pitch_mm": null,
+            "predicted_full_time_s": null,
+            "seconds": [],
+        }),
+        _ => serde_json::json!({}),
+    };
+    if let (Some(summary), Some(neutral)) = (
+        v.pointer_mut("/study/summary")
+            .and_then(|s| s.as_object_mut()),
+        neutral.as_object(),
+    ) {
+        for (key, value) in neutral {
+            summary.entry(key.clone()).or_insert(value.clone());
+        }
+    }
+    serde_json::from_value(v).map_err(|e| e.to_string())
+}
+
+/// What the shards of one study share: the record with its own counts,
+/// statistics, clocks and checksum of its data left out.
+fn identity(record: &StudyRecord) -> serde_json::Value {
+    let mut v = serde_json::to_value(record).unwrap_or_default();
+    let mut derived = merged_keys(&record.study).to_vec();
+    if let StudySummary::Verify(_) = record.study {
+        derived.push("timings");
+    }
+    let mut out = serde_json::Map::new();
+    if let Some(map) = v.as_object_mut() {
+        for key in [
+            "shard",
+            "start_indices",
+            "sample_s",
+            "oracle_s",
+            "data_sha256",
+        ] {
+            map.remove(key);
+        }
+        let study = map.remove("study").unwrap_or_default();
+        let mut summary = study.get("summary").cloned().unwrap_or_default();
+        if let Some(s) = summary.as_object_mut() {
+            for key in &derived {
+                s.remove(*key);
+            }
+            // Keyed by the summary's own names, so that a mismatch names
+            // the option that differs.
+            out.extend(s.clone());
+        }
+        out.insert(
+            "kind".into(),
+            study.get("kind").cloned().unwrap_or_default(),
+        );
+        out.extend(map.clone());
+    }
+    serde_json::Value::Object(out)
+}
+
+fn read_study(dir: &Path) -> Result<StudyFiles, ShardError> {
+    let json_path = dir.join("shard.json");
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| ShardError::Io { path, source }
+    };
+    let text = crate::limits::read_bounded(&json_path, crate::limits::MAX_RUN_JSON_BYTES)
+        .map_err(io(&json_path))?;
+    let corrupt = |reason: String| ShardError::Corrupt {
+        path: json_path.clone(),
+        reason,
+    };
+    let record =
+        from_json(&text).map_err(|e| corrupt(format!("not a kneeform study shard.json: {e}")))?;
+    if record.format != FORMAT {
+        return Err(corrupt(format!(
+            "study shard format {}, this kneeform reads {FORMAT}",
+            record.format
+        )));
+    }
+    let shard = record.shard;
+    if shard.index == 0
+        || shard.index > shard.count
+        || shard.count > record.starts
+        || record.start_indices != shard.indices(record.starts)
+    {
+        return Err(corrupt(format!(
+            "shard {}/{} of {} starts does not hold starts {:?}",
+            shard.index, shard.count, record.starts, record.start_indices
+        )));
+    }
+    let bin_path = dir.join("shard.bin");
+    let bin = crate::limits::read_bounded(&bin_path, MAX_BIN_BYTES).map_err(io(&bin_path))?;
+    let bad_bin = |reason: String| ShardError::Corrupt {
+        path: bin_path.clone(),
+        reason,
+    };
+    if hex_sha256(&bin) != record.data_sha256 {
+        return Err(bad_bin(
+            "its SHA-256 is not the one shard.json records".into(),
+        ));
+    }
+    let part = decode(&bin, &record).map_err(bad_bin)?;
+    Ok(StudyFiles {
+        dir: dir.to_path_buf(),
+        record,
+        part,
+    })
+}
+
+/// The study part `bin` holds, checked against its `record`.
+fn decode(bin: &[u8], record: &StudyRecord) -> Result<StudyPart, String> {
+    let mut r = Reader::new(bin);
+    if r.take(16)? != MAGIC {
+        return Err("not a kneeform study shard.bin (its header)".into());
+    }
+    let (nx, nz) = (r.len()?, r.len()?);
+    let (i_origin, j_origin) = (r.u64()? as i64, r.u64()? as i64);
+    let pitch = r.f64()?;
+    let spec = GridSpec {
+        pitch,
+        i_origin,
+        j_origin,
+        nx,
+        nz,
+    };
+    let angles_deg = r.f64s()?;
+    let starts = r.points()?;
+    if hex_sha256(&bin[..r.at]) != record.common_sha256 {
+        return Err("its common part's SHA-256 is not the one shard.json records".into());
+    }
+    let (summary_angles, summary_pitches) = match &record.study {
+        StudySummary::Verify(s) => (&s.angles_deg, vec![s.pitch_mm]),
+        StudySummary::Converge(s) => (&s.angles_deg, s.pitches_mm.clone()),
+    };
+    let same = |a: &[f64], b: &[f64]| {
+        a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+    };
+    if starts.len() != record.starts
+        || !same(&angles_deg, summary_angles)
+        || !same(&summary_pitches, &record.settings.pitches_mm)
+        || summary_pitches.first().map(|p| p.to_bits()) != Some(pitch.to_bits())
+    {
+        return Err("its grid, angles or starts are not the ones shard.json describes".into());
+    }
+    let share = record.start_indices.len();
+    let expected_pairs = share * angles_deg.len();
+    let pitch_count = r.len()?;
+    if pitch_count != summary_pitches.len() {
+        return Err(format!(
+            "{pitch_count} pitches where shard.json names {}",
+            summary_pitches.len()
+        ));
+    }
+    let mut pitches = Vec::with_capacity(pitch_count);
+    for &expected in &summary_pitches {
+        let p = r.f64()?;
+        let band = TieBand {
+            sigma: r.f64()?,
+            m: r.f64()?,
+        };
+        let (grid_s, seconds) = (r.f64()?, r.f64()?);
+        let nodes = r.len()?;
+        let count = r.len()?;
+        if p.to_bits() != expected.to_bits() || count != expected_pairs {
+            return Err(format!(
+                "pitch {p} mm holds {count} start-angle pairs where shard.json says {expected} mm and {expected_pairs}"
+            ));
+        }
+        let mut pairs = Vec::with_capacity(count);
+        for k in 0..count {
+            pairs.push(r.pair(angles_deg[k / share.max(1)])?);
+        }
+        pitches.push(PitchPart {
+            pitch: p,
+            pairs,
+            band,
+            grid_s,
+            seconds,
+            nodes,
+        });
+    }
+    if r.at != bin.len() {
+        return Err("it holds more than its header says".into());
+    }
+    Ok(StudyPart {
+        shard: record.shard,
+        spec,
+        starts,
+        angles_deg,
+        pitches,
+        settings: record.settings.clone(),
+        summary: record.study.clone(),
+        sample_s: record.sample_s,
+        oracle_s: record.oracle_s,
+    })
+}
