@@ -91,7 +91,8 @@ impl RankedGrid {
     ///
     /// A level strikes only above the node's own height, so the search
     /// runs over the heights above it, and it is a binary search because
-    /// the rule is monotone in the level.
+    /// the rule is monotone in the level; galloping, because the threshold
+    /// is most often a few heights above the node's own (`h + e0`).
     pub fn thresholds(&self, padded: &PaddedGrid, rule: &StrikeRule) -> Vec<Rank> {
         let pitch = padded.spec.pitch;
         let h = &padded.h;
@@ -110,7 +111,7 @@ impl RankedGrid {
                     }
                     let above = self.ranks[n] as usize;
                     let higher = &self.heights[above..];
-                    let lowest = higher.partition_point(|&f| !rule.strikes(own, behind, f, pitch));
+                    let lowest = first_true(higher, |f| rule.strikes(own, behind, f, pitch));
                     if lowest < higher.len() {
                         *t = (above + lowest) as Rank + 1;
                     }
@@ -122,6 +123,26 @@ impl RankedGrid {
     /// Memory held (bytes).
     pub fn bytes(&self) -> usize {
         self.ranks.len() * 4 + self.heights.len() * 8
+    }
+}
+
+/// The index of the first element of `values` for which `pred` holds
+/// (`values.len()` if none), for a `pred` false and then true along
+/// `values`: a galloping search from the front, then a binary search in
+/// the last gallop's step.
+fn first_true(values: &[f64], pred: impl Fn(f64) -> bool) -> usize {
+    let mut lo = 0;
+    let mut step = 1;
+    loop {
+        let probe = lo + step - 1;
+        if probe >= values.len() {
+            return lo + values[lo..].partition_point(|&v| !pred(v));
+        }
+        if pred(values[probe]) {
+            return lo + values[lo..probe].partition_point(|&v| !pred(v));
+        }
+        lo = probe + 1;
+        step *= 2;
     }
 }
 
@@ -165,6 +186,17 @@ mod tests {
         assert_eq!(ranked.height(NEVER), f64::NEG_INFINITY);
         // -0.0 and 0.0 share a rank; 3.0 appears twice: 5 distinct.
         assert_eq!(ranked.heights.len(), 5);
+    }
+
+    #[test]
+    fn galloping_finds_the_first_true_at_every_place() {
+        let values: Vec<f64> = (0..100).map(f64::from).collect();
+        for len in [0, 1, 2, 3, 7, 64, 100] {
+            for first in 0..=len {
+                let got = first_true(&values[..len], |v| v >= first as f64);
+                assert_eq!(got, first, "len {len}");
+            }
+        }
     }
 
     /// The threshold decides as the rule does, at every level the grid
