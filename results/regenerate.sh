@@ -9,6 +9,9 @@
 #     bash results/regenerate.sh converge-direct  # the direct approach's studies only
 #     bash results/regenerate.sh ab REV     # results/ab.md: this tree against
 #                                           # the commit REV, end to end, in one run
+#     bash results/regenerate.sh pitch      # results/pitch.md: the bundled console
+#                                           # at 0.5 mm (61 angles) and 0.25 mm
+#                                           # (3 angles), about 6 minutes
 #
 # Every study uses the same settings so they can be compared: pitches 4, 2,
 # 1 and 0.5 mm (0.25 mm too on the wave and the depression), angles -30, 0
@@ -91,4 +94,41 @@ PY
     done
   } > results/ab.md
   cat results/ab.md
+fi
+
+# The fine pitches on the bundled console (`scenarios/console.toml`, 600 x
+# 300 mm class): 0.5 mm with SPEC's 61 angles, and 0.25 mm with 3 (its 61
+# would take about half an hour here): time by stage, peak RSS against the
+# memory estimate.
+if [[ "$what" == pitch ]]; then
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+  {
+    echo "# Fine pitches on the bundled console"
+    echo
+    echo "\`bash results/regenerate.sh pitch\` on $(date -u +%Y-%m-%d), $(nproc) CPUs"
+    echo "($(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)), load average at the start"
+    echo "$(cut -d' ' -f1-3 /proc/loadavg); $(git rev-parse --short HEAD). Part: \`scenarios/console.toml\`,"
+    echo "default settings otherwise (2 threads)."
+    echo
+    echo "| pitch mm | angles | grid | push+slide s | per angle s | total s | write s | peak MiB | estimate MiB |"
+    echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+    for run in "0.5 -30:30:1" "0.25 -30,0,30"; do
+      set -- $run
+      rm -rf "$work/out"
+      "$bin" analyze scenarios/console.toml --pitch "$1" --angles="$2" --threads 2 \
+        --out "$work/out" >/dev/null 2>&1
+      python3 - "$work/out/summary.json" "$1" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+t = s["timings"]
+n = len(s["angles_deg"])
+g = s["grid_size"]
+print(f"| {sys.argv[2]} | {n} | {g[0]} x {g[1]} | {t['push_slide_s']:.1f} | "
+      f"{t['push_slide_s'] / n:.2f} | {t['total_s']:.1f} | {t['write_s']:.1f} | "
+      f"{s['peak_rss_mib']:.0f} | {s['memory_estimate_mib']:.0f} |")
+PY
+    done
+  } > results/pitch.md
+  cat results/pitch.md
 fi
