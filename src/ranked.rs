@@ -55,7 +55,10 @@ impl RankedGrid {
     /// `2^30` nodes).
     pub fn new(padded: &PaddedGrid) -> RankedGrid {
         let mut heights: Vec<f64> = padded.h.iter().copied().filter(|h| h.is_finite()).collect();
-        heights.par_sort_unstable_by(|a, b| a.partial_cmp(b).expect("no NaN height"));
+        // The total order puts -0.0 before 0.0, so the one of the two that
+        // stands for their shared rank is -0.0 whatever the thread count.
+        assert!(!heights.iter().any(|h| h.is_nan()), "no NaN height");
+        heights.par_sort_unstable_by(f64::total_cmp);
         heights.dedup_by(|a, b| a == b);
         heights.shrink_to_fit();
         assert!(heights.len() < (OFF - 1) as usize, "too many heights");
@@ -184,8 +187,15 @@ mod tests {
             }
         }
         assert_eq!(ranked.height(NEVER), f64::NEG_INFINITY);
-        // -0.0 and 0.0 share a rank; 3.0 appears twice: 5 distinct.
+        // -0.0 and 0.0 share a rank (-0.0 stands for it); 3.0 appears
+        // twice: 5 distinct.
         assert_eq!(ranked.heights.len(), 5);
+        assert!(
+            ranked
+                .heights
+                .iter()
+                .any(|h| *h == 0.0 && h.is_sign_negative())
+        );
     }
 
     #[test]
