@@ -337,19 +337,13 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, ShardError> {
     let first = shards
         .first()
         .ok_or_else(|| ShardError::Mismatch("no shard directory given".into()))?;
-    let count = first.record.shard.count;
     let identity = identity(&first.record.summary);
-    let mut owner: Vec<Option<&Path>> = vec![None; count];
-    for s in &shards {
-        let shard = s.record.shard;
-        if shard.count != count {
-            return Err(ShardError::Mismatch(format!(
-                "{} is shard {shard}, {} shard {}/{count}: shards of one run have one N",
-                s.dir.display(),
-                first.dir.display(),
-                first.record.shard.index
-            )));
-        }
+    let sets: Vec<(Shard, &Path)> = shards
+        .iter()
+        .map(|s| (s.record.shard, s.dir.as_path()))
+        .collect();
+    check_set(&sets, "run", |k| {
+        let s = &shards[k];
         if let Some(key) = first_difference(&identity, &self::identity(&s.record.summary)) {
             return Err(ShardError::Mismatch(format!(
                 "{} and {} are shards of different runs (their summaries' `{key}` differ)",
@@ -364,23 +358,8 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, ShardError> {
                 s.dir.display()
             )));
         }
-        match owner[shard.index - 1] {
-            Some(other) => {
-                return Err(ShardError::Mismatch(format!(
-                    "shard {shard} is given twice: {} and {}",
-                    other.display(),
-                    s.dir.display()
-                )));
-            }
-            None => owner[shard.index - 1] = Some(&s.dir),
-        }
-    }
-    if let Some(missing) = owner.iter().position(Option::is_none) {
-        return Err(ShardError::Mismatch(format!(
-            "shard {}/{count} is missing: merge needs the directory of every shard",
-            missing + 1
-        )));
-    }
+        Ok(())
+    })?;
     let summary = &first.record.summary;
     let angles = &summary.angles_deg;
     let header = first.header;
@@ -487,6 +466,51 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, ShardError> {
         blind_spots,
         summary: merged,
     })
+}
+
+/// Checks that `shards` (each one's K/N and directory; the first is the
+/// reference) are every shard of one `set` ("run", "study") exactly once:
+/// one N, no K twice, none missing. `same(k)` refuses shard `k` when it
+/// belongs to another set than the first's. The first refusal found,
+/// shard by shard in the order given, is the one returned.
+fn check_set(
+    shards: &[(Shard, &Path)],
+    set: &str,
+    same: impl Fn(usize) -> Result<(), ShardError>,
+) -> Result<(), ShardError> {
+    let Some(&(first, first_dir)) = shards.first() else {
+        return Err(ShardError::Mismatch("no shard directory given".into()));
+    };
+    let count = first.count;
+    let mut owner: Vec<Option<&Path>> = vec![None; count];
+    for (k, &(shard, dir)) in shards.iter().enumerate() {
+        if shard.count != count {
+            return Err(ShardError::Mismatch(format!(
+                "{} is shard {shard}, {} shard {}/{count}: shards of one {set} have one N",
+                dir.display(),
+                first_dir.display(),
+                first.index
+            )));
+        }
+        same(k)?;
+        match owner[shard.index - 1] {
+            Some(other) => {
+                return Err(ShardError::Mismatch(format!(
+                    "shard {shard} is given twice: {} and {}",
+                    other.display(),
+                    dir.display()
+                )));
+            }
+            None => owner[shard.index - 1] = Some(dir),
+        }
+    }
+    if let Some(missing) = owner.iter().position(Option::is_none) {
+        return Err(ShardError::Mismatch(format!(
+            "shard {}/{count} is missing: merge needs the directory of every shard",
+            missing + 1
+        )));
+    }
+    Ok(())
 }
 
 /// A summary with what differs between the shards of one run left out:

@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::codec::{Reader, put_f64, put_f64s, put_pair, put_points, put_u64};
-use super::{Shard, ShardError, first_difference, hex_sha256};
+use super::{Shard, ShardError, check_set, first_difference, hex_sha256};
 use crate::grid::GridSpec;
 use crate::harness::metrics::TieBand;
 use crate::harness::sharded::PitchPart;
@@ -189,43 +189,22 @@ pub fn merge_study(dirs: &[PathBuf]) -> Result<MergedStudy, ShardError> {
     let first = shards
         .first()
         .ok_or_else(|| ShardError::Mismatch("no shard directory given".into()))?;
-    let count = first.record.shard.count;
     let identity = identity(&first.record);
-    let mut owner: Vec<Option<usize>> = vec![None; count];
-    for (k, s) in shards.iter().enumerate() {
-        let shard = s.record.shard;
-        if shard.count != count {
-            return Err(ShardError::Mismatch(format!(
-                "{} is shard {shard}, {} shard {}/{count}: shards of one study have one N",
-                s.dir.display(),
-                first.dir.display(),
-                first.record.shard.index
-            )));
-        }
-        if let Some(key) = first_difference(&identity, &self::identity(&s.record)) {
-            return Err(ShardError::Mismatch(format!(
+    let sets: Vec<(Shard, &Path)> = shards
+        .iter()
+        .map(|s| (s.record.shard, s.dir.as_path()))
+        .collect();
+    check_set(&sets, "study", |k| {
+        let s = &shards[k];
+        match first_difference(&identity, &self::identity(&s.record)) {
+            Some(key) => Err(ShardError::Mismatch(format!(
                 "{} and {} are shards of different studies (their `{key}` differ)",
                 first.dir.display(),
                 s.dir.display()
-            )));
+            ))),
+            None => Ok(()),
         }
-        match owner[shard.index - 1] {
-            Some(other) => {
-                return Err(ShardError::Mismatch(format!(
-                    "shard {shard} is given twice: {} and {}",
-                    shards[other].dir.display(),
-                    s.dir.display()
-                )));
-            }
-            None => owner[shard.index - 1] = Some(k),
-        }
-    }
-    if let Some(missing) = owner.iter().position(Option::is_none) {
-        return Err(ShardError::Mismatch(format!(
-            "shard {}/{count} is missing: merge needs the directory of every shard",
-            missing + 1
-        )));
-    }
+    })?;
     // In shard order: shard K's share is parts[K - 1].
     let mut shards = shards;
     shards.sort_by_key(|s| s.record.shard.index);
