@@ -702,7 +702,11 @@ impl Analysis {
 
         let composite = composite(&masks);
         let struck = composite.iter().filter(|&&c| c > 0).count();
-        let mut result_warnings = sanity::blind_spot_warnings(&blind);
+        let placement = crate::frame::Placement {
+            approach: setup.approach,
+            ..input.placement()
+        };
+        let mut result_warnings = sanity::blind_spot_warnings(&blind, &placement);
         result_warnings.extend(sanity::result_warnings(struck));
         for w in &result_warnings {
             progress.warn(w);

@@ -31,9 +31,24 @@ use rayon::prelude::*;
 use crate::grid::HeightGrid;
 use crate::mesh::Triangle;
 
-/// The columns of `blind_spots.csv`, as the writer writes them and the
-/// report reads them.
-pub const CSV_COLUMNS: [&str; 8] = [
+/// The columns of `blind_spots.csv`, as the writer writes them: the cell
+/// (`i`, `j`), its lowest point in the part's coordinates (`x`, `y`, `z`,
+/// mm), and the rest of [`BlindSpot`].
+pub const CSV_COLUMNS: [&str; 9] = [
+    "i",
+    "j",
+    "x",
+    "y",
+    "z",
+    "depth_missed_mm",
+    "width_mm",
+    "resolving_pitch_mm",
+    "met_angles_deg",
+];
+
+/// The columns of `blind_spots.csv` the report reads, by name: every
+/// version's file has them (`y` came later).
+pub const CSV_READ_COLUMNS: [&str; 8] = [
     "i",
     "j",
     "x",
@@ -53,7 +68,8 @@ pub struct BlindSpot {
     pub i: usize,
     /// Row of the cell's first corner node.
     pub j: usize,
-    /// x of the mesh's lowest point in the cell (mm, analysis frame).
+    /// x of the mesh's lowest point in the cell (mm, the analysis grid's
+    /// frame: [`BlindSpot::in_part`] maps it to the part's).
     pub x: f64,
     /// z of that point (mm).
     pub z: f64,
@@ -69,6 +85,15 @@ pub struct BlindSpot {
     /// a level this point sticks out past: a contact the grid cannot see
     /// (filled in by the analysis, from the engine's probes).
     pub met_angles_deg: Vec<f64>,
+}
+
+impl BlindSpot {
+    /// The lowest point `(x, y, z)` in the part's coordinates (mm), mapped
+    /// back from the analysis grid's frame by `placement` (the side's
+    /// mirror, a `--frame`, the direct approach's turn).
+    pub fn in_part(&self, placement: &crate::frame::Placement) -> [f64; 3] {
+        placement.to_part([self.x, self.y, self.z])
+    }
 }
 
 /// The blind spots of `grid` (sampled from `triangles`) deeper than

@@ -91,7 +91,7 @@ pub enum Warning {
     /// Features between the nodes, unseen by the grid, that the
     /// knee-form meets.
     #[error(
-        "{count} blind spots the knee-form meets (angles {angles}): the part sticks out up to {depth_mm:.2} mm past the grid's nodes where the grid cannot see it, first at x = {x:.1}, z = {z:.1} mm; their strikes are missing from the result; --pitch {pitch} resolves them (blind_spots.csv)"
+        "{count} blind spots the knee-form meets (angles {angles}): the part sticks out up to {depth_mm:.2} mm past the grid's nodes where the grid cannot see it, first at x = {x:.1}, y = {y:.1}, z = {z:.1} mm (part coordinates); their strikes are missing from the result; --pitch {pitch} resolves them (blind_spots.csv)"
     )]
     BlindSpotsMet {
         /// Cells the knee-form meets.
@@ -100,8 +100,10 @@ pub enum Warning {
         depth_mm: f64,
         /// The angles at which they are met, listed.
         angles: String,
-        /// The first one's x (mm, part frame).
+        /// The first one's lowest point, in the part's coordinates: x (mm).
         x: f64,
+        /// Its y (mm).
+        y: f64,
         /// Its z (mm).
         z: f64,
         /// The pitch resolving every one of them (mm).
@@ -218,8 +220,12 @@ pub fn angle_warnings(angles_deg: &[f64]) -> Vec<Warning> {
 }
 
 /// The blind spots the knee-form meets (contacts the grid cannot see), as
-/// one warning.
-pub fn blind_spot_warnings(spots: &[crate::blind::BlindSpot]) -> Vec<Warning> {
+/// one warning; where they are is said in the part's coordinates, through
+/// `placement` (the spots lie in the analysis grid's frame).
+pub fn blind_spot_warnings(
+    spots: &[crate::blind::BlindSpot],
+    placement: &crate::frame::Placement,
+) -> Vec<Warning> {
     let near: Vec<&crate::blind::BlindSpot> = spots
         .iter()
         .filter(|s| !s.met_angles_deg.is_empty())
@@ -230,12 +236,14 @@ pub fn blind_spot_warnings(spots: &[crate::blind::BlindSpot]) -> Vec<Warning> {
     let mut angles: Vec<f64> = near.iter().flat_map(|s| s.met_angles_deg.clone()).collect();
     angles.sort_by(f64::total_cmp);
     angles.dedup();
+    let [x, y, z] = first.in_part(placement);
     vec![Warning::BlindSpotsMet {
         count: near.len(),
         depth_mm: near.iter().map(|s| s.depth_missed_mm).fold(0.0, f64::max),
         angles: angle_list(&angles),
-        x: first.x,
-        z: first.z,
+        x,
+        y,
+        z,
         pitch: near
             .iter()
             .map(|s| s.resolving_pitch_mm)

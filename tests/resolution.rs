@@ -191,3 +191,53 @@ fn blind_spots_are_written_crossed_and_reported() {
     );
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn blind_spots_are_located_in_the_parts_coordinates_whatever_the_frame() {
+    // The thin ribs (scenarios/thin-rib.toml): one at part x = 10.3 +- 0.3
+    // for |z| <= 100, one at part z = 40.3 +- 0.3 for x in -250..-50, both
+    // 5 mm proud of the wall y = 0 towards -y. A blind spot's lowest point
+    // lies on a rib in the part's coordinates, whether the grid was laid in
+    // the part's frame, in a vehicle frame turned about y (`z,y,-x`: the
+    // grid's x is the part's z), or in the direct approach's frame.
+    let dir = crate::util::scratch_dir("blind-frames");
+    let on_a_rib = |x: f64, y: f64, z: f64| {
+        let tol = 0.3 + 1e-6;
+        let across = (x - 10.3).abs() <= tol && z.abs() <= 100.0 + 1e-6;
+        let along = (z - 40.3).abs() <= tol && (-250.0 - 1e-6..=-50.0 + 1e-6).contains(&x);
+        (across || along) && (-5.0 - 1e-6..=1e-6).contains(&y)
+    };
+    for (k, extra) in [
+        &[][..],
+        &["--frame=z,y,-x"][..],
+        &["--frame=-y,x,z", "--approach", "direct"][..],
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let out_dir = dir.join(format!("run{k}"));
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_kneeform"))
+            .args(["analyze"])
+            .arg(scenario_file("thin-rib"))
+            .args(["--pitch", "4", "--angles=0", "--out"])
+            .arg(&out_dir)
+            .args(extra)
+            .output()
+            .unwrap();
+        crate::util::ok(out, &format!("{extra:?}"));
+        let mut csv = csv::Reader::from_path(out_dir.join("blind_spots.csv")).unwrap();
+        let headers = csv.headers().unwrap().clone();
+        let column = |name: &str| headers.iter().position(|h| h == name).unwrap();
+        let (cx, cy, cz) = (column("x"), column("y"), column("z"));
+        let mut spots = 0;
+        for row in csv.records() {
+            let row = row.unwrap();
+            let at = |c: usize| row[c].parse::<f64>().unwrap();
+            let (x, y, z) = (at(cx), at(cy), at(cz));
+            assert!(on_a_rib(x, y, z), "{extra:?}: ({x}, {y}, {z}) is on no rib");
+            spots += 1;
+        }
+        assert!(spots > 20, "{extra:?}: {spots} blind spots");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}

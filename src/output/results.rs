@@ -140,7 +140,7 @@ pub fn write_results(
         placement,
         &blind,
     )?;
-    write_blind_spots(&out.path("blind_spots.csv"), results.blind_spots)?;
+    write_blind_spots(&out.path("blind_spots.csv"), results.blind_spots, placement)?;
     let t_ = &mut summary.timings;
     t_.write_s = started.elapsed().as_secs_f64();
     t_.total_s = t_.read_s + t_.sample_s + t_.push_slide_s + t_.write_s;
@@ -300,20 +300,27 @@ pub fn write_direct_convergence(
 }
 
 /// Writes `blind_spots.csv`: one row per blind spot ([`crate::blind`]),
-/// where (cell `i, j`; `x, z` of its lowest point, mm, part frame), how
-/// deep and wide, the pitch resolving it, and the angles at which the
-/// knee-form meets it (`;`-separated, empty when none).
-fn write_blind_spots(path: &Path, spots: &[BlindSpot]) -> Result<(), WriteError> {
+/// where (cell `i, j` of the analysis grid; `x, y, z` of its lowest point,
+/// mm, in the part's coordinates through `placement`), how deep and wide,
+/// the pitch resolving it, and the angles at which the knee-form meets it
+/// (`;`-separated, empty when none).
+fn write_blind_spots(
+    path: &Path,
+    spots: &[BlindSpot],
+    placement: &Placement,
+) -> Result<(), WriteError> {
     (|| -> csv::Result<()> {
         let mut csv = csv::Writer::from_path(path)?;
         csv.write_record(crate::blind::CSV_COLUMNS)?;
         for b in spots {
             let angles: Vec<String> = b.met_angles_deg.iter().map(f64::to_string).collect();
+            let [x, y, z] = b.in_part(placement);
             csv.write_record([
                 b.i.to_string(),
                 b.j.to_string(),
-                b.x.to_string(),
-                b.z.to_string(),
+                x.to_string(),
+                y.to_string(),
+                z.to_string(),
                 b.depth_missed_mm.to_string(),
                 b.width_mm.to_string(),
                 b.resolving_pitch_mm.to_string(),

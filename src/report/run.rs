@@ -370,7 +370,7 @@ fn run_frame(summary: &Summary, path: &Path) -> Result<Frame, ReportError> {
 }
 
 fn read_blind_spots(path: &Path, spec: GridSpec) -> Result<Vec<BlindRow>, ReportError> {
-    let mut rows = CsvRows::open(path, &crate::blind::CSV_COLUMNS)?;
+    let mut rows = CsvRows::open(path, &crate::blind::CSV_READ_COLUMNS)?;
     let mut out = Vec::new();
     while let Some(row) = rows.next_row()? {
         let (i, j): (usize, usize) = (rows.parse(&row, 0)?, rows.parse(&row, 1)?);

@@ -231,7 +231,12 @@ pub fn write_shard(out: &OutputDir, analysis: &Analysis, shard: Shard) -> Result
         pack_bits(&mut bin, m.probes_met.iter().copied());
     }
     let summary = analysis.summary();
-    let tail = result_warnings(&analysis.blind_spots, &analysis.composite).len();
+    let tail = result_warnings(
+        &analysis.blind_spots,
+        &analysis.composite,
+        &analysis.placement(),
+    )
+    .len();
     let warnings = &summary.warnings;
     let record = ShardRecord {
         format: FORMAT,
@@ -251,9 +256,9 @@ pub fn write_shard(out: &OutputDir, analysis: &Analysis, shard: Shard) -> Result
 
 /// The warnings an analysis adds once its masks are known: blind spots
 /// met, nothing struck.
-fn result_warnings(blind: &[BlindSpot], composite: &[u16]) -> Vec<String> {
+fn result_warnings(blind: &[BlindSpot], composite: &[u16], placement: &Placement) -> Vec<String> {
     let struck = composite.iter().filter(|&&c| c > 0).count();
-    crate::sanity::blind_spot_warnings(blind)
+    crate::sanity::blind_spot_warnings(blind, placement)
         .into_iter()
         .chain(crate::sanity::result_warnings(struck))
         .map(|w| w.to_string())
@@ -430,10 +435,20 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, ShardError> {
         .iter()
         .filter(|b| !b.met_angles_deg.is_empty())
         .count();
+    let frame = merged
+        .frame
+        .as_ref()
+        .map_or(Ok(Frame::none()), Frame::from_record)
+        .map_err(|e| first.corrupt(format!("frame: {e}")))?;
+    let placement = Placement {
+        side: merged.side,
+        frame,
+        approach: merged.approach,
+    };
     merged.warnings = first.record.base_warnings.clone();
     merged
         .warnings
-        .extend(result_warnings(&blind_spots, &composite));
+        .extend(result_warnings(&blind_spots, &composite, &placement));
     let t = &mut merged.timings;
     for s in &shards {
         let st = &s.record.summary.timings;
@@ -448,21 +463,12 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, ShardError> {
     merged.run_unix_time = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_secs());
-    let frame = merged
-        .frame
-        .as_ref()
-        .map_or(Ok(Frame::none()), Frame::from_record)
-        .map_err(|e| first.corrupt(format!("frame: {e}")))?;
     Ok(Merged {
         grid,
         masks,
         composite,
         node_file,
-        placement: Placement {
-            side: merged.side,
-            frame,
-            approach: merged.approach,
-        },
+        placement,
         blind_spots,
         summary: merged,
     })
