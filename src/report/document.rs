@@ -942,7 +942,16 @@ fn resolution_section(inputs: &Inputs) -> Markup {
                     format!("{lo:.0}..{hi:.0}")
                 }
             };
-            format!("x = {}, z = {}", span(f[0], f[1]), span(f[2], f[3]))
+            if f[2].is_finite() {
+                format!(
+                    "x = {}, y = {}, z = {}",
+                    span(f[0], f[1]),
+                    span(f[2], f[3]),
+                    span(f[4], f[5])
+                )
+            } else {
+                format!("x = {}, z = {}", span(f[0], f[1]), span(f[4], f[5]))
+            }
         })
         .collect();
     let met = blind.iter().filter(|b| b.met_angles > 0).count();
@@ -990,10 +999,10 @@ fn resolution_section(inputs: &Inputs) -> Markup {
                 "\n"
                 table class="compact" {
                     "\n"
-                    tr { th { "x (mm)" } th { "z (mm)" } th { "depth missed (mm)" } th { "width (mm)" } th { "resolving pitch (mm)" } th { "angles meeting it" } }
+                    tr { th { "x (mm)" } th { "y (mm)" } th { "z (mm)" } th { "depth missed (mm)" } th { "width (mm)" } th { "resolving pitch (mm)" } th { "angles meeting it" } }
                     "\n"
                     @for b in &worst {
-                        tr { td { (fmt_num(b.x)) } td { (fmt_num(b.z)) } td { (fmt_num(b.depth_mm)) } td { (fmt_num(b.width_mm)) } td { (fmt_num(b.resolving_pitch_mm)) } td { (b.met_angles) } }
+                        tr { td { (fmt_num(b.x)) } td { (b.y.map_or(String::from("-"), fmt_num)) } td { (fmt_num(b.z)) } td { (fmt_num(b.depth_mm)) } td { (fmt_num(b.width_mm)) } td { (fmt_num(b.resolving_pitch_mm)) } td { (b.met_angles) } }
                         "\n"
                     }
                 }
@@ -1026,20 +1035,24 @@ fn resolution_section(inputs: &Inputs) -> Markup {
 /// The blind spots grouped into features (cells touching, corners
 /// included), each as its lowest points' extent `[x_lo, x_hi, z_lo, z_hi]`
 /// (mm), largest first.
-fn blind_features(blind: &[super::run::BlindRow]) -> Vec<[f64; 4]> {
+fn blind_features(blind: &[super::run::BlindRow]) -> Vec<[f64; 6]> {
     let index: std::collections::HashMap<(usize, usize), usize> = blind
         .iter()
         .enumerate()
         .map(|(k, b)| ((b.i, b.j), k))
         .collect();
     let mut feature = vec![usize::MAX; blind.len()];
-    let mut out: Vec<([f64; 4], usize)> = Vec::new();
+    let mut out: Vec<([f64; 6], usize)> = Vec::new();
     for start in 0..blind.len() {
         if feature[start] != usize::MAX {
             continue;
         }
         let id = out.len();
+        // x, y and z, each from lowest to highest; y stays infinite in
+        // files of versions that wrote no `y`.
         let mut extent = [
+            f64::INFINITY,
+            f64::NEG_INFINITY,
             f64::INFINITY,
             f64::NEG_INFINITY,
             f64::INFINITY,
@@ -1050,11 +1063,14 @@ fn blind_features(blind: &[super::run::BlindRow]) -> Vec<[f64; 4]> {
         feature[start] = id;
         while let Some(k) = stack.pop() {
             let b = &blind[k];
+            let y = b.y.map_or([f64::INFINITY, f64::NEG_INFINITY], |y| [y, y]);
             extent = [
                 extent[0].min(b.x),
                 extent[1].max(b.x),
-                extent[2].min(b.z),
-                extent[3].max(b.z),
+                extent[2].min(y[0]),
+                extent[3].max(y[1]),
+                extent[4].min(b.z),
+                extent[5].max(b.z),
             ];
             cells += 1;
             for (di, dj) in [

@@ -139,8 +139,11 @@ pub struct BlindRow {
     pub i: usize,
     /// Its row.
     pub j: usize,
-    /// The lowest point's x (mm).
+    /// The lowest point's x (mm, the part's coordinates; the analysis
+    /// grid's in files of versions before the `y` column).
     pub x: f64,
+    /// Its y (mm); `None` in files of versions that wrote none.
+    pub y: Option<f64>,
     /// Its z (mm).
     pub z: f64,
     /// Depth missed (mm).
@@ -371,6 +374,7 @@ fn run_frame(summary: &Summary, path: &Path) -> Result<Frame, ReportError> {
 
 fn read_blind_spots(path: &Path, spec: GridSpec) -> Result<Vec<BlindRow>, ReportError> {
     let mut rows = CsvRows::open(path, &crate::blind::CSV_READ_COLUMNS)?;
+    let y_column = rows.headers.iter().position(|h| h == "y");
     let mut out = Vec::new();
     while let Some(row) = rows.next_row()? {
         let (i, j): (usize, usize) = (rows.parse(&row, 0)?, rows.parse(&row, 1)?);
@@ -382,6 +386,14 @@ fn read_blind_spots(path: &Path, spec: GridSpec) -> Result<Vec<BlindRow>, Report
             i,
             j,
             x: rows.parse(&row, 2)?,
+            y: match y_column {
+                Some(c) => Some(
+                    row.get(c)
+                        .and_then(|v| v.parse().ok())
+                        .ok_or_else(|| rows.bad("column \"y\": not a number".into()))?,
+                ),
+                None => None,
+            },
             z: rows.parse(&row, 3)?,
             depth_mm: rows.parse(&row, 4)?,
             width_mm: rows.parse(&row, 5)?,
