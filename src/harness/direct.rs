@@ -796,6 +796,38 @@ pub struct DirectConvergence {
     pub summary: DirectConvergeSummary,
 }
 
+/// One pitch of a direct convergence study on some positions: its pairs,
+/// not yet assembled, and what was measured.
+struct DirectPitchPairs {
+    pitch: f64,
+    pairs: Vec<DirectPair>,
+    grid_s: f64,
+    nodes: usize,
+}
+
+impl DirectPitchPairs {
+    /// The pitch assembled: the unsharded study's.
+    fn assemble(self) -> DirectPitchResult {
+        DirectPitchResult {
+            pitch: self.pitch,
+            comparison: assemble_direct(self.pairs, self.grid_s),
+            nodes: self.nodes,
+        }
+    }
+
+    /// The pitch as a shard keeps it.
+    fn part(self) -> PitchPart {
+        PitchPart {
+            pitch: self.pitch,
+            pairs: Pairs::Direct(self.pairs),
+            band: NO_BAND,
+            grid_s: self.grid_s,
+            seconds: 0.0,
+            nodes: self.nodes,
+        }
+    }
+}
+
 /// The direct convergence study's pitches on `shard`'s share of the
 /// positions (all of them without a shard), coarsest first: the study,
 /// each pitch's pairs, and the oracle's seconds.
@@ -805,7 +837,7 @@ fn converge_pairs(
     options: &ConvergeOptions,
     shard: Option<Shard>,
     progress: &dyn Progress,
-) -> Result<(DirectStudy, Vec<PitchPart>, f64), HarnessError> {
+) -> Result<(DirectStudy, Vec<DirectPitchPairs>, f64), HarnessError> {
     options.validate()?;
     let pitches = &options.pitches;
     let coarse_setup = Setup {
@@ -841,12 +873,10 @@ fn converge_pairs(
         );
         progress.end();
         let (pairs, grid_s) = pairs?;
-        parts.push(PitchPart {
+        parts.push(DirectPitchPairs {
             pitch: p,
-            pairs: Pairs::Direct(pairs),
-            band: NO_BAND,
+            pairs,
             grid_s,
-            seconds: 0.0,
             nodes: spec.len(),
         });
     }
@@ -930,19 +960,8 @@ pub fn converge_direct(
     progress: &dyn Progress,
 ) -> Result<DirectConvergence, HarnessError> {
     let (study, parts, oracle_s) = converge_pairs(input, setup, options, None, progress)?;
-    let results: Vec<DirectPitchResult> = parts
-        .into_iter()
-        .filter_map(|p| {
-            let Pairs::Direct(pairs) = p.pairs else {
-                return None;
-            };
-            Some(DirectPitchResult {
-                pitch: p.pitch,
-                comparison: assemble_direct(pairs, p.grid_s),
-                nodes: p.nodes,
-            })
-        })
-        .collect();
+    let results: Vec<DirectPitchResult> =
+        parts.into_iter().map(DirectPitchPairs::assemble).collect();
     let mut summary =
         DirectConvergeSummary::new(input, setup, options, study.positions.len(), oracle_s);
     summary.set_results(&results);
@@ -968,7 +987,7 @@ pub fn converge_direct_shard(
         spec: study.spec,
         starts: study.positions,
         angles_deg: setup.angles.clone(),
-        pitches,
+        pitches: pitches.into_iter().map(DirectPitchPairs::part).collect(),
         settings: study_settings(
             &options.selection,
             options.tie_band_per_mm,

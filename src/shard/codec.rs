@@ -341,4 +341,58 @@ mod tests {
         bad[0] = STATUSES.len() as u8;
         assert!(Reader { bin: &bad, at: 0 }.pair(0.0).is_err());
     }
+
+    #[test]
+    fn a_direct_pair_reads_back_bit_for_bit_and_a_cut_one_is_an_error() {
+        let p = DirectPair {
+            row: DirectRow {
+                y: 12.0,
+                z: -4.0,
+                angle_deg: 30.0,
+                status: "both".into(),
+                grid_level: Some(-0.0),
+                exact_level: Some(0.1 + 0.2),
+                level_error: Some(f64::MIN_POSITIVE),
+                exact_y: Some(11.5),
+                exact_z: None,
+                contact_distance: Some(f64::INFINITY),
+                grid_contacted: 7,
+                exact_ties: 2,
+            },
+            engine_mismatch: true,
+        };
+        let mut bin = Vec::new();
+        put_direct_pair(&mut bin, &p);
+        let mut r = Reader { bin: &bin, at: 0 };
+        let back = r.direct_pair([12.0, -4.0], 30.0).unwrap();
+        assert_eq!(r.at, bin.len());
+        assert_eq!(back, p);
+        // PartialEq on f64 would take -0.0 for 0.0: compare the bits too.
+        assert_eq!(
+            back.row.grid_level.map(f64::to_bits),
+            Some((-0.0f64).to_bits())
+        );
+        for end in 0..bin.len() {
+            let mut r = Reader {
+                bin: &bin[..end],
+                at: 0,
+            };
+            assert!(r.direct_pair([0.0, 0.0], 0.0).is_err(), "cut at {end}");
+        }
+        // An unknown status, an unknown flag.
+        let mut bad = bin.clone();
+        bad[0] = DIRECT_STATUSES.len() as u8;
+        assert!(
+            Reader { bin: &bad, at: 0 }
+                .direct_pair([0.0, 0.0], 0.0)
+                .is_err()
+        );
+        let mut bad = bin.clone();
+        *bad.last_mut().unwrap() = 2;
+        assert!(
+            Reader { bin: &bad, at: 0 }
+                .direct_pair([0.0, 0.0], 0.0)
+                .is_err()
+        );
+    }
 }
