@@ -1,7 +1,7 @@
 //! Fan-out: `analyze --shard K/N`, `verify --shard K/N` and `converge
-//! --shard K/N` with `kneeform merge` give the unsharded command's files
-//! byte for byte (clock readings aside); `kneeform batch` resumes a killed
-//! batch without redoing finished items.
+//! --shard K/N` (with `--approach direct` too) with `kneeform merge` give
+//! the unsharded command's files byte for byte (clock readings aside);
+//! `kneeform batch` resumes a killed batch without redoing finished items.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -23,21 +23,26 @@ fn refused(out: &Output, needle: &str, what: &str) {
 const CLOCK_KEYS: [&str; 4] = ["timings", "run_unix_time", "peak_rss_mib", "threads"];
 
 /// The clock readings of a result file set aside: `summary.json`'s
-/// [`CLOCK_KEYS`], `verify.json`'s timings, `converge.json`'s engine
-/// seconds and the time predicted from them, `converge.csv`'s `seconds`
-/// column; `None` for a file that is a clock reading as a whole (the
-/// plot of the engine's time against the pitch). Other files as they are.
+/// [`CLOCK_KEYS`], `verify.json`'s timings (the direct approach's
+/// `grid_s` and `oracle_s`), `converge.json`'s engine seconds and the time
+/// predicted from them (the direct approach's `oracle_s`),
+/// `converge.csv`'s `seconds` column where it has one; `None` for a file
+/// that is a clock reading as a whole (the plot of the engine's time
+/// against the pitch). Other files as they are.
 fn without_clocks(name: &str, bytes: &[u8]) -> Option<Vec<u8>> {
     let json_keys: &[&str] = match name {
         "summary.json" => &CLOCK_KEYS,
-        "verify.json" => &["timings"],
-        "converge.json" => &["seconds", "predicted_full_time_s"],
+        "verify.json" => &["timings", "grid_s", "oracle_s"],
+        "converge.json" => &["seconds", "predicted_full_time_s", "oracle_s"],
         "time_vs_pitch.png" => return None,
         "converge.csv" => {
             let text = String::from_utf8(bytes.to_vec()).unwrap();
             let mut lines = text.lines();
             let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-            let col = header.iter().position(|h| *h == "seconds").unwrap();
+            let Some(col) = header.iter().position(|h| *h == "seconds") else {
+                // The direct approach's: no clock reading.
+                return Some(bytes.to_vec());
+            };
             let rows = lines.map(|l| {
                 let mut cells: Vec<&str> = l.split(',').collect();
                 cells[col] = "";
@@ -461,11 +466,6 @@ fn merge_refuses_a_study_s_missing_repeated_foreign_or_damaged_shard() {
         ("0/3", "--shard", &extra[..]),
         ("x", "--shard", &extra[..]),
         ("1/999", "999 shards of 16 starts", &extra[..]),
-        (
-            "1/2",
-            "--approach direct",
-            &["--pitch", "4", "--approach", "direct"][..],
-        ),
     ] {
         let bad_out = dir.join("bad");
         refused(
@@ -480,6 +480,146 @@ fn merge_refuses_a_study_s_missing_repeated_foreign_or_damaged_shard() {
             bad,
         );
         assert!(!bad_out.exists());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The flags of the direct approach's study tests: the part turned to
+/// face the knee-form coming from +x, as `results/regenerate.sh
+/// converge-direct` turns it.
+const DIRECT: [&str; 3] = ["--frame=-y,x,z", "--approach", "direct"];
+
+#[test]
+fn four_direct_verify_shards_merged_are_the_unsharded_verification_byte_for_byte() {
+    // The wave within a loose tolerance (its level errors at 4 mm reach
+    // 7.4 mm where it is steep) and beyond a tight one.
+    let part = scenario("wave");
+    let mut codes = Vec::new();
+    for tolerance in ["8", "1"] {
+        let dir = scratch_dir(&format!("verify-direct-shards-{tolerance}"));
+        let extra = [&DIRECT[..], &["--pitch", "4", "--tolerance", tolerance]].concat();
+        let whole = study("verify", &part, &dir.join("whole"), None, &extra);
+        let code = whole.status.code();
+        assert!(
+            matches!(code, Some(0 | 1)),
+            "{tolerance}: {}",
+            String::from_utf8_lossy(&whole.stderr)
+        );
+        let shards = study_shards("verify", &part, &dir, 4, &extra);
+        let record: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(shards[1].join("shard.json")).unwrap()).unwrap();
+        assert_eq!(record["shard"], serde_json::json!({"index": 2, "count": 4}));
+        assert_eq!(record["study"]["kind"], "verify-direct");
+        let summary = &record["study"]["summary"];
+        assert_eq!(summary["approach"], "direct");
+        assert!(summary.get("pass").is_none() && summary.get("metrics").is_none());
+        let starts = record["starts"].as_u64().unwrap() as usize;
+        let mine: Vec<usize> = (1..starts).step_by(4).collect();
+        assert_eq!(record["start_indices"], serde_json::json!(mine));
+        let merged = dir.join("merged");
+        let order: Vec<&Path> = [1, 3, 0, 2].iter().map(|&k| shards[k].as_path()).collect();
+        let result = merge_study(&order, &merged);
+        assert_eq!(
+            result.status.code(),
+            code,
+            "{tolerance}: {}",
+            String::from_utf8_lossy(&result.stderr)
+        );
+        assert_eq!(assert_same_files(&dir.join("whole"), &merged), 2);
+        let rows = std::fs::read_to_string(merged.join("verify.csv")).unwrap();
+        assert_eq!(
+            rows.lines().count(),
+            1 + 3 * starts,
+            "a row per position and angle"
+        );
+        let summary: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(merged.join("verify.json")).unwrap()).unwrap();
+        assert!(
+            summary["counts"]["both"].as_u64().unwrap() > 0,
+            "{tolerance}: nothing touched on both sides"
+        );
+        codes.push(code);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+    assert_eq!(codes, [Some(0), Some(1)]);
+}
+
+#[test]
+fn four_direct_converge_shards_merged_are_the_unsharded_study_byte_for_byte() {
+    let dir = scratch_dir("converge-direct-shards");
+    let part = scenario("tilted-wave");
+    let extra = [&DIRECT[..], &["--pitches", "8,4", "--tolerance", "2"]].concat();
+    ok(
+        study("converge", &part, &dir.join("whole"), None, &extra),
+        "the unsharded study",
+    );
+    let shards = study_shards("converge", &part, &dir, 4, &extra);
+    let merged = dir.join("merged");
+    let order: Vec<&Path> = [2, 3, 1, 0].iter().map(|&k| shards[k].as_path()).collect();
+    ok(merge_study(&order, &merged), "merge");
+    // converge.csv and .json, a verify_<pitch>mm.csv per pitch.
+    assert_eq!(assert_same_files(&dir.join("whole"), &merged), 4);
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(merged.join("converge.json")).unwrap()).unwrap();
+    assert_eq!(summary["approach"], "direct");
+    // A slide study's shard, or a direct verification's, among them.
+    let slide = dir.join("slide");
+    ok(
+        study(
+            "converge",
+            &part,
+            &slide,
+            Some((2, 4)),
+            &["--pitches", "8,4"],
+        ),
+        "a slide shard",
+    );
+    let verify = dir.join("verify");
+    ok(
+        study(
+            "verify",
+            &part,
+            &verify,
+            Some((2, 4)),
+            &[&DIRECT[..], &["--pitch", "8"]].concat(),
+        ),
+        "a direct verification's shard",
+    );
+    let out = dir.join("refused");
+    for (other, needle) in [
+        (&slide, "a convergence study (converge --shard)"),
+        (&verify, "a direct-approach verification"),
+    ] {
+        let given = [shards[0].as_path(), other, &shards[2], &shards[3]];
+        refused(&merge_study(&given, &out), needle, needle);
+        assert!(!out.exists(), "{needle}: output left behind");
+    }
+    // Missing and repeated shards, and another study (another tolerance).
+    let tight = dir.join("tight");
+    ok(
+        study(
+            "converge",
+            &part,
+            &tight,
+            Some((2, 4)),
+            &[&DIRECT[..], &["--pitches", "8,4", "--tolerance", "1"]].concat(),
+        ),
+        "another study's shard",
+    );
+    let s: Vec<&Path> = shards.iter().map(PathBuf::as_path).collect();
+    for (given, needle) in [
+        (vec![s[0], s[2], s[3]], "shard 2/4 is missing"),
+        (
+            vec![s[0], s[1], s[1], s[2], s[3]],
+            "shard 2/4 is given twice",
+        ),
+        (
+            vec![s[0], &tight, s[2], s[3]],
+            "shards of different studies",
+        ),
+    ] {
+        refused(&merge_study(&given, &out), needle, needle);
+        assert!(!out.exists(), "{needle}: output left behind");
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

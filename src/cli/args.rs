@@ -397,8 +397,9 @@ pub struct StudyArgs {
     /// the study's starts s (0-based, in the order the study compares them,
     /// after --starts sampling) with s % N == K - 1, and runs the exact
     /// oracle on those alone. 1 <= K <= N <= the number of starts. A
-    /// shard exits 0 once written: pass or fail is the merge's. Not with
-    /// --approach direct. Default: every start.
+    /// shard exits 0 once written: pass or fail is the merge's. With
+    /// --approach direct, the study's positions alike. Default: every
+    /// start.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<String>,
 }

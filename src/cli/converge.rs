@@ -38,8 +38,11 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
     let shard = super::study_shard(&args.study)?;
     let (input, setup) = super::study_inputs(&args.study, options.validate())?;
     if setup.approach == Approach::Direct {
-        if shard.is_some() {
-            return Err(super::refuse_direct_shard());
+        if let Some(shard) = shard {
+            let part =
+                harness::converge_direct_shard(&input, &setup, &options, shard, &Bars::default())
+                    .map_err(super::harness_error)?;
+            return super::write_study_shard(&args.out, &part);
         }
         return run_direct(args, &input, &setup, &options);
     }
@@ -78,32 +81,6 @@ fn run_direct(
         study.summary.oracle_s
     );
     output::write_direct_convergence(&args.out, &study)?;
-    for r in &study.results {
-        let c = &r.comparison;
-        let stats: Vec<String> = c
-            .stats
-            .iter()
-            .map(|(m, s)| format!("{m} max {:.4} median {:.4}", s.max, s.median))
-            .collect();
-        eprintln!(
-            "p = {:>6} mm: {} | {} both, {} grid only, {} exact only, {} failed, {} engine mismatches",
-            r.pitch,
-            stats.join(", "),
-            c.counts.both,
-            c.counts.grid_only,
-            c.counts.exact_only,
-            c.counts.oracle_failed,
-            c.counts.engine_mismatch
-        );
-    }
-    for (m, f) in &study.summary.fits {
-        eprintln!("{m:>16}: max error ~ {:.3} p^{:.2}", f.c, f.alpha);
-    }
-    match (args.tolerance, study.summary.recommended_pitch_mm) {
-        (Some(t), Some(p)) => eprintln!("kneeform: the coarsest pitch within {t} mm is {p} mm"),
-        (Some(t), None) => eprintln!("kneeform: no pitch tried is within {t} mm"),
-        _ => {}
-    }
-    eprintln!("kneeform: results in {}", args.out.display());
+    super::study::print_direct_convergence(&study, &args.out);
     Ok(ExitCode::SUCCESS)
 }

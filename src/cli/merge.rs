@@ -42,6 +42,8 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<ExitCode> {
     match &merged {
         MergedStudy::Verify(v) => output::write_verification_files(&out, v)?,
         MergedStudy::Converge(c) => output::write_convergence_files(&out, c)?,
+        MergedStudy::VerifyDirect(v) => output::write_direct_verification_files(&out, v)?,
+        MergedStudy::ConvergeDirect(c) => output::write_direct_convergence_files(&out, c)?,
     }
     out.commit()
         .with_context(|| format!("cannot move results into {}", args.out.display()))?;
@@ -50,6 +52,11 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<ExitCode> {
         MergedStudy::Verify(v) => super::study::print_verification(v, &args.out),
         MergedStudy::Converge(c) => {
             super::study::print_convergence(c, &args.out);
+            ExitCode::SUCCESS
+        }
+        MergedStudy::VerifyDirect(v) => super::study::print_direct_verification(v, &args.out),
+        MergedStudy::ConvergeDirect(c) => {
+            super::study::print_direct_convergence(c, &args.out);
             ExitCode::SUCCESS
         }
     })

@@ -95,14 +95,6 @@ pub fn write_study_shard(out: &Path, part: &StudyPart) -> anyhow::Result<ExitCod
     Ok(ExitCode::SUCCESS)
 }
 
-/// `--shard` with `--approach direct`: not built (the direct approach's
-/// positions are not a study's starts).
-pub fn refuse_direct_shard() -> anyhow::Error {
-    anyhow::anyhow!(
-        "--shard is not built for --approach direct yet: run the direct approach's study unsharded"
-    )
-}
-
 /// A harness error with the flag it concerns in front, where one does.
 pub fn harness_error(err: HarnessError) -> anyhow::Error {
     let flag = match &err {

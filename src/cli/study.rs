@@ -1,11 +1,14 @@
-//! What `verify` and `converge` print of their results, and `kneeform
-//! merge` of their shards alike: the statistics, the verdict and
-//! `verify`'s exit status.
+//! What `verify` and `converge` print of their results (with `--approach
+//! direct` too), and `kneeform merge` of their shards alike: the
+//! statistics, the verdict and `verify`'s exit status.
 
 use std::path::Path;
 use std::process::ExitCode;
 
-use kneeform::harness::{Convergence, DECIDED_METRICS, Verification};
+use kneeform::harness::{
+    Convergence, DECIDED_METRICS, DIRECT_METRICS, DirectConvergence, DirectVerification,
+    Verification,
+};
 
 /// What would resolve a failure, in words: the pitch a first-order error
 /// (`error ~ C p`, what the evidence in `results/` shows for push, miss and
@@ -149,6 +152,77 @@ pub fn print_convergence(study: &Convergence, out: &Path) {
             r.pitch,
             study.summary.predicted_full_time_s.unwrap_or(f64::NAN)
         ),
+        (Some(t), None) => eprintln!("kneeform: no pitch tried is within {t} mm"),
+        _ => {}
+    }
+    eprintln!("kneeform: results in {}", out.display());
+}
+
+/// Prints a direct verification's statistics, counts and verdict (its
+/// results are in `out`) and returns `verify`'s exit status: 0 when it
+/// passes, 1 when it fails.
+pub fn print_direct_verification(result: &DirectVerification, out: &Path) -> ExitCode {
+    let s = &result.summary;
+    for name in DIRECT_METRICS {
+        let stats = &s.metrics[name];
+        eprintln!(
+            "{name:>16}: max {:.4}  p95 {:.4}  median {:.4} mm  (n = {})",
+            stats.max, stats.p95, stats.median, stats.n
+        );
+    }
+    let c = &s.counts;
+    eprintln!(
+        "{:>16}: {} position-angle pairs, {} touched on both sides, {} on the grid only, {} exactly only, {} oracle failures, {} engine levels unlike the harness's",
+        "positions",
+        c.compared,
+        c.both,
+        c.grid_only,
+        c.exact_only,
+        c.oracle_failed,
+        c.engine_mismatch
+    );
+    let verdict = if s.pass { "PASS" } else { "FAIL" };
+    eprintln!(
+        "kneeform: {verdict} (direct approach) at tolerance {} mm; results in {}",
+        s.tolerance_mm,
+        out.display()
+    );
+    if s.pass {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
+}
+
+/// Prints a direct convergence study's errors per pitch, fitted orders
+/// and the pitch it recommends (its results are in `out`).
+pub fn print_direct_convergence(study: &DirectConvergence, out: &Path) {
+    for r in &study.results {
+        let c = &r.comparison;
+        let stats: Vec<String> = c
+            .stats
+            .iter()
+            .map(|(m, s)| format!("{m} max {:.4} median {:.4}", s.max, s.median))
+            .collect();
+        eprintln!(
+            "p = {:>6} mm: {} | {} both, {} grid only, {} exact only, {} failed, {} engine mismatches",
+            r.pitch,
+            stats.join(", "),
+            c.counts.both,
+            c.counts.grid_only,
+            c.counts.exact_only,
+            c.counts.oracle_failed,
+            c.counts.engine_mismatch
+        );
+    }
+    for (m, f) in &study.summary.fits {
+        eprintln!("{m:>16}: max error ~ {:.3} p^{:.2}", f.c, f.alpha);
+    }
+    match (
+        study.summary.tolerance_mm,
+        study.summary.recommended_pitch_mm,
+    ) {
+        (Some(t), Some(p)) => eprintln!("kneeform: the coarsest pitch within {t} mm is {p} mm"),
         (Some(t), None) => eprintln!("kneeform: no pitch tried is within {t} mm"),
         _ => {}
     }

@@ -20,8 +20,11 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
     let shard = super::study_shard(&args.study)?;
     let (input, setup) = super::study_inputs(&args.study, options.validate())?;
     if setup.approach == Approach::Direct {
-        if shard.is_some() {
-            return Err(super::refuse_direct_shard());
+        if let Some(shard) = shard {
+            let part =
+                harness::verify_direct_shard(&input, &setup, &options, shard, &Bars::default())
+                    .map_err(super::harness_error)?;
+            return super::write_study_shard(&args.out, &part);
         }
         return run_direct(args, &input, &setup, &options);
     }
@@ -47,34 +50,5 @@ fn run_direct(
     let result = harness::verify_direct(input, setup, options, &Bars::default())
         .map_err(super::harness_error)?;
     output::write_direct_verification(&args.out, &result)?;
-    let s = &result.summary;
-    for name in harness::DIRECT_METRICS {
-        let stats = &s.metrics[name];
-        eprintln!(
-            "{name:>16}: max {:.4}  p95 {:.4}  median {:.4} mm  (n = {})",
-            stats.max, stats.p95, stats.median, stats.n
-        );
-    }
-    let c = &s.counts;
-    eprintln!(
-        "{:>16}: {} position-angle pairs, {} touched on both sides, {} on the grid only, {} exactly only, {} oracle failures, {} engine levels unlike the harness's",
-        "positions",
-        c.compared,
-        c.both,
-        c.grid_only,
-        c.exact_only,
-        c.oracle_failed,
-        c.engine_mismatch
-    );
-    let verdict = if s.pass { "PASS" } else { "FAIL" };
-    eprintln!(
-        "kneeform: {verdict} (direct approach) at tolerance {} mm; results in {}",
-        s.tolerance_mm,
-        args.out.display()
-    );
-    Ok(if s.pass {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(1)
-    })
+    Ok(super::study::print_direct_verification(&result, &args.out))
 }

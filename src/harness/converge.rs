@@ -8,9 +8,11 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use super::HarnessError;
-use super::compare::{CompareOptions, Comparison, StartSelection, assemble, pair_results};
+use super::compare::{
+    CompareOptions, Comparison, PairResult, StartSelection, assemble, pair_results,
+};
 use super::metrics::{METRICS, TieBand};
-use super::sharded::PitchPart;
+use super::sharded::{Pairs, PitchPart};
 use super::verify::{
     check_selection, check_tie_band, check_tolerance, oracle_options, run_oracle, start_positions,
     tie_band_rule,
@@ -233,10 +235,10 @@ impl<'a> Ladder<'a> {
         p: f64,
         progress: &dyn Progress,
     ) -> Result<(PitchResult, Vec<AngleMask>, HeightGrid), HarnessError> {
-        let (pitch, masks, grid) = self.measure_pairs(p, progress)?;
+        let (pairs, pitch, masks, grid) = self.measure_raw(p, progress)?;
         let result = PitchResult {
             pitch: p,
-            comparison: assemble(pitch.pairs, &self.setup.angles, pitch.band, pitch.grid_s),
+            comparison: assemble(pairs, &self.setup.angles, pitch.band, pitch.grid_s),
             seconds: pitch.seconds,
             nodes: pitch.nodes,
         };
@@ -249,7 +251,21 @@ impl<'a> Ladder<'a> {
         &self,
         p: f64,
         progress: &dyn Progress,
-    ) -> Result<(PitchPart, Vec<AngleMask>, HeightGrid), HarnessError> {
+    ) -> Result<PitchPart, HarnessError> {
+        let (pairs, pitch, _, _) = self.measure_raw(p, progress)?;
+        Ok(PitchPart {
+            pairs: Pairs::Slide(pairs),
+            ..pitch
+        })
+    }
+
+    /// The pairs of pitch `p`, and the pitch's part without them (its
+    /// timings), its masks and grid.
+    fn measure_raw(
+        &self,
+        p: f64,
+        progress: &dyn Progress,
+    ) -> Result<(Vec<PairResult>, PitchPart, Vec<AngleMask>, HeightGrid), HarnessError> {
         let spec = self.spec_at(p);
         progress.begin(
             &format!("pitch {p} mm: {} x {} grid", spec.nx, spec.nz),
@@ -281,13 +297,13 @@ impl<'a> Ladder<'a> {
         progress.end();
         let part = PitchPart {
             pitch: p,
-            pairs: pairs?,
+            pairs: Pairs::Slide(Vec::new()),
             band: TieBand::new(self.compare.rule.sigma, p, self.compare.tie_band_per_mm),
             grid_s,
             seconds,
             nodes: spec.len(),
         };
-        Ok((part, masks, grid))
+        Ok((pairs?, part, masks, grid))
     }
 }
 

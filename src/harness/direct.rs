@@ -44,6 +44,7 @@ use super::HarnessError;
 use super::compare::{StartSelection, choose_nodes, node_at};
 use super::converge::{Fit, fit_power_law};
 use super::metrics::{nearest_rank, sorted_abs};
+use super::sharded::{NO_BAND, Pairs, PitchPart, StudyPart, StudySummary, share, study_settings};
 use super::verify::{check_selection, check_tolerance};
 use super::{ConvergeOptions, VerifyOptions};
 use crate::analysis::{Approach, Progress, Setup};
@@ -51,6 +52,7 @@ use crate::direct::{DirectFootprint, contact_levels, to_direct};
 use crate::grid::{GridSpec, HeightGrid};
 use crate::kneeform::KneeForm;
 use crate::mesh::{Part, PartFile, Triangle};
+use crate::shard::Shard;
 
 /// The metrics of the direct approach, in the order of `converge.csv`.
 pub const DIRECT_METRICS: [&str; 2] = ["level_error", "contact_distance"];
@@ -273,6 +275,26 @@ impl DirectComparison {
     }
 }
 
+/// One position at one angle as a shard keeps it: its row, and whether
+/// the engine's level there is not the transcription's (which the row
+/// does not say). A comparison is [`assemble_direct`]d from these alone.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DirectPair {
+    /// The row.
+    pub row: DirectRow,
+    /// The engine's level differs from the transcription's, to the bit.
+    pub engine_mismatch: bool,
+}
+
+/// The statuses of a [`DirectRow`].
+pub const DIRECT_STATUSES: [&str; 5] = [
+    "both",
+    "grid_only",
+    "exact_only",
+    "neither",
+    "oracle_failed",
+];
+
 /// Compares the grid's first contacts at `positions` (mm; `(y0, z0)`,
 /// nodes of `grid`, which is in the direct frame) with `traces`
 /// (angle-major, one per position and angle of `footprints`).
@@ -283,6 +305,19 @@ pub fn compare_direct(
     traces: &[DirectTrace],
     e0: f64,
 ) -> Result<DirectComparison, HarnessError> {
+    let (pairs, grid_s) = direct_pairs(grid, footprints, positions, traces, e0)?;
+    Ok(assemble_direct(pairs, grid_s))
+}
+
+/// [`compare_direct`]'s pairs, angle-major, not yet assembled, and the
+/// seconds they took.
+pub fn direct_pairs(
+    grid: &HeightGrid,
+    footprints: &[DirectFootprint],
+    positions: &[[f64; 2]],
+    traces: &[DirectTrace],
+    e0: f64,
+) -> Result<(Vec<DirectPair>, f64), HarnessError> {
     let spec = grid.spec;
     if traces.len() != positions.len() * footprints.len() {
         return Err(HarnessError::TraceCount {
@@ -301,8 +336,7 @@ pub fn compare_direct(
         })
         .collect::<Result<Vec<_>, _>>()?;
     let t = Instant::now();
-    let mut rows = Vec::with_capacity(traces.len());
-    let mut counts = DirectCounts::default();
+    let mut pairs = Vec::with_capacity(traces.len());
     for (fp, traces) in footprints.iter().zip(traces.chunks(positions.len().max(1))) {
         let levels = contact_levels(grid, fp);
         for ((&node, &[y, z]), trace) in nodes.iter().zip(positions).zip(traces) {
@@ -312,9 +346,6 @@ pub fn compare_direct(
             // sums): a difference is counted and fails the comparison.
             let engine = levels[node.1 * spec.nx + node.0];
             let mine = grid_contact.as_ref().map_or(f64::INFINITY, |g| g.level);
-            if engine.to_bits() != mine.to_bits() {
-                counts.engine_mismatch += 1;
-            }
             let mut row = DirectRow {
                 y,
                 z,
@@ -329,29 +360,18 @@ pub fn compare_direct(
                 grid_contacted: grid_contact.as_ref().map_or(0, |g| g.contacted.len()),
                 exact_ties: 0,
             };
-            counts.compared += 1;
             row.status = match (&trace.status, &grid_contact) {
-                (DirectStatus::Failed(_), _) => {
-                    counts.oracle_failed += 1;
-                    "oracle_failed"
-                }
+                (DirectStatus::Failed(_), _) => "oracle_failed",
                 (DirectStatus::Clear, None) => "neither",
-                (DirectStatus::Clear, Some(_)) => {
-                    counts.grid_only += 1;
-                    "grid_only"
-                }
+                (DirectStatus::Clear, Some(_)) => "grid_only",
                 (DirectStatus::Contact(c), g) => {
                     row.exact_level = Some(c.level);
                     row.exact_y = Some(c.witness[1]);
                     row.exact_z = Some(c.witness[2]);
                     row.exact_ties = c.ties.len();
                     match g {
-                        None => {
-                            counts.exact_only += 1;
-                            "exact_only"
-                        }
+                        None => "exact_only",
                         Some(g) => {
-                            counts.both += 1;
                             row.level_error = Some((g.level + c.level).abs());
                             row.contact_distance = g
                                 .contacted
@@ -366,10 +386,36 @@ pub fn compare_direct(
                 }
             }
             .into();
-            rows.push(row);
+            pairs.push(DirectPair {
+                row,
+                engine_mismatch: engine.to_bits() != mine.to_bits(),
+            });
         }
     }
-    let grid_s = t.elapsed().as_secs_f64();
+    Ok((pairs, t.elapsed().as_secs_f64()))
+}
+
+/// The comparison of `pairs` (angle-major): their rows, counts and
+/// statistics, in their order; `grid_s` the seconds they took. A merge of
+/// shards assembles the pairs in the unsharded order with this function,
+/// as the unsharded study does.
+pub fn assemble_direct(pairs: Vec<DirectPair>, grid_s: f64) -> DirectComparison {
+    let mut counts = DirectCounts {
+        compared: pairs.len(),
+        ..DirectCounts::default()
+    };
+    let mut rows = Vec::with_capacity(pairs.len());
+    for pair in pairs {
+        counts.engine_mismatch += usize::from(pair.engine_mismatch);
+        match pair.row.status.as_str() {
+            "both" => counts.both += 1,
+            "grid_only" => counts.grid_only += 1,
+            "exact_only" => counts.exact_only += 1,
+            "oracle_failed" => counts.oracle_failed += 1,
+            _ => {}
+        }
+        rows.push(pair.row);
+    }
     let collect =
         |f: fn(&DirectRow) -> Option<f64>| -> Vec<f64> { rows.iter().filter_map(f).collect() };
     let stats = vec![
@@ -382,12 +428,12 @@ pub fn compare_direct(
             DirectStats::of(&collect(|r| r.contact_distance)),
         ),
     ];
-    Ok(DirectComparison {
+    DirectComparison {
         rows,
         stats,
         counts,
         grid_s,
-    })
+    }
 }
 
 /// The oracle's options for `knee` and rounding tolerance `e0` (mm).
@@ -449,17 +495,19 @@ impl DirectStudy {
         })
     }
 
-    /// The exact casts of the positions at `setup`'s angles.
+    /// The exact casts of `positions` (the study's, or a shard's share
+    /// of them) at `setup`'s angles.
     fn exact(
         &self,
         input: &PartFile,
         setup: &Setup,
+        positions: &[[f64; 2]],
         progress: &dyn Progress,
     ) -> Result<(Vec<DirectTrace>, f64), HarnessError> {
         progress.begin(
             &format!(
                 "exact oracle (direct): {} positions x {} angles",
-                self.positions.len(),
+                positions.len(),
                 setup.angles.len()
             ),
             None,
@@ -468,7 +516,7 @@ impl DirectStudy {
         let part = kneeform_oracle::Part::from_triangles(&input.part.triangles)?;
         let traces = kneeform_oracle::evaluate_direct(
             &part,
-            &self.positions,
+            positions,
             &setup.angles,
             &direct_oracle_options(&setup.knee, setup.rule.e0),
         );
@@ -551,6 +599,79 @@ fn starts_text(selection: &StartSelection) -> (String, u64) {
     }
 }
 
+/// The direct verification of `shard`'s share of the positions (all of
+/// them without a shard): the study, the share's pairs, the seconds of
+/// their grid side and of the oracle.
+fn verify_pairs(
+    input: &PartFile,
+    setup: &Setup,
+    options: &VerifyOptions,
+    shard: Option<Shard>,
+    progress: &dyn Progress,
+) -> Result<(DirectStudy, Vec<DirectPair>, f64, f64), HarnessError> {
+    setup.validate()?;
+    check_selection(&options.selection)?;
+    check_tolerance(options.tolerance)?;
+    let study = DirectStudy::new(input, setup, &options.selection)?;
+    let positions = share(&study.positions, shard)?;
+    let (traces, oracle_s) = study.exact(input, setup, &positions, progress)?;
+    let grid = HeightGrid::sample(&study.part.triangles, study.spec);
+    let (pairs, grid_s) = direct_pairs(
+        &grid,
+        &footprints(setup, setup.pitch),
+        &positions,
+        &traces,
+        setup.rule.e0,
+    )?;
+    Ok((study, pairs, grid_s, oracle_s))
+}
+
+impl DirectVerifySummary {
+    /// `verify.json` of `input`, `setup` and `options` before any
+    /// comparison: no pass, no statistics, no counts, no seconds
+    /// ([`DirectVerifySummary::set_comparison`] sets them).
+    fn new(input: &PartFile, setup: &Setup, options: &VerifyOptions) -> DirectVerifySummary {
+        let (starts, seed) = starts_text(&options.selection);
+        DirectVerifySummary {
+            approach: "direct".into(),
+            kneeform_version: env!("CARGO_PKG_VERSION").into(),
+            input_file: input.path.display().to_string(),
+            input_sha256: input.sha256.clone(),
+            scale: input.scale,
+            side: input.side,
+            frame: input.frame.record(),
+            pitch_mm: setup.pitch,
+            tolerance_mm: options.tolerance,
+            pass: false,
+            angles_deg: setup.angles.clone(),
+            knee_form_mm: [
+                setup.knee.triangle_side,
+                setup.knee.radius,
+                setup.knee.thickness,
+            ],
+            e0_mm: setup.rule.e0,
+            note: NOTE.into(),
+            starts,
+            seed,
+            metrics: std::collections::BTreeMap::new(),
+            counts: DirectCounts::default(),
+            grid_s: 0.0,
+            oracle_s: 0.0,
+        }
+    }
+
+    /// Sets what `comparison` decides (pass, statistics, counts, its grid
+    /// seconds) and the oracle's seconds: for the unsharded verification
+    /// and a merge of its shards alike.
+    pub fn set_comparison(&mut self, comparison: &DirectComparison, oracle_s: f64) {
+        self.pass = comparison.passes(self.tolerance_mm);
+        self.metrics = comparison.stats.iter().cloned().collect();
+        self.counts = comparison.counts;
+        self.grid_s = comparison.grid_s;
+        self.oracle_s = oracle_s;
+    }
+}
+
 /// Verifies the direct approach's grid first contacts against the exact
 /// casts at `setup`'s pitch; positions are `(y0, z0)` nodes of the grid.
 pub fn verify_direct(
@@ -559,49 +680,55 @@ pub fn verify_direct(
     options: &VerifyOptions,
     progress: &dyn Progress,
 ) -> Result<DirectVerification, HarnessError> {
-    setup.validate()?;
-    check_selection(&options.selection)?;
-    check_tolerance(options.tolerance)?;
-    let study = DirectStudy::new(input, setup, &options.selection)?;
-    let (traces, oracle_s) = study.exact(input, setup, progress)?;
-    let grid = HeightGrid::sample(&study.part.triangles, study.spec);
-    let comparison = compare_direct(
-        &grid,
-        &footprints(setup, setup.pitch),
-        &study.positions,
-        &traces,
-        setup.rule.e0,
-    )?;
-    let (starts, seed) = starts_text(&options.selection);
-    let summary = DirectVerifySummary {
-        approach: "direct".into(),
-        kneeform_version: env!("CARGO_PKG_VERSION").into(),
-        input_file: input.path.display().to_string(),
-        input_sha256: input.sha256.clone(),
-        scale: input.scale,
-        side: input.side,
-        frame: input.frame.record(),
-        pitch_mm: setup.pitch,
-        tolerance_mm: options.tolerance,
-        pass: comparison.passes(options.tolerance),
-        angles_deg: setup.angles.clone(),
-        knee_form_mm: [
-            setup.knee.triangle_side,
-            setup.knee.radius,
-            setup.knee.thickness,
-        ],
-        e0_mm: setup.rule.e0,
-        note: NOTE.into(),
-        starts,
-        seed,
-        metrics: comparison.stats.iter().cloned().collect(),
-        counts: comparison.counts,
-        grid_s: comparison.grid_s,
-        oracle_s,
-    };
+    let (_, pairs, grid_s, oracle_s) = verify_pairs(input, setup, options, None, progress)?;
+    let comparison = assemble_direct(pairs, grid_s);
+    let mut summary = DirectVerifySummary::new(input, setup, options);
+    summary.set_comparison(&comparison, oracle_s);
     Ok(DirectVerification {
         comparison,
         summary,
+    })
+}
+
+/// [`verify_direct`] of `shard`'s share of the positions only: the
+/// positions `s` (0-based, in the study's order, after sampling) with
+/// `s % N == K - 1`, the oracle run on those alone.
+pub fn verify_direct_shard(
+    input: &PartFile,
+    setup: &Setup,
+    options: &VerifyOptions,
+    shard: Shard,
+    progress: &dyn Progress,
+) -> Result<StudyPart, HarnessError> {
+    let (study, pairs, grid_s, oracle_s) =
+        verify_pairs(input, setup, options, Some(shard), progress)?;
+    // The study's identity and settings, the shard's own seconds; its
+    // statistics are the merge's.
+    let mut summary = DirectVerifySummary::new(input, setup, options);
+    summary.grid_s = grid_s;
+    summary.oracle_s = oracle_s;
+    Ok(StudyPart {
+        shard,
+        spec: study.spec,
+        pitches: vec![PitchPart {
+            pitch: setup.pitch,
+            pairs: Pairs::Direct(pairs),
+            band: NO_BAND,
+            grid_s,
+            seconds: 0.0,
+            nodes: study.spec.len(),
+        }],
+        starts: study.positions,
+        angles_deg: setup.angles.clone(),
+        settings: study_settings(
+            &options.selection,
+            options.tie_band_per_mm,
+            Some(options.tolerance),
+            vec![setup.pitch],
+        ),
+        summary: StudySummary::VerifyDirect(summary),
+        sample_s: 0.0,
+        oracle_s,
     })
 }
 
@@ -669,15 +796,48 @@ pub struct DirectConvergence {
     pub summary: DirectConvergeSummary,
 }
 
-/// The direct approach compared with the exact casts at every pitch of
-/// `options`, on the coarsest grid's positions (nodes of every finer grid,
-/// since the pitches nest); the oracle runs once.
-pub fn converge_direct(
+/// One pitch of a direct convergence study on some positions: its pairs,
+/// not yet assembled, and what was measured.
+struct DirectPitchPairs {
+    pitch: f64,
+    pairs: Vec<DirectPair>,
+    grid_s: f64,
+    nodes: usize,
+}
+
+impl DirectPitchPairs {
+    /// The pitch assembled: the unsharded study's.
+    fn assemble(self) -> DirectPitchResult {
+        DirectPitchResult {
+            pitch: self.pitch,
+            comparison: assemble_direct(self.pairs, self.grid_s),
+            nodes: self.nodes,
+        }
+    }
+
+    /// The pitch as a shard keeps it.
+    fn part(self) -> PitchPart {
+        PitchPart {
+            pitch: self.pitch,
+            pairs: Pairs::Direct(self.pairs),
+            band: NO_BAND,
+            grid_s: self.grid_s,
+            seconds: 0.0,
+            nodes: self.nodes,
+        }
+    }
+}
+
+/// The direct convergence study's pitches on `shard`'s share of the
+/// positions (all of them without a shard), coarsest first: the study,
+/// each pitch's pairs, and the oracle's seconds.
+fn converge_pairs(
     input: &PartFile,
     setup: &Setup,
     options: &ConvergeOptions,
+    shard: Option<Shard>,
     progress: &dyn Progress,
-) -> Result<DirectConvergence, HarnessError> {
+) -> Result<(DirectStudy, Vec<DirectPitchPairs>, f64), HarnessError> {
     options.validate()?;
     let pitches = &options.pitches;
     let coarse_setup = Setup {
@@ -694,8 +854,9 @@ pub fn converge_direct(
     for &p in pitches {
         setup.check_memory(&spec_at(p), study.part.triangles.len())?;
     }
-    let (traces, oracle_s) = study.exact(input, setup, progress)?;
-    let mut results = Vec::new();
+    let positions = share(&study.positions, shard)?;
+    let (traces, oracle_s) = study.exact(input, setup, &positions, progress)?;
+    let mut parts = Vec::new();
     for &p in pitches {
         let spec = spec_at(p);
         progress.begin(
@@ -703,66 +864,140 @@ pub fn converge_direct(
             None,
         );
         let grid = HeightGrid::sample(&study.part.triangles, spec);
-        let comparison = compare_direct(
+        let pairs = direct_pairs(
             &grid,
             &footprints(setup, p),
-            &study.positions,
+            &positions,
             &traces,
             setup.rule.e0,
         );
         progress.end();
-        results.push(DirectPitchResult {
+        let (pairs, grid_s) = pairs?;
+        parts.push(DirectPitchPairs {
             pitch: p,
-            comparison: comparison?,
+            pairs,
+            grid_s,
             nodes: spec.len(),
         });
     }
-    let fit = |pick: fn(&DirectStats) -> f64| -> std::collections::BTreeMap<String, Fit> {
-        DIRECT_METRICS
-            .iter()
-            .filter_map(|m| {
-                let points: Vec<(f64, f64)> = results
-                    .iter()
-                    .map(|r| (r.pitch, pick(&r.comparison.stat(m))))
-                    .collect();
-                fit_power_law(&points).map(|f| (m.to_string(), f))
-            })
-            .collect()
-    };
-    let recommended = options.tolerance.and_then(|t| {
-        results
-            .iter()
-            .filter(|r| r.comparison.passes(t))
-            .map(|r| r.pitch)
-            .max_by(f64::total_cmp)
-    });
-    let (_, seed) = starts_text(&options.selection);
-    let summary = DirectConvergeSummary {
-        approach: "direct".into(),
-        kneeform_version: env!("CARGO_PKG_VERSION").into(),
-        input_file: input.path.display().to_string(),
-        input_sha256: input.sha256.clone(),
-        scale: input.scale,
-        side: input.side,
-        frame: input.frame.record(),
-        knee_form_mm: [
-            setup.knee.triangle_side,
-            setup.knee.radius,
-            setup.knee.thickness,
-        ],
-        pitches_mm: pitches.clone(),
-        fits: fit(|s| s.max),
-        fits_median: fit(|s| s.median),
-        tolerance_mm: options.tolerance,
-        recommended_pitch_mm: recommended,
-        angles_deg: setup.angles.clone(),
-        e0_mm: setup.rule.e0,
-        note: NOTE.into(),
-        starts: study.positions.len(),
-        seed,
-        oracle_s,
-    };
+    Ok((study, parts, oracle_s))
+}
+
+impl DirectConvergeSummary {
+    /// `converge.json` of `input`, `setup` and `options` with `starts`
+    /// positions before any comparison: no fits, no recommended pitch
+    /// ([`DirectConvergeSummary::set_results`] sets them).
+    fn new(
+        input: &PartFile,
+        setup: &Setup,
+        options: &ConvergeOptions,
+        starts: usize,
+        oracle_s: f64,
+    ) -> DirectConvergeSummary {
+        let (_, seed) = starts_text(&options.selection);
+        DirectConvergeSummary {
+            approach: "direct".into(),
+            kneeform_version: env!("CARGO_PKG_VERSION").into(),
+            input_file: input.path.display().to_string(),
+            input_sha256: input.sha256.clone(),
+            scale: input.scale,
+            side: input.side,
+            frame: input.frame.record(),
+            knee_form_mm: [
+                setup.knee.triangle_side,
+                setup.knee.radius,
+                setup.knee.thickness,
+            ],
+            pitches_mm: options.pitches.clone(),
+            fits: std::collections::BTreeMap::new(),
+            fits_median: std::collections::BTreeMap::new(),
+            tolerance_mm: options.tolerance,
+            recommended_pitch_mm: None,
+            angles_deg: setup.angles.clone(),
+            e0_mm: setup.rule.e0,
+            note: NOTE.into(),
+            starts,
+            seed,
+            oracle_s,
+        }
+    }
+
+    /// Sets what `results` decide (the fits of the max and median errors,
+    /// the coarsest pitch within the tolerance): for the unsharded study
+    /// and a merge of its shards alike.
+    pub fn set_results(&mut self, results: &[DirectPitchResult]) {
+        let fit = |pick: fn(&DirectStats) -> f64| -> std::collections::BTreeMap<String, Fit> {
+            DIRECT_METRICS
+                .iter()
+                .filter_map(|m| {
+                    let points: Vec<(f64, f64)> = results
+                        .iter()
+                        .map(|r| (r.pitch, pick(&r.comparison.stat(m))))
+                        .collect();
+                    fit_power_law(&points).map(|f| (m.to_string(), f))
+                })
+                .collect()
+        };
+        self.fits = fit(|s| s.max);
+        self.fits_median = fit(|s| s.median);
+        self.recommended_pitch_mm = self.tolerance_mm.and_then(|t| {
+            results
+                .iter()
+                .filter(|r| r.comparison.passes(t))
+                .map(|r| r.pitch)
+                .max_by(f64::total_cmp)
+        });
+    }
+}
+
+/// The direct approach compared with the exact casts at every pitch of
+/// `options`, on the coarsest grid's positions (nodes of every finer grid,
+/// since the pitches nest); the oracle runs once.
+pub fn converge_direct(
+    input: &PartFile,
+    setup: &Setup,
+    options: &ConvergeOptions,
+    progress: &dyn Progress,
+) -> Result<DirectConvergence, HarnessError> {
+    let (study, parts, oracle_s) = converge_pairs(input, setup, options, None, progress)?;
+    let results: Vec<DirectPitchResult> =
+        parts.into_iter().map(DirectPitchPairs::assemble).collect();
+    let mut summary =
+        DirectConvergeSummary::new(input, setup, options, study.positions.len(), oracle_s);
+    summary.set_results(&results);
     Ok(DirectConvergence { results, summary })
+}
+
+/// [`converge_direct`] of `shard`'s share of the positions only (as
+/// [`verify_direct_shard`]), every pitch compared on the share.
+pub fn converge_direct_shard(
+    input: &PartFile,
+    setup: &Setup,
+    options: &ConvergeOptions,
+    shard: Shard,
+    progress: &dyn Progress,
+) -> Result<StudyPart, HarnessError> {
+    let (study, pitches, oracle_s) = converge_pairs(input, setup, options, Some(shard), progress)?;
+    // The study's identity and settings, the shard's own oracle seconds;
+    // its fits are the merge's.
+    let summary =
+        DirectConvergeSummary::new(input, setup, options, study.positions.len(), oracle_s);
+    Ok(StudyPart {
+        shard,
+        spec: study.spec,
+        starts: study.positions,
+        angles_deg: setup.angles.clone(),
+        pitches: pitches.into_iter().map(DirectPitchPairs::part).collect(),
+        settings: study_settings(
+            &options.selection,
+            options.tie_band_per_mm,
+            options.tolerance,
+            options.pitches.clone(),
+        ),
+        summary: StudySummary::ConvergeDirect(summary),
+        sample_s: 0.0,
+        oracle_s,
+    })
 }
 
 #[cfg(test)]

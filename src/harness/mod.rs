@@ -44,13 +44,14 @@ pub use compare::{
 };
 pub use converge::{ConvergeOptions, ConvergeSummary, Convergence, PitchResult, converge};
 pub use direct::{
-    DIRECT_METRICS, DirectComparison, DirectConvergence, DirectRow, DirectStats,
-    DirectVerification, converge_direct, verify_direct,
+    DIRECT_METRICS, DIRECT_STATUSES, DirectComparison, DirectConvergeSummary, DirectConvergence,
+    DirectCounts, DirectPair, DirectRow, DirectStats, DirectVerification, DirectVerifySummary,
+    converge_direct, converge_direct_shard, verify_direct, verify_direct_shard,
 };
 pub use metrics::{DECIDED_METRICS, METRICS, Stats, TieBand};
 pub use sharded::{
-    StudyPart, StudySettings, StudySummary, converge_shard, merge_converge, merge_verify,
-    verify_shard,
+    Pairs, StudyPart, StudySettings, StudySummary, converge_shard, merge_converge,
+    merge_converge_direct, merge_verify, merge_verify_direct, verify_shard,
 };
 pub use trace::{GridContact, GridTrace};
 pub use verify::{

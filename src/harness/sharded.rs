@@ -3,26 +3,35 @@
 //! study's order, after sampling) with `s % N == K - 1`, since the exact
 //! oracle of each start and angle is the expensive part; [`merge_verify`]
 //! and [`merge_converge`] put the N shares back together into the study
-//! the unsharded command computes.
+//! the unsharded command computes. The direct approach's studies
+//! (`--approach direct`, [`super::direct`]) fan out over their positions
+//! alike ([`super::verify_direct_shard`], [`super::converge_direct_shard`];
+//! [`merge_verify_direct`], [`merge_converge_direct`]).
 //!
 //! A share ([`StudyPart`]) keeps every start-angle pair it compared as a
-//! [`PairResult`]: a comparison's statistics, counts, area distances and
-//! worst starts are computed from those alone ([`assemble`]), so a merge
-//! that puts the pairs back in the unsharded order computes them exactly
-//! as the unsharded run does. The file format of a share is
-//! [`crate::shard::study`]'s.
+//! [`PairResult`] (the direct approach's position-angle pairs as a
+//! [`DirectPair`]): a comparison's statistics, counts, area distances and
+//! worst starts are computed from those alone ([`assemble`],
+//! [`assemble_direct`]), so a merge that puts the pairs back in the
+//! unsharded order computes them exactly as the unsharded run does. The
+//! file format of a share is [`crate::shard::study`]'s.
 //!
-//! **Invariant:** a merged comparison is [`assemble`]d from the pairs in
-//! the unsharded run's order (angle-major, then the study's start order),
+//! **Invariant:** a merged comparison is assembled from the pairs in the
+//! unsharded run's order (angle-major, then the study's start order),
 //! and its summary is set by the same function as the unsharded run's
-//! ([`VerifySummary::set_comparison`], [`ConvergeSummary::set_results`]);
-//! only clock readings differ.
+//! ([`VerifySummary::set_comparison`], [`ConvergeSummary::set_results`],
+//! [`DirectVerifySummary::set_comparison`],
+//! [`DirectConvergeSummary::set_results`]); only clock readings differ.
 
 use std::time::Instant;
 
 use super::HarnessError;
 use super::compare::{CompareOptions, PairResult, StartSelection, assemble, pair_results};
 use super::converge::{ConvergeOptions, ConvergeSummary, Convergence, Ladder, PitchResult};
+use super::direct::{
+    DirectConvergeSummary, DirectConvergence, DirectPair, DirectPitchResult, DirectVerification,
+    DirectVerifySummary, assemble_direct,
+};
 use super::metrics::TieBand;
 use super::verify::{
     Verification, VerifyOptions, VerifySummary, oracle_options, run_oracle, start_positions,
@@ -32,6 +41,34 @@ use crate::grid::{GridSpec, HeightGrid};
 use crate::mesh::PartFile;
 use crate::shard::Shard;
 
+/// The pairs of one pitch of a share, angle-major over the share's starts.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Pairs {
+    /// Push-and-slide's start-angle pairs.
+    Slide(Vec<PairResult>),
+    /// The direct approach's position-angle pairs.
+    Direct(Vec<DirectPair>),
+}
+
+impl Pairs {
+    /// How many pairs.
+    pub fn len(&self) -> usize {
+        match self {
+            Pairs::Slide(p) => p.len(),
+            Pairs::Direct(p) => p.len(),
+        }
+    }
+
+    /// Whether there is none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// The tie band of a direct study's pitch, which has none (the knee does
+/// not slide): zero.
+pub(super) const NO_BAND: TieBand = TieBand { sigma: 0.0, m: 0.0 };
+
 /// One pitch of a share: its start-angle pairs, angle-major over the
 /// share's starts, and what was timed.
 #[derive(Debug, Clone, PartialEq)]
@@ -39,8 +76,8 @@ pub struct PitchPart {
     /// The pitch (mm).
     pub pitch: f64,
     /// The pairs compared, angle-major over the share's starts.
-    pub pairs: Vec<PairResult>,
-    /// The tie band at this pitch.
+    pub pairs: Pairs,
+    /// The tie band at this pitch (zero for the direct approach).
     pub band: TieBand,
     /// Seconds on the grid side of the comparison.
     pub grid_s: f64,
@@ -62,6 +99,12 @@ pub enum StudySummary {
     Verify(VerifySummary),
     /// A convergence study's.
     Converge(ConvergeSummary),
+    /// A direct verification's (`verify --approach direct`).
+    #[serde(rename = "verify-direct")]
+    VerifyDirect(DirectVerifySummary),
+    /// A direct convergence study's (`converge --approach direct`).
+    #[serde(rename = "converge-direct")]
+    ConvergeDirect(DirectConvergeSummary),
 }
 
 /// The options of a sharded study as given, beyond its summary: what
@@ -98,7 +141,8 @@ pub struct StudyPart {
     pub settings: StudySettings,
     /// The study's summary as the shard knows it ([`StudySummary`]).
     pub summary: StudySummary,
-    /// Seconds sampling the grid.
+    /// Seconds sampling the grid (0 for the direct approach, whose
+    /// summaries do not report it).
     pub sample_s: f64,
     /// Seconds of the oracle on the share's starts.
     pub oracle_s: f64,
@@ -123,14 +167,21 @@ pub(super) fn share(all: &[[f64; 2]], shard: Option<Shard>) -> Result<Vec<[f64; 
         .collect())
 }
 
-fn settings(selection: &StartSelection, tie_band_per_mm: f64) -> StudySettings {
+/// A study's [`StudySettings`]: `selection` as given, its tie band,
+/// tolerance and pitches.
+pub(super) fn study_settings(
+    selection: &StartSelection,
+    tie_band_per_mm: f64,
+    tolerance_mm: Option<f64>,
+    pitches_mm: Vec<f64>,
+) -> StudySettings {
     let (starts, seed) = super::verify::selection_words(selection);
     StudySettings {
         starts,
         seed,
         tie_band_per_mm,
-        tolerance_mm: None,
-        pitches_mm: Vec::new(),
+        tolerance_mm,
+        pitches_mm,
     }
 }
 
@@ -178,17 +229,18 @@ pub fn verify_shard(
         angles_deg: setup.angles.clone(),
         pitches: vec![PitchPart {
             pitch: spec.pitch,
-            pairs,
+            pairs: Pairs::Slide(pairs),
             band,
             grid_s,
             seconds: 0.0,
             nodes: spec.len(),
         }],
-        settings: StudySettings {
-            tolerance_mm: Some(options.tolerance),
-            pitches_mm: vec![setup.pitch],
-            ..settings(&options.selection, options.tie_band_per_mm)
-        },
+        settings: study_settings(
+            &options.selection,
+            options.tie_band_per_mm,
+            Some(options.tolerance),
+            vec![setup.pitch],
+        ),
         summary: StudySummary::Verify(summary),
         sample_s,
         oracle_s,
@@ -229,7 +281,7 @@ pub fn converge_shard(
     }
     let mut parts = Vec::new();
     for &p in pitches {
-        parts.push(ladder.measure_pairs(p, progress)?.0);
+        parts.push(ladder.measure_pairs(p, progress)?);
     }
     // The study's identity and settings; its fits are the merge's.
     let summary = ConvergeSummary::new(input, setup, options, ladder.all_starts.len(), &[]);
@@ -239,57 +291,99 @@ pub fn converge_shard(
         starts: ladder.all_starts.clone(),
         angles_deg: setup.angles.clone(),
         pitches: parts,
-        settings: StudySettings {
-            tolerance_mm: options.tolerance,
-            pitches_mm: pitches.clone(),
-            ..settings(&options.selection, options.tie_band_per_mm)
-        },
+        settings: study_settings(
+            &options.selection,
+            options.tie_band_per_mm,
+            options.tolerance,
+            pitches.clone(),
+        ),
         summary: StudySummary::Converge(summary),
         sample_s,
         oracle_s: ladder.oracle_s,
     })
 }
 
-fn pitch_result(part: &PitchPart, pairs: Vec<PairResult>, angles: &[f64]) -> PitchResult {
-    PitchResult {
-        pitch: part.pitch,
-        comparison: assemble(pairs, angles, part.band, part.grid_s),
-        seconds: part.seconds,
-        nodes: part.nodes,
-    }
-}
-
 /// The pairs of pitch `k` of `parts` (every shard of one study exactly
 /// once, in shard order: `parts[K - 1]` is shard K's) in the unsharded
-/// order: angle-major, then the study's start order.
-fn unsharded_pairs(parts: &[StudyPart], k: usize) -> Vec<PairResult> {
+/// order: angle-major, then the study's start order. `pick` gives a
+/// share's pairs of the study's kind (`None` for another kind, which
+/// makes the merge `None`).
+fn unsharded_pairs<T: Clone>(
+    parts: &[StudyPart],
+    k: usize,
+    pick: impl Fn(&Pairs) -> Option<&[T]>,
+) -> Option<Vec<T>> {
     let first = &parts[0];
     let (n, total) = (parts.len(), first.starts.len());
-    let shares: Vec<usize> = parts.iter().map(|p| p.shard.indices(total).len()).collect();
+    let shares = parts
+        .iter()
+        .map(|p| pick(&p.pitches.get(k)?.pairs))
+        .collect::<Option<Vec<&[T]>>>()?;
+    let sizes: Vec<usize> = parts.iter().map(|p| p.shard.indices(total).len()).collect();
     let mut out = Vec::with_capacity(total * first.angles_deg.len());
     for a in 0..first.angles_deg.len() {
         for s in 0..total {
-            let pairs = &parts[s % n].pitches[k].pairs;
-            out.push(pairs[a * shares[s % n] + s / n].clone());
+            out.push(shares[s % n].get(a * sizes[s % n] + s / n)?.clone());
         }
     }
-    out
+    Some(out)
 }
 
-/// Pitch `k` of the study `parts` merged: its pairs in the unsharded
-/// order, assembled; grid seconds summed over the shards, the engine's
-/// seconds (which every shard measures alike) their longest.
-fn merged_pitch(parts: &[StudyPart], k: usize) -> PitchResult {
+fn slide(pairs: &Pairs) -> Option<&[PairResult]> {
+    match pairs {
+        Pairs::Slide(p) => Some(p),
+        Pairs::Direct(_) => None,
+    }
+}
+
+fn direct(pairs: &Pairs) -> Option<&[DirectPair]> {
+    match pairs {
+        Pairs::Direct(p) => Some(p),
+        Pairs::Slide(_) => None,
+    }
+}
+
+/// Grid seconds of pitch `k` summed over the shards, the engine's seconds
+/// (which every shard measures alike) their longest.
+fn merged_clocks(parts: &[StudyPart], k: usize) -> PitchPart {
     let first = &parts[0].pitches[k];
-    let merged = PitchPart {
+    PitchPart {
         grid_s: parts.iter().map(|p| p.pitches[k].grid_s).sum(),
         seconds: parts
             .iter()
             .map(|p| p.pitches[k].seconds)
             .fold(0.0, f64::max),
         ..first.clone()
-    };
-    pitch_result(&merged, unsharded_pairs(parts, k), &parts[0].angles_deg)
+    }
+}
+
+/// Pitch `k` of the study `parts` merged: its pairs in the unsharded
+/// order, assembled, with [`merged_clocks`].
+fn merged_pitch(parts: &[StudyPart], k: usize) -> Option<PitchResult> {
+    let merged = merged_clocks(parts, k);
+    let pairs = unsharded_pairs(parts, k, slide)?;
+    Some(PitchResult {
+        pitch: merged.pitch,
+        comparison: assemble(pairs, &parts[0].angles_deg, merged.band, merged.grid_s),
+        seconds: merged.seconds,
+        nodes: merged.nodes,
+    })
+}
+
+/// Pitch `k` of the direct study `parts` merged (as [`merged_pitch`]).
+fn merged_direct_pitch(parts: &[StudyPart], k: usize) -> Option<DirectPitchResult> {
+    let merged = merged_clocks(parts, k);
+    let pairs = unsharded_pairs(parts, k, direct)?;
+    Some(DirectPitchResult {
+        pitch: merged.pitch,
+        comparison: assemble_direct(pairs, merged.grid_s),
+        nodes: merged.nodes,
+    })
+}
+
+/// The oracle's seconds summed over the shards.
+fn oracle_s(parts: &[StudyPart]) -> f64 {
+    parts.iter().map(|p| p.oracle_s).sum()
 }
 
 /// The verification of the shares `parts`: every shard of one study
@@ -300,12 +394,12 @@ pub fn merge_verify(parts: &[StudyPart]) -> Option<Verification> {
     let StudySummary::Verify(summary) = &first.summary else {
         return None;
     };
-    let result = merged_pitch(parts, 0);
+    let result = merged_pitch(parts, 0)?;
     let mut summary = summary.clone();
     summary.set_comparison(&result.comparison, &first.spec);
     let t = &mut summary.timings;
     t.sample_s = parts.iter().map(|p| p.sample_s).fold(0.0, f64::max);
-    t.oracle_s = parts.iter().map(|p| p.oracle_s).sum();
+    t.oracle_s = oracle_s(parts);
     Some(Verification {
         comparison: result.comparison,
         summary,
@@ -318,15 +412,46 @@ pub fn merge_converge(parts: &[StudyPart]) -> Option<Convergence> {
     let StudySummary::Converge(summary) = &first.summary else {
         return None;
     };
-    let results: Vec<PitchResult> = (0..first.pitches.len())
+    let results = (0..first.pitches.len())
         .map(|k| merged_pitch(parts, k))
-        .collect();
+        .collect::<Option<Vec<PitchResult>>>()?;
     let mut summary = summary.clone();
     summary.set_results(&results);
     Some(Convergence {
         fits: super::converge::fits(&results),
         results,
         summary,
-        oracle_s: parts.iter().map(|p| p.oracle_s).sum(),
+        oracle_s: oracle_s(parts),
     })
+}
+
+/// The direct verification of the shares `parts` (as [`merge_verify`]).
+pub fn merge_verify_direct(parts: &[StudyPart]) -> Option<DirectVerification> {
+    let first = parts.first()?;
+    let StudySummary::VerifyDirect(summary) = &first.summary else {
+        return None;
+    };
+    let comparison = merged_direct_pitch(parts, 0)?.comparison;
+    let mut summary = summary.clone();
+    summary.set_comparison(&comparison, oracle_s(parts));
+    Some(DirectVerification {
+        comparison,
+        summary,
+    })
+}
+
+/// The direct convergence study of the shares `parts` (as
+/// [`merge_verify`]).
+pub fn merge_converge_direct(parts: &[StudyPart]) -> Option<DirectConvergence> {
+    let first = parts.first()?;
+    let StudySummary::ConvergeDirect(summary) = &first.summary else {
+        return None;
+    };
+    let results = (0..first.pitches.len())
+        .map(|k| merged_direct_pitch(parts, k))
+        .collect::<Option<Vec<DirectPitchResult>>>()?;
+    let mut summary = summary.clone();
+    summary.oracle_s = oracle_s(parts);
+    summary.set_results(&results);
+    Some(DirectConvergence { results, summary })
 }

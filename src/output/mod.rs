@@ -43,8 +43,8 @@ pub use self::png::{
 };
 pub use self::results::{
     RunResults, WriteOptions, write_analysis, write_convergence, write_convergence_files,
-    write_direct_convergence, write_direct_verification, write_results, write_verification,
-    write_verification_files,
+    write_direct_convergence, write_direct_convergence_files, write_direct_verification,
+    write_direct_verification_files, write_results, write_verification, write_verification_files,
 };
 pub(crate) use self::stl::to_stl_triangle;
 pub use self::stl::write_colliding_area;

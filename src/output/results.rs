@@ -230,9 +230,18 @@ pub fn write_direct_verification(
     verification: &DirectVerification,
 ) -> Result<(), WriteError> {
     let out = stage(dir)?;
-    write_rows(&out.path("verify.csv"), &verification.comparison.rows)?;
-    write_json(&out.path("verify.json"), &verification.summary)?;
+    write_direct_verification_files(&out, verification)?;
     commit(out, dir)
+}
+
+/// Writes [`write_direct_verification`]'s files into the staged directory
+/// `out` (`kneeform merge` of a direct verification's shards).
+pub fn write_direct_verification_files(
+    out: &OutputDir,
+    verification: &DirectVerification,
+) -> Result<(), WriteError> {
+    write_rows(&out.path("verify.csv"), &verification.comparison.rows)?;
+    write_json(&out.path("verify.json"), &verification.summary)
 }
 
 /// Writes a direct convergence study into `dir`: `converge.csv` (both
@@ -243,6 +252,16 @@ pub fn write_direct_convergence(
     convergence: &DirectConvergence,
 ) -> Result<(), WriteError> {
     let out = stage(dir)?;
+    write_direct_convergence_files(&out, convergence)?;
+    commit(out, dir)
+}
+
+/// Writes [`write_direct_convergence`]'s files into the staged directory
+/// `out` (`kneeform merge` of a direct convergence study's shards).
+pub fn write_direct_convergence_files(
+    out: &OutputDir,
+    convergence: &DirectConvergence,
+) -> Result<(), WriteError> {
     let tolerance = convergence.summary.tolerance_mm;
     let path = out.path("converge.csv");
     (|| -> csv::Result<()> {
@@ -295,8 +314,7 @@ pub fn write_direct_convergence(
             &r.comparison.rows,
         )?;
     }
-    write_json(&out.path("converge.json"), &convergence.summary)?;
-    commit(out, dir)
+    write_json(&out.path("converge.json"), &convergence.summary)
 }
 
 /// Writes `blind_spots.csv`: one row per blind spot ([`crate::blind`]),

@@ -2,13 +2,16 @@
 //! ([`super::study`]): lengths and counts as u64, every f64 as its bits
 //! (infinities, NaN and -0.0 read back as written), and a start-angle
 //! pair as its status, node, metric values and points ([`put_pair`],
-//! [`Reader::pair`]).
+//! [`Reader::pair`]); a direct study's position-angle pair as its row's
+//! status, values and counts ([`put_direct_pair`],
+//! [`Reader::direct_pair`]).
 //!
 //! **Invariant:** reading is bounds-checked: a cut or damaged file is an
 //! error, never a panic, and a count larger than the bytes left allocates
 //! nothing.
 
 use crate::harness::compare::{PairResult, STATUSES, row_of};
+use crate::harness::direct::{DIRECT_STATUSES, DirectPair, DirectRow};
 use crate::harness::metrics::{StartComparison, StartPoints};
 
 pub(super) fn put_u64(out: &mut Vec<u8>, v: u64) {
@@ -86,6 +89,31 @@ pub(super) fn put_pair(out: &mut Vec<u8>, pair: &PairResult) {
     put_nodes(out, &pair.snapped);
 }
 
+/// One direct pair: its row's status, levels, contact and counts, and
+/// whether the engine's level differed; the position and angle are the
+/// shard's (the reader is given them, as [`Reader::direct_pair`]).
+pub(super) fn put_direct_pair(out: &mut Vec<u8>, pair: &DirectPair) {
+    let r = &pair.row;
+    let status = DIRECT_STATUSES
+        .iter()
+        .position(|s| *s == r.status)
+        .unwrap_or(DIRECT_STATUSES.len());
+    out.push(status as u8);
+    for v in [
+        r.grid_level,
+        r.exact_level,
+        r.level_error,
+        r.exact_y,
+        r.exact_z,
+        r.contact_distance,
+    ] {
+        put_opt(out, v);
+    }
+    put_u64(out, r.grid_contacted as u64);
+    put_u64(out, r.exact_ties as u64);
+    out.push(u8::from(pair.engine_mismatch));
+}
+
 /// Reads `shard.bin`; every read checks the bytes left, and a length
 /// never exceeds them (a damaged length cannot make a huge allocation).
 pub(super) struct Reader<'a> {
@@ -161,6 +189,44 @@ impl<'a> Reader<'a> {
     pub(super) fn nodes(&mut self) -> Result<Vec<(usize, usize)>, String> {
         let n = self.count(16)?;
         (0..n).map(|_| Ok((self.len()?, self.len()?))).collect()
+    }
+
+    /// A direct pair ([`put_direct_pair`]) of the position `[y, z]` at
+    /// `angle_deg`.
+    pub(super) fn direct_pair(
+        &mut self,
+        [y, z]: [f64; 2],
+        angle_deg: f64,
+    ) -> Result<DirectPair, String> {
+        let status = self.u8()?;
+        let status = DIRECT_STATUSES
+            .get(usize::from(status))
+            .ok_or(format!("a direct status {status}"))?;
+        let mut row = DirectRow {
+            y,
+            z,
+            angle_deg,
+            status: (*status).into(),
+            grid_level: self.opt()?,
+            exact_level: self.opt()?,
+            level_error: self.opt()?,
+            exact_y: self.opt()?,
+            exact_z: self.opt()?,
+            contact_distance: self.opt()?,
+            grid_contacted: 0,
+            exact_ties: 0,
+        };
+        row.grid_contacted = self.len()?;
+        row.exact_ties = self.len()?;
+        let engine_mismatch = match self.u8()? {
+            0 => false,
+            1 => true,
+            b => return Err(format!("an engine mismatch flag {b}")),
+        };
+        Ok(DirectPair {
+            row,
+            engine_mismatch,
+        })
     }
 
     pub(super) fn pair(&mut self, angle_deg: f64) -> Result<PairResult, String> {
@@ -274,5 +340,59 @@ mod tests {
         let mut bad = bin.clone();
         bad[0] = STATUSES.len() as u8;
         assert!(Reader { bin: &bad, at: 0 }.pair(0.0).is_err());
+    }
+
+    #[test]
+    fn a_direct_pair_reads_back_bit_for_bit_and_a_cut_one_is_an_error() {
+        let p = DirectPair {
+            row: DirectRow {
+                y: 12.0,
+                z: -4.0,
+                angle_deg: 30.0,
+                status: "both".into(),
+                grid_level: Some(-0.0),
+                exact_level: Some(0.1 + 0.2),
+                level_error: Some(f64::MIN_POSITIVE),
+                exact_y: Some(11.5),
+                exact_z: None,
+                contact_distance: Some(f64::INFINITY),
+                grid_contacted: 7,
+                exact_ties: 2,
+            },
+            engine_mismatch: true,
+        };
+        let mut bin = Vec::new();
+        put_direct_pair(&mut bin, &p);
+        let mut r = Reader { bin: &bin, at: 0 };
+        let back = r.direct_pair([12.0, -4.0], 30.0).unwrap();
+        assert_eq!(r.at, bin.len());
+        assert_eq!(back, p);
+        // PartialEq on f64 would take -0.0 for 0.0: compare the bits too.
+        assert_eq!(
+            back.row.grid_level.map(f64::to_bits),
+            Some((-0.0f64).to_bits())
+        );
+        for end in 0..bin.len() {
+            let mut r = Reader {
+                bin: &bin[..end],
+                at: 0,
+            };
+            assert!(r.direct_pair([0.0, 0.0], 0.0).is_err(), "cut at {end}");
+        }
+        // An unknown status, an unknown flag.
+        let mut bad = bin.clone();
+        bad[0] = DIRECT_STATUSES.len() as u8;
+        assert!(
+            Reader { bin: &bad, at: 0 }
+                .direct_pair([0.0, 0.0], 0.0)
+                .is_err()
+        );
+        let mut bad = bin.clone();
+        *bad.last_mut().unwrap() = 2;
+        assert!(
+            Reader { bin: &bad, at: 0 }
+                .direct_pair([0.0, 0.0], 0.0)
+                .is_err()
+        );
     }
 }

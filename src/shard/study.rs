@@ -1,13 +1,17 @@
 //! The files of a study's shard: `verify --shard K/N` and `converge
-//! --shard K/N` write one [`crate::harness::StudyPart`] as `shard.json`
-//! and `shard.bin`; [`merge_study`] reads N of them, checks that they are
-//! every shard of one study exactly once, and merges them
-//! ([`crate::harness::merge_verify`], [`crate::harness::merge_converge`]).
+//! --shard K/N` (with `--approach direct` too) write one
+//! [`crate::harness::StudyPart`] as `shard.json` and `shard.bin`;
+//! [`merge_study`] reads N of them, checks that they are every shard of
+//! one study exactly once, and merges them
+//! ([`crate::harness::merge_verify`], [`crate::harness::merge_converge`],
+//! [`crate::harness::merge_verify_direct`],
+//! [`crate::harness::merge_converge_direct`]).
 //!
 //! * `shard.json` ([`StudyRecord`]): which shard of how many, the study's
 //!   start count and this shard's start indices, the options
 //!   ([`StudySettings`]), the study's `verify.json` or `converge.json` as
-//!   the shard knows it (`"study": {"kind": "verify", "summary": ...}`:
+//!   the shard knows it (`"study": {"kind": "verify", "summary": ...}`;
+//!   kinds `verify`, `converge`, `verify-direct`, `converge-direct`:
 //!   the part's SHA-256, every parameter and the shard's own timings; no
 //!   statistics, fits or verdict, which are the merge's),
 //!   its clock readings, and the SHA-256 of `shard.bin` and of its common
@@ -17,7 +21,9 @@
 //!   pitch its tie band and timings and, per start-angle pair of the
 //!   shard (angle-major), the pair's status, node, every metric value and
 //!   point its comparison holds, the grid's colliding nodes and the exact
-//!   strikes snapped to nodes: all a comparison is assembled from.
+//!   strikes snapped to nodes: all a comparison is assembled from (a
+//!   direct study's: its row's status, levels, contact and counts, and
+//!   whether the engine's level differed; its tie band is zero).
 //!
 //! Every value is stored as its bits, so a merge sees exactly what the
 //! shard computed.
@@ -26,13 +32,15 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::codec::{Reader, put_f64, put_f64s, put_pair, put_points, put_u64};
+use super::codec::{Reader, put_direct_pair, put_f64, put_f64s, put_pair, put_points, put_u64};
 use super::{Shard, ShardError, check_set, first_difference, hex_sha256};
 use crate::grid::GridSpec;
 use crate::harness::metrics::TieBand;
 use crate::harness::sharded::PitchPart;
 use crate::harness::{
-    Convergence, StudyPart, StudySettings, StudySummary, Verification, merge_converge, merge_verify,
+    Convergence, DirectConvergence, DirectVerification, Pairs, StudyPart, StudySettings,
+    StudySummary, Verification, merge_converge, merge_converge_direct, merge_verify,
+    merge_verify_direct,
 };
 use crate::output::{OutputDir, WriteError};
 
@@ -77,6 +85,10 @@ pub enum MergedStudy {
     Verify(Box<Verification>),
     /// `converge`'s.
     Converge(Box<Convergence>),
+    /// `verify --approach direct`'s.
+    VerifyDirect(Box<DirectVerification>),
+    /// `converge --approach direct`'s.
+    ConvergeDirect(Box<DirectConvergence>),
 }
 
 /// Writes `part` as its shard: `shard.json` and `shard.bin` in the staged
@@ -100,8 +112,11 @@ pub fn write_study_shard(out: &OutputDir, part: &StudyPart) -> Result<(), WriteE
         }
         put_u64(&mut bin, p.nodes as u64);
         put_u64(&mut bin, p.pairs.len() as u64);
-        for pair in &p.pairs {
-            put_pair(&mut bin, pair);
+        match &p.pairs {
+            Pairs::Slide(pairs) => pairs.iter().for_each(|pair| put_pair(&mut bin, pair)),
+            Pairs::Direct(pairs) => pairs
+                .iter()
+                .for_each(|pair| put_direct_pair(&mut bin, pair)),
         }
     }
     let record = StudyRecord {
@@ -133,6 +148,11 @@ pub enum ShardKind {
     Verify,
     /// A convergence study's (`converge --shard`).
     Converge,
+    /// A direct verification's (`verify --approach direct --shard`).
+    VerifyDirect,
+    /// A direct convergence study's (`converge --approach direct
+    /// --shard`).
+    ConvergeDirect,
 }
 
 impl std::fmt::Display for ShardKind {
@@ -141,6 +161,12 @@ impl std::fmt::Display for ShardKind {
             ShardKind::Analysis => "an analysis (analyze --shard)",
             ShardKind::Verify => "a verification (verify --shard)",
             ShardKind::Converge => "a convergence study (converge --shard)",
+            ShardKind::VerifyDirect => {
+                "a direct-approach verification (verify --approach direct --shard)"
+            }
+            ShardKind::ConvergeDirect => {
+                "a direct-approach convergence study (converge --approach direct --shard)"
+            }
         })
     }
 }
@@ -164,6 +190,8 @@ pub fn shard_kind(dir: &Path) -> Result<ShardKind, ShardError> {
         None => Ok(ShardKind::Analysis),
         Some(Some(k)) if k == "verify" => Ok(ShardKind::Verify),
         Some(Some(k)) if k == "converge" => Ok(ShardKind::Converge),
+        Some(Some(k)) if k == "verify-direct" => Ok(ShardKind::VerifyDirect),
+        Some(Some(k)) if k == "converge-direct" => Ok(ShardKind::ConvergeDirect),
         Some(k) => Err(ShardError::Corrupt {
             path,
             reason: format!("a study of unknown kind {k:?}"),
@@ -214,6 +242,12 @@ pub fn merge_study(dirs: &[PathBuf]) -> Result<MergedStudy, ShardError> {
         StudySummary::Converge(_) => {
             merge_converge(&parts).map(|c| MergedStudy::Converge(Box::new(c)))
         }
+        StudySummary::VerifyDirect(_) => {
+            merge_verify_direct(&parts).map(|v| MergedStudy::VerifyDirect(Box::new(v)))
+        }
+        StudySummary::ConvergeDirect(_) => {
+            merge_converge_direct(&parts).map(|c| MergedStudy::ConvergeDirect(Box::new(c)))
+        }
     };
     merged.ok_or_else(|| ShardError::Mismatch("the shards hold no study".into()))
 }
@@ -240,6 +274,8 @@ fn merged_keys(study: &StudySummary) -> &'static [&'static str] {
             "predicted_full_time_s",
             "seconds",
         ],
+        StudySummary::VerifyDirect(_) => &["pass", "metrics", "counts"],
+        StudySummary::ConvergeDirect(_) => &["fits", "fits_median", "recommended_pitch_mm"],
     }
 }
 
@@ -279,6 +315,16 @@ fn from_json(text: &[u8]) -> Result<StudyRecord, String> {
             "predicted_full_time_s": null,
             "seconds": [],
         }),
+        Some("verify-direct") => serde_json::json!({
+            "pass": false,
+            "metrics": {},
+            "counts": crate::harness::DirectCounts::default(),
+        }),
+        Some("converge-direct") => serde_json::json!({
+            "fits": {},
+            "fits_median": {},
+            "recommended_pitch_mm": null,
+        }),
         _ => serde_json::json!({}),
     };
     if let (Some(summary), Some(neutral)) = (
@@ -298,9 +344,13 @@ fn from_json(text: &[u8]) -> Result<StudyRecord, String> {
 fn identity(record: &StudyRecord) -> serde_json::Value {
     let mut v = serde_json::to_value(record).unwrap_or_default();
     let mut derived = merged_keys(&record.study).to_vec();
-    if let StudySummary::Verify(_) = record.study {
-        derived.push("timings");
-    }
+    // The shard's own clock readings.
+    derived.extend_from_slice(match record.study {
+        StudySummary::Verify(_) => &["timings"][..],
+        StudySummary::Converge(_) => &[],
+        StudySummary::VerifyDirect(_) => &["grid_s", "oracle_s"],
+        StudySummary::ConvergeDirect(_) => &["oracle_s"],
+    });
     let mut out = serde_json::Map::new();
     if let Some(map) = v.as_object_mut() {
         for key in [
@@ -405,7 +455,13 @@ fn decode(bin: &[u8], record: &StudyRecord) -> Result<StudyPart, String> {
     let (summary_angles, summary_pitches) = match &record.study {
         StudySummary::Verify(s) => (&s.angles_deg, vec![s.pitch_mm]),
         StudySummary::Converge(s) => (&s.angles_deg, s.pitches_mm.clone()),
+        StudySummary::VerifyDirect(s) => (&s.angles_deg, vec![s.pitch_mm]),
+        StudySummary::ConvergeDirect(s) => (&s.angles_deg, s.pitches_mm.clone()),
     };
+    let direct = matches!(
+        record.study,
+        StudySummary::VerifyDirect(_) | StudySummary::ConvergeDirect(_)
+    );
     let same = |a: &[f64], b: &[f64]| {
         a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
     };
@@ -440,10 +496,22 @@ fn decode(bin: &[u8], record: &StudyRecord) -> Result<StudyPart, String> {
                 "pitch {p} mm holds {count} start-angle pairs where shard.json says {expected} mm and {expected_pairs}"
             ));
         }
-        let mut pairs = Vec::with_capacity(count);
-        for k in 0..count {
-            pairs.push(r.pair(angles_deg[k / share.max(1)])?);
-        }
+        let angle = |k: usize| angles_deg[k / share.max(1)];
+        let pairs = if direct {
+            // The position of pair k: the share's start k % share.
+            let mut pairs = Vec::with_capacity(count);
+            for k in 0..count {
+                let s = record.start_indices[k % share];
+                pairs.push(r.direct_pair(starts[s], angle(k))?);
+            }
+            Pairs::Direct(pairs)
+        } else {
+            let mut pairs = Vec::with_capacity(count);
+            for k in 0..count {
+                pairs.push(r.pair(angle(k))?);
+            }
+            Pairs::Slide(pairs)
+        };
         pitches.push(PitchPart {
             pitch: p,
             pairs,
