@@ -26,18 +26,16 @@
 use std::time::Instant;
 
 use super::HarnessError;
-use super::compare::{CompareOptions, PairResult, StartSelection, assemble, pair_results};
+use super::compare::{PairResult, StartSelection, assemble, pair_results};
 use super::converge::{ConvergeOptions, ConvergeSummary, Convergence, Ladder, PitchResult};
 use super::direct::{
     DirectConvergeSummary, DirectConvergence, DirectPair, DirectPitchResult, DirectVerification,
     DirectVerifySummary, assemble_direct,
 };
 use super::metrics::TieBand;
-use super::verify::{
-    Verification, VerifyOptions, VerifySummary, oracle_options, run_oracle, start_positions,
-};
+use super::verify::{Traced, Verification, VerifyOptions, VerifySummary};
 use crate::analysis::{Progress, Setup};
-use crate::grid::{GridSpec, HeightGrid};
+use crate::grid::GridSpec;
 use crate::mesh::PartFile;
 use crate::shard::Shard;
 
@@ -193,26 +191,17 @@ pub fn verify_shard(
     shard: Shard,
     progress: &dyn Progress,
 ) -> Result<StudyPart, HarnessError> {
-    setup.validate()?;
-    if setup.approach == crate::analysis::Approach::Direct {
-        return Err(HarnessError::DirectApproach);
-    }
-    options.validate()?;
-    let t = Instant::now();
-    let triangles = &input.part.triangles;
-    let spec = setup.grid_spec(&input.part)?;
-    let grid = HeightGrid::sample(triangles, spec);
-    let footprints = setup.footprints(&spec);
-    let sample_s = t.elapsed().as_secs_f64();
-    let all = start_positions(&grid, &footprints, &options.selection)?;
-    let starts = share(&all, Some(shard))?;
-    let oracle = oracle_options(&setup.knee, setup.pitch, spec.x(0));
-    let (traces, oracle_s) = run_oracle(triangles, &starts, &setup.angles, &oracle, progress)?;
-    let compare = CompareOptions {
-        knee: setup.knee,
-        rule: setup.rule,
-        tie_band_per_mm: options.tie_band_per_mm,
-    };
+    let Traced {
+        spec,
+        grid,
+        footprints,
+        all,
+        starts,
+        traces,
+        compare,
+        sample_s,
+        oracle_s,
+    } = Traced::new(input, setup, options, Some(shard), progress)?;
     let t = Instant::now();
     let pairs = pair_results(&grid, &footprints, &starts, &traces, &compare, None)?;
     let grid_s = t.elapsed().as_secs_f64();

@@ -163,40 +163,94 @@ pub(crate) fn verify_with(
     progress: &dyn Progress,
     fault: Option<Fault>,
 ) -> Result<Verification, HarnessError> {
-    setup.validate()?;
-    if setup.approach == crate::analysis::Approach::Direct {
-        return Err(HarnessError::DirectApproach);
-    }
-
-    options.validate()?;
-    let t = Instant::now();
-    let triangles = &input.part.triangles;
-    let spec = setup.grid_spec(&input.part)?;
-    let grid = HeightGrid::sample(triangles, spec);
-    let footprints = setup.footprints(&spec);
-    let sample_s = t.elapsed().as_secs_f64();
-    let starts = start_positions(&grid, &footprints, &options.selection)?;
-    let oracle = oracle_options(&setup.knee, setup.pitch, spec.x(0));
-    let (traces, oracle_s) = run_oracle(triangles, &starts, &setup.angles, &oracle, progress)?;
-    let compare = CompareOptions {
-        knee: setup.knee,
-        rule: setup.rule,
-        tie_band_per_mm: options.tie_band_per_mm,
-    };
-    let comparison = compare_grid_with(&grid, &footprints, &starts, &traces, &compare, fault)?;
+    let traced = Traced::new(input, setup, options, None, progress)?;
+    let Traced {
+        spec,
+        grid,
+        footprints,
+        starts,
+        traces,
+        compare,
+        sample_s,
+        oracle_s,
+        ..
+    } = &traced;
+    let comparison = compare_grid_with(grid, footprints, starts, traces, compare, fault)?;
     let summary = VerifySummary::new(
         input,
         setup,
         options,
-        &spec,
+        spec,
         &comparison,
-        sample_s,
-        oracle_s,
+        *sample_s,
+        *oracle_s,
     );
     Ok(Verification {
         comparison,
         summary,
     })
+}
+
+/// The first half of a verification, up to the comparison: the options
+/// checked, the grid sampled, the study's starts chosen, and the exact
+/// oracle run on `shard`'s share of them (all of them without a shard).
+/// [`verify`] and [`super::verify_shard`] both begin here.
+pub(super) struct Traced {
+    pub spec: GridSpec,
+    pub grid: HeightGrid,
+    pub footprints: Vec<GridFootprint>,
+    /// Every start of the study, in its order.
+    pub all: Vec<[f64; 2]>,
+    /// The share traced: `all`, or the shard's.
+    pub starts: Vec<[f64; 2]>,
+    /// The oracle's traces of `starts`.
+    pub traces: Vec<StartTrace>,
+    pub compare: CompareOptions,
+    /// Seconds sampling the grid.
+    pub sample_s: f64,
+    /// Seconds of the oracle.
+    pub oracle_s: f64,
+}
+
+impl Traced {
+    pub(super) fn new(
+        input: &PartFile,
+        setup: &Setup,
+        options: &VerifyOptions,
+        shard: Option<crate::shard::Shard>,
+        progress: &dyn Progress,
+    ) -> Result<Traced, HarnessError> {
+        setup.validate()?;
+        if setup.approach == crate::analysis::Approach::Direct {
+            return Err(HarnessError::DirectApproach);
+        }
+        options.validate()?;
+        let t = Instant::now();
+        let triangles = &input.part.triangles;
+        let spec = setup.grid_spec(&input.part)?;
+        let grid = HeightGrid::sample(triangles, spec);
+        let footprints = setup.footprints(&spec);
+        let sample_s = t.elapsed().as_secs_f64();
+        let all = start_positions(&grid, &footprints, &options.selection)?;
+        let starts = super::sharded::share(&all, shard)?;
+        let oracle = oracle_options(&setup.knee, setup.pitch, spec.x(0));
+        let (traces, oracle_s) = run_oracle(triangles, &starts, &setup.angles, &oracle, progress)?;
+        Ok(Traced {
+            spec,
+            grid,
+            footprints,
+            all,
+            starts,
+            traces,
+            compare: CompareOptions {
+                knee: setup.knee,
+                rule: setup.rule,
+                tie_band_per_mm: options.tie_band_per_mm,
+            },
+            sample_s,
+            oracle_s,
+        })
+    }
 }
 
 impl VerifySummary {
