@@ -453,31 +453,42 @@ fn paper_band(
 /// `+inf` where the start is not placed. For comparisons with the exact
 /// oracle; [`colliding_masks`] computes these on the way.
 pub fn push_levels(grid: &HeightGrid, fp: &GridFootprint) -> Vec<f64> {
-    assert_same_pitch(grid, std::slice::from_ref(fp));
-    let padded = PaddedGrid::new(grid, std::slice::from_ref(fp));
+    let mut levels = Vec::new();
+    for_each_push_levels(grid, std::slice::from_ref(fp), |yr| levels = yr);
+    levels
+}
+
+/// [`push_levels`] at every angle of `footprints` in turn, handed to
+/// `each` in their order: the padded grid, its ranks and the push table
+/// are built once for all of them.
+pub fn for_each_push_levels(
+    grid: &HeightGrid,
+    footprints: &[GridFootprint],
+    mut each: impl FnMut(Vec<f64>),
+) {
+    assert_same_pitch(grid, footprints);
+    let padded = PaddedGrid::new(grid, footprints);
     let ranked = RankedGrid::new(&padded);
-    let table = WindowMin::new(
-        &padded,
-        &ranked.ranks,
-        WindowMin::max_width(std::slice::from_ref(fp)),
-    );
-    let rows = PushRows::new(&padded, fp);
+    let table = WindowMin::new(&padded, &ranked.ranks, WindowMin::max_width(footprints));
     let nx = grid.spec.nx;
-    let mut yr = vec![f64::INFINITY; grid.spec.len()];
-    for (j0, out) in yr.chunks_exact_mut(nx).enumerate() {
-        for (block, out) in out.chunks_mut(LANES).enumerate() {
-            // The padding's slack covers the lanes past the last column.
-            let levels: [Rank; LANES] = push_block(
-                &table,
-                rows.within(j0, grid.spec.nz),
-                padded.index(j0 as i64, 0) + block * LANES,
-            );
-            for (y, &r) in out.iter_mut().zip(&levels) {
-                *y = ranked.height(r);
+    for fp in footprints {
+        let rows = PushRows::new(&padded, fp);
+        let mut yr = vec![f64::INFINITY; grid.spec.len()];
+        for (j0, out) in yr.chunks_exact_mut(nx).enumerate() {
+            for (block, out) in out.chunks_mut(LANES).enumerate() {
+                // The padding's slack covers the lanes past the last column.
+                let levels: [Rank; LANES] = push_block(
+                    &table,
+                    rows.within(j0, grid.spec.nz),
+                    padded.index(j0 as i64, 0) + block * LANES,
+                );
+                for (y, &r) in out.iter_mut().zip(&levels) {
+                    *y = ranked.height(r);
+                }
             }
         }
+        each(yr);
     }
-    yr
 }
 
 /// SPEC's composite: for every node, the number of angles whose mask holds it.

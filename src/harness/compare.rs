@@ -85,11 +85,11 @@ pub fn select_starts(
     }
     let nx = grid.spec.nx;
     let mut placed = vec![false; grid.spec.len()];
-    for fp in footprints {
-        for (p, y) in placed.iter_mut().zip(crate::engine::push_levels(grid, fp)) {
+    crate::engine::for_each_push_levels(grid, footprints, |yr| {
+        for (p, y) in placed.iter_mut().zip(yr) {
             *p |= y.is_finite();
         }
-    }
+    });
     let nodes: Vec<(usize, usize)> = (0..spec.len())
         .filter(|&n| placed[n])
         .map(|n| (n % nx, n / nx))
