@@ -702,11 +702,7 @@ impl Analysis {
 
         let composite = composite(&masks);
         let struck = composite.iter().filter(|&&c| c > 0).count();
-        let placement = crate::frame::Placement {
-            approach: setup.approach,
-            ..input.placement()
-        };
-        let mut result_warnings = sanity::blind_spot_warnings(&blind, &placement);
+        let mut result_warnings = sanity::blind_spot_warnings(&blind, &placement(&input, setup));
         result_warnings.extend(sanity::result_warnings(struck));
         for w in &result_warnings {
             progress.warn(w);
@@ -738,10 +734,7 @@ impl Analysis {
     /// the direct frame ([`crate::direct`]). The writers map results back
     /// by it.
     pub fn placement(&self) -> crate::frame::Placement {
-        crate::frame::Placement {
-            approach: self.setup.approach,
-            ..self.input.placement()
-        }
+        placement(&self.input, &self.setup)
     }
 
     /// Nodes colliding at some angle.
@@ -892,4 +885,13 @@ pub(crate) fn probes_met(masks: &[AngleMask], probes: usize) -> Vec<Vec<f64>> {
                 .collect()
         })
         .collect()
+}
+
+/// How `input`'s coordinates map to the grid of an analysis by `setup`:
+/// the file's frame and side, then the approach's turn.
+fn placement(input: &PartFile, setup: &Setup) -> crate::frame::Placement {
+    crate::frame::Placement {
+        approach: setup.approach,
+        ..input.placement()
+    }
 }
