@@ -96,7 +96,8 @@ pub fn write_results(
     let (grid, masks, counts) = (results.grid, results.masks, results.composite);
     let node_file = results.node_file;
     let file =
-        |name: &str, write: &dyn Fn(&mut BufWriter<std::fs::File>) -> std::io::Result<()>| {
+        |name: &str,
+         write: &(dyn Fn(&mut BufWriter<std::fs::File>) -> std::io::Result<()> + Sync)| {
             let path = out.path(name);
             std::fs::File::create(&path)
                 .and_then(|f| {
@@ -106,41 +107,54 @@ pub fn write_results(
                 })
                 .map_err(WriteError::at(&path))
         };
-    if options.points_csv {
-        file("colliding_points.csv", &|w| {
-            Ok(super::write_colliding_points(
-                w, grid, masks, placement, node_file,
+    // The files are independent: three groups of about equal time are
+    // written in parallel. Each file's bytes do not depend on it; the
+    // first error in the order below is the one reported.
+    let tables = || -> Result<(), WriteError> {
+        if options.points_csv {
+            file("colliding_points.csv", &|w| {
+                Ok(super::write_colliding_points(
+                    w, grid, masks, placement, node_file,
+                )?)
+            })?;
+        }
+        file("composite.csv", &|w| {
+            Ok(super::write_composite(
+                w, grid, masks, counts, placement, node_file,
             )?)
+        })
+    };
+    let meshes = || -> Result<(), WriteError> {
+        file("colliding_area.stl", &|w| {
+            super::write_colliding_area(w, grid, counts, placement).map(drop)
         })?;
-    }
-    file("composite.csv", &|w| {
-        Ok(super::write_composite(
-            w, grid, masks, counts, placement, node_file,
-        )?)
-    })?;
-    file("colliding_area.stl", &|w| {
-        super::write_colliding_area(w, grid, counts, placement).map(drop)
-    })?;
-    file("colliding_area.ply", &|w| {
-        super::write_colliding_area_ply(w, grid, counts, masks.len(), placement).map(drop)
-    })?;
-    super::write_depth_png(&out.path("depth.png"), grid, placement)?;
-    let title = format!(
-        "Composite colliding area, {} angles (L = {} mm)",
-        masks.len(),
-        results.triangle_side
-    );
-    let blind: Vec<(usize, usize)> = results.blind_spots.iter().map(|b| (b.i, b.j)).collect();
-    super::write_composite_png(
-        &out.path("composite.png"),
-        grid,
-        counts,
-        masks.len(),
-        &title,
-        placement,
-        &blind,
-    )?;
-    write_blind_spots(&out.path("blind_spots.csv"), results.blind_spots, placement)?;
+        file("colliding_area.ply", &|w| {
+            super::write_colliding_area_ply(w, grid, counts, masks.len(), placement).map(drop)
+        })
+    };
+    let pictures = || -> Result<(), WriteError> {
+        super::write_depth_png(&out.path("depth.png"), grid, placement)?;
+        let title = format!(
+            "Composite colliding area, {} angles (L = {} mm)",
+            masks.len(),
+            results.triangle_side
+        );
+        let blind: Vec<(usize, usize)> = results.blind_spots.iter().map(|b| (b.i, b.j)).collect();
+        super::write_composite_png(
+            &out.path("composite.png"),
+            grid,
+            counts,
+            masks.len(),
+            &title,
+            placement,
+            &blind,
+        )?;
+        write_blind_spots(&out.path("blind_spots.csv"), results.blind_spots, placement)
+    };
+    let (tables, (meshes, pictures)) = rayon::join(tables, || rayon::join(meshes, pictures));
+    tables?;
+    meshes?;
+    pictures?;
     let t_ = &mut summary.timings;
     t_.write_s = started.elapsed().as_secs_f64();
     t_.total_s = t_.read_s + t_.sample_s + t_.push_slide_s + t_.write_s;
