@@ -15,7 +15,7 @@ use crate::grid::{GridSpec, HeightGrid};
 use crate::kneeform::GridFootprint;
 use crate::padded::PaddedGrid;
 use crate::paper::{PaperCounts, PaperScratch, paper_row};
-use crate::push::{PushRows, WindowMin, push_block};
+use crate::push::{PushRows, WindowMin, push_block, push_tile};
 use crate::ranked::{NEVER, OFF, Rank, RankedGrid};
 use crate::simd::dispatch;
 use crate::slide::{LayerRows, slide_block, slide_carried};
@@ -103,6 +103,9 @@ const LANES: usize = 16;
 /// a little faster than 64 on the benchmark (and than 256; within the
 /// machine's noise, about 10%).
 pub const BAND_ROWS: usize = 128;
+
+/// Start rows pushed at once ([`push_tile`]).
+const TILE: usize = 4;
 
 /// Runs push and slide for every footprint (one per angle) on `grid`.
 /// `on_angle` is called once per finished angle (for a progress bar).
@@ -198,6 +201,10 @@ struct Fast<'a> {
     ranked: &'a RankedGrid,
     table: WindowMin<'a>,
     thresholds: Vec<Rank>,
+    /// Whether the slides that change nothing are skipped
+    /// ([`fast_band_impl`]): always, except in the tests that compare the
+    /// results with and without.
+    skip_still: bool,
 }
 
 impl<'a> Fast<'a> {
@@ -213,6 +220,7 @@ impl<'a> Fast<'a> {
             ranked,
             table: WindowMin::new(padded, &ranked.ranks, max_width),
             thresholds: ranked.thresholds(padded, rule),
+            skip_still: true,
         }
     }
 }
@@ -285,7 +293,8 @@ fn fast_window(
     let start = first_row * padded.stride;
     let end = (last_row + 1) * padded.stride;
     let mut reach = vec![NEVER; end - start];
-    let placed = fast_band(padded, fast, fp, band, start, &mut reach);
+    let visits = ProbeVisits::new(padded, fp, band, start, &options.probes);
+    let placed = fast_band(padded, fast, fp, band, start, &visits, &mut reach);
     let strikes = strike_mask(&fast.thresholds[start..end], &reach);
     let probe_levels = probe_levels(padded, start, &reach, &options.probes)
         .into_iter()
@@ -335,9 +344,10 @@ pub(crate) fn assert_same_pitch(grid: &HeightGrid, footprints: &[GridFootprint])
 dispatch! {
     /// The fast path over a band of start rows: blocks of starts from +x
     /// to -x, each swept over every start row of the band, carrying each
-    /// row's slide level from one block into the next. Records each node's
-    /// reach (see [`crate::slide`]) in `reach`, whose first element is the
-    /// padded node `window`, and returns the number of placed starts.
+    /// row's slide level from one block into the next. Records in `reach`
+    /// (whose first element is the padded node `window`) each node's reach,
+    /// as far as the strikes and `visits` depend on it (see
+    /// [`fast_band_impl`]), and returns the number of placed starts.
     ///
     /// A block is 128 starts with AVX-512 (eight registers of ranks), 64
     /// with AVX2 (eight), 16 without: wider blocks walk the footprint's
@@ -345,9 +355,25 @@ dispatch! {
     /// about 5% faster than 32 and level with 128 (the noise is about
     /// 10%); 16 slower. [`LANE_SLACK`](crate::padded::LANE_SLACK) covers the
     /// widest block.
-    fn fast_band(padded: &PaddedGrid, fast: &Fast, fp: &GridFootprint, band: &[usize], window: usize, reach: &mut [Rank]) -> usize => fast_band_impl::<128, 64, 16>
+    fn fast_band(padded: &PaddedGrid, fast: &Fast, fp: &GridFootprint, band: &[usize], window: usize, visits: &ProbeVisits, reach: &mut [Rank]) -> usize => fast_band_impl::<128, 64, 16>
 }
 
+/// The band's work in blocks of `W` starts.
+///
+/// **Slides that change nothing are skipped.** A placed start's first
+/// layer, in every footprint row with a node inside, is that row's first
+/// node inside the footprint of the start one column to -x (`kf = klo - 1`,
+/// [`crate::kneeform::FootprintRow`]). So when that start's push level is
+/// not below this one's, and neither is any height of the layer's other
+/// nodes ([`LayerRows::outside`]), no node of the layer lies below the
+/// level: the slide's level stays `yr` across the layer, and every node it
+/// meets is met at a level no higher than its own height, below its strike
+/// threshold ([`RankedGrid::thresholds`]), so it strikes nothing. A block
+/// whose placed starts are all like that leaves its reach alone, except at
+/// the probed nodes, which are told the level (`visits`). The push of the
+/// start left of a block's first lane is the last lane of the next block,
+/// so each row's block waits for its left neighbour's push before it
+/// slides.
 #[inline(always)]
 fn fast_band_impl<const W: usize>(
     padded: &PaddedGrid,
@@ -355,10 +381,10 @@ fn fast_band_impl<const W: usize>(
     fp: &GridFootprint,
     band: &[usize],
     window: usize,
+    visits: &ProbeVisits,
     reach: &mut [Rank],
 ) -> usize {
     let push_rows = PushRows::new(padded, fp);
-    let h = &fast.ranked.ranks[window..];
     let nz = padded.spec.nz;
     let layer = LayerRows::new(padded, fp);
     let active: Vec<std::ops::Range<i64>> = band
@@ -374,50 +400,272 @@ fn fast_band_impl<const W: usize>(
     let (Some(lo), Some(hi)) = (lo, hi) else {
         return 0;
     };
-    let nx = padded.spec.nx as i64;
     let layers: Vec<_> = band.iter().map(|&j0| layer.within(j0, nz)).collect();
-    let mut carry = vec![NEVER; band.len()];
+    let slider = Slider {
+        skip_still: fast.skip_still,
+        h: &fast.ranked.ranks[window..],
+        window,
+        nx: padded.spec.nx as i64,
+        visits,
+    };
+    let mut rows: Vec<RowState<W>> = band
+        .iter()
+        .map(|&j0| RowState {
+            first: padded.index(j0 as i64, 0),
+            carry: NEVER,
+            pending: None,
+        })
+        .collect();
     let mut placed = 0;
     let mut block_end = hi;
     while block_end > lo {
         // The block may reach below `lo`: those starts do nothing, and the
         // padding's slack keeps them inside the array.
         let block = block_end - W as i64;
-        for (k, &j0) in band.iter().enumerate() {
-            if active[k].is_empty() || block >= active[k].end || block_end <= active[k].start {
-                continue;
-            }
-            let base = padded
-                .index(j0 as i64, 0)
-                .wrapping_add_signed(block as isize);
-            let yr: [Rank; W] = push_block(&fast.table, push_rows.within(j0, nz), base);
-            let base = base - window;
-            // Only real starts are placed.
-            let mut level = [NEVER; W];
-            for w in 0..W {
-                let i0 = block + w as i64;
-                if (0..nx).contains(&i0) && yr[w] != OFF {
-                    level[w] = yr[w];
-                    placed += 1;
+        let inside = |k: usize| !(block >= active[k].end || block_end <= active[k].start);
+        let mut k = 0;
+        while k < band.len() {
+            let base = rows[k].first.wrapping_add_signed(block as isize);
+            // A tile of consecutive start rows is pushed at once.
+            let tile = band
+                .get(k..k + TILE)
+                .filter(|tile| tile[TILE - 1] - tile[0] == TILE - 1);
+            if let Some(tile) = tile {
+                let yr: Option<[[Rank; W]; TILE]> = (k..k + TILE)
+                    .any(inside)
+                    .then(|| push_tile(&fast.table, &push_rows, tile[0], nz, padded.stride, base));
+                for t in 0..TILE {
+                    let yr = yr.filter(|_| inside(k + t)).map(|yr| yr[t]);
+                    placed += rows[k + t].advance(&slider, reach, &layers[k + t], k + t, block, yr);
                 }
+                k += TILE;
+            } else {
+                let yr = inside(k)
+                    .then(|| push_block::<W>(&fast.table, push_rows.within(band[k], nz), base));
+                placed += rows[k].advance(&slider, reach, &layers[k], k, block, yr);
+                k += 1;
             }
-            let layer = &layers[k];
-            let after = slide_block(h, reach, layer, base, level);
-            // Starts that are not placed continue the slide of the start on
-            // their +x side, from +x to -x.
-            let mut c = carry[k];
-            for w in (0..W).rev() {
-                if level[w] != NEVER {
-                    c = after[w];
-                } else if c != NEVER {
-                    c = slide_carried(h, reach, layer, base + w, c);
-                }
-            }
-            carry[k] = c;
         }
         block_end = block;
     }
+    for (k, row) in rows.iter_mut().enumerate() {
+        if let Some((right, yr_right)) = row.pending.take() {
+            // Left of the last block lie no active starts.
+            placed += slider.slide(reach, &layers[k], k, row, right, yr_right, OFF);
+        }
+    }
     placed
+}
+
+/// One start row's state in [`fast_band_impl`].
+struct RowState<const W: usize> {
+    /// The padded index of the row's column 0.
+    first: usize,
+    /// The level the slides carry into the next block, from +x.
+    carry: Rank,
+    /// The block pushed but not yet slid: its first start column and the
+    /// starts' push levels.
+    pending: Option<(i64, [Rank; W])>,
+}
+
+impl<const W: usize> RowState<W> {
+    /// Takes the push levels `yr` of the row's block from column `block`
+    /// (`None` where the block has none of the row's active starts), and
+    /// slides the block pushed before it, whose left neighbour it is.
+    /// Returns the starts placed.
+    #[inline(always)]
+    fn advance(
+        &mut self,
+        slider: &Slider,
+        reach: &mut [Rank],
+        layer: &LayerRows,
+        k: usize,
+        block: i64,
+        yr: Option<[Rank; W]>,
+    ) -> usize {
+        let mut placed = 0;
+        if let Some((right, yr_right)) = self.pending.take() {
+            // Outside the row's active starts, no start is placed: no
+            // finite height lies inside its footprint.
+            let left = yr.map_or(OFF, |yr| yr[W - 1]);
+            placed = slider.slide(reach, layer, k, self, right, yr_right, left);
+        }
+        self.pending = yr.map(|yr| (block, yr));
+        placed
+    }
+}
+
+/// What the slides of a band share.
+struct Slider<'a> {
+    /// The height ranks from the reach window's first node on.
+    h: &'a [Rank],
+    /// The padded index of the reach window's first node.
+    window: usize,
+    nx: i64,
+    visits: &'a ProbeVisits,
+    /// [`Fast::skip_still`].
+    skip_still: bool,
+}
+
+impl Slider<'_> {
+    /// Slides the block of starts from column `block` (push levels `yr`) of
+    /// the band's `k`-th start row, whose start one column to -x of the
+    /// first has the push level `left`; returns the starts placed.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn slide<const W: usize>(
+        &self,
+        reach: &mut [Rank],
+        layer: &LayerRows,
+        k: usize,
+        row: &mut RowState<W>,
+        block: i64,
+        yr: [Rank; W],
+        left: Rank,
+    ) -> usize {
+        let base = row.first.wrapping_add_signed(block as isize) - self.window;
+        // Only real starts are placed.
+        let mut level = [NEVER; W];
+        let mut placed = 0;
+        for w in 0..W {
+            let i0 = block + w as i64;
+            if (0..self.nx).contains(&i0) && yr[w] != OFF {
+                level[w] = yr[w];
+                placed += 1;
+            }
+        }
+        let after = if self.moves(layer, base, left, &yr, &level) {
+            slide_block(self.h, reach, layer, base, level)
+        } else {
+            self.visits.record(k, base + self.window, &level, reach);
+            level
+        };
+        // Starts that are not placed continue the slide of the start on
+        // their +x side, from +x to -x.
+        let mut c = row.carry;
+        for w in (0..W).rev() {
+            if level[w] != NEVER {
+                c = after[w];
+            } else if c != NEVER {
+                c = slide_carried(self.h, reach, layer, base + w, c);
+            }
+        }
+        row.carry = c;
+        placed
+    }
+
+    /// Whether the first layer of some placed start of the block (levels
+    /// `level`, [`NEVER`] where not placed) holds a node below its level:
+    /// its start one column to -x pushed lower (`left` for the first
+    /// lane's), or a node of a footprint row with none inside is lower.
+    #[inline(always)]
+    fn moves<const W: usize>(
+        &self,
+        layer: &LayerRows,
+        base: usize,
+        left: Rank,
+        yr: &[Rank; W],
+        level: &[Rank; W],
+    ) -> bool {
+        if !self.skip_still {
+            return true;
+        }
+        let mut beside = [OFF; W];
+        beside[0] = left;
+        beside[1..].copy_from_slice(&yr[..W - 1]);
+        let mut lower = 0u32;
+        for w in 0..W {
+            lower |= u32::from(beside[w] < level[w]);
+        }
+        if lower != 0 {
+            return true;
+        }
+        for offset in layer.outside() {
+            let a = base.wrapping_add_signed(offset);
+            let hv: &[Rank; W] = self.h[a..a + W].try_into().expect("W values");
+            for w in 0..W {
+                lower |= u32::from(hv[w] < level[w]);
+            }
+        }
+        lower != 0
+    }
+}
+
+/// The probed nodes the slides of a band meet: per start row of the band,
+/// `(start, node)` for every start whose first layer holds a corner node
+/// of a probe, as padded indices, sorted. A skipped block of slides
+/// ([`fast_band_impl`]) still raises their reach to the level that met
+/// them, so that the probes see every level, as without the skip.
+struct ProbeVisits {
+    rows: Vec<Vec<(usize, usize)>>,
+    /// The padded index of the reach window's first node.
+    window: usize,
+}
+
+impl ProbeVisits {
+    /// The visits of `probes` by the slides of `band` at the angle of `fp`,
+    /// with the reach window beginning at the padded node `window`.
+    fn new(
+        padded: &PaddedGrid,
+        fp: &GridFootprint,
+        band: &[usize],
+        window: usize,
+        probes: &[Probe],
+    ) -> ProbeVisits {
+        let layer = LayerRows::new(padded, fp);
+        let nz = padded.spec.nz as i64;
+        let corners: Vec<(i64, i64)> = probes
+            .iter()
+            .flat_map(|probe| {
+                let (i, j) = (probe.cell.0 as i64, probe.cell.1 as i64);
+                [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]
+            })
+            .filter(|&(_, j)| j < nz)
+            .collect();
+        let rows = band
+            .iter()
+            .map(|&j0| {
+                let mut visits: Vec<(usize, usize)> = Vec::new();
+                if corners.is_empty() {
+                    return visits;
+                }
+                for (dj, offset) in layer.rows() {
+                    let j = j0 as i64 + i64::from(dj);
+                    for &(i, _) in corners.iter().filter(|&&(_, cj)| cj == j) {
+                        let node = padded.index(j, i as i32);
+                        visits.push((node.wrapping_add_signed(-offset), node));
+                    }
+                }
+                visits.sort_unstable();
+                visits
+            })
+            .collect();
+        ProbeVisits { rows, window }
+    }
+
+    /// Raises the reach of the probed nodes met by the `k`-th start row's
+    /// block of starts from the padded node `first`, whose levels, unchanged
+    /// across their first layers, are `level`.
+    fn record<const W: usize>(
+        &self,
+        k: usize,
+        first: usize,
+        level: &[Rank; W],
+        reach: &mut [Rank],
+    ) {
+        let visits = &self.rows[k];
+        if visits.is_empty() {
+            return;
+        }
+        let from = visits.partition_point(|&(start, _)| start < first);
+        for &(start, node) in visits[from..]
+            .iter()
+            .take_while(|&&(start, _)| start < first + W)
+        {
+            let r = &mut reach[node - self.window];
+            *r = (*r).max(level[start - first]);
+        }
+    }
 }
 
 /// SPEC's strike rule applied once per node to its reach, the highest face
@@ -510,11 +758,14 @@ mod tests {
     use crate::kneeform::KneeForm;
 
     /// [`fast_band`]'s signature.
-    type BandFn = fn(&PaddedGrid, &Fast, &GridFootprint, &[usize], usize, &mut [Rank]) -> usize;
+    type BandFn =
+        fn(&PaddedGrid, &Fast, &GridFootprint, &[usize], usize, &ProbeVisits, &mut [Rank]) -> usize;
 
     /// The block width is a tuning knob per instruction set: every width
-    /// gives the same reach and placed count (the tests elsewhere run only
-    /// the width this machine's instruction set picks).
+    /// gives the same strikes, probe answers and placed count (the tests
+    /// elsewhere run only the width this machine's instruction set picks).
+    /// The reach itself may differ where it decides nothing: the slides
+    /// skipped are those of whole blocks.
     #[test]
     fn every_block_width_gives_the_same_result() {
         let spec = GridSpec {
@@ -547,13 +798,37 @@ mod tests {
             let padded = PaddedGrid::new(&grid, std::slice::from_ref(&fp));
             let ranked = RankedGrid::new(&padded);
             let fast = Fast::new(&padded, &ranked, 512, &StrikeRule::default());
-            let run = |f: BandFn| {
+            let probes: Vec<Probe> = (0..spec.nz - 1)
+                .step_by(7)
+                .flat_map(|j| (0..spec.nx - 1).step_by(13).map(move |i| (i, j)))
+                .map(|cell| Probe {
+                    cell,
+                    y: -1.0 + 0.02 * (cell.0 + cell.1) as f64,
+                })
+                .collect();
+            let visits = ProbeVisits::new(&padded, &fp, &rows, 0, &probes);
+            let mut still = Fast::new(&padded, &ranked, 512, &StrikeRule::default());
+            still.skip_still = false;
+            let run_with = |fast: &Fast, f: BandFn| {
                 let mut reach = vec![NEVER; padded.h.len()];
-                let placed = f(&padded, &fast, &fp, &rows, 0, &mut reach);
-                (reach, placed)
+                let placed = f(&padded, fast, &fp, &rows, 0, &visits, &mut reach);
+                let mask = strike_mask(&fast.thresholds, &reach);
+                (mask, probe_levels(&padded, 0, &reach, &probes), placed)
             };
+            let run = |f: BandFn| run_with(&fast, f);
             let w16 = run(fast_band_impl::<16>);
-            assert!(w16.1 > 0);
+            assert!(w16.2 > 0);
+            assert!(w16.0.contains(&1));
+            // Probes both met and not, so that a lost visit shows.
+            let met: Vec<bool> = (w16.1.iter().zip(&probes))
+                .map(|(&level, probe)| probe.y < ranked.height(level) - 1e-6)
+                .collect();
+            assert!(met.contains(&true) && met.contains(&false), "angle {angle}");
+            // Skipping the slides that change nothing changes nothing.
+            assert!(
+                run_with(&still, fast_band_impl::<64>) == w16,
+                "angle {angle}: no skip"
+            );
             assert!(run(fast_band_impl::<8>) == w16, "angle {angle}: 8 lanes");
             assert!(run(fast_band_impl::<32>) == w16, "angle {angle}: 32 lanes");
             assert!(run(fast_band_impl::<64>) == w16, "angle {angle}: 64 lanes");
@@ -562,6 +837,108 @@ mod tests {
                 "angle {angle}: 128 lanes"
             );
         }
+    }
+
+    /// Skipping the slides that change nothing loses nothing: on rough
+    /// random grids with plateaus and holes, at angles and pitches where
+    /// some footprint rows hold no node, every node's reach where it lies
+    /// above the node (where the strike rule can be met) and every probe's
+    /// level are those of sliding every start. Probes on the plateau, below
+    /// it, are met only by slides that do not fall, the skipped ones.
+    #[test]
+    fn skipped_slides_lose_nothing() {
+        let knee = KneeForm {
+            triangle_side: 30.0,
+            radius: 6.0,
+            thickness: 100.0,
+        };
+        let (mut empty_rows, mut skipped) = (0, 0);
+        // Pitches and angles with rows of no node at the footprint's tips
+        // (found by laying this knee-form at every whole angle).
+        let cases: [(u64, f64, &[f64]); 4] = [
+            (1, 2.5, &[-2.0, 2.0, -30.0]),
+            (2, 1.6, &[-20.0, 15.0, 30.0]),
+            (3, 2.6, &[-12.0, 0.0, 6.0, 19.0]),
+            (4, 1.4, &[0.0, 11.0]),
+        ];
+        for (seed, pitch, angles) in cases {
+            let spec = GridSpec {
+                pitch,
+                i_origin: -20,
+                j_origin: -7,
+                nx: 110,
+                nz: 50,
+            };
+            let mut rng = crate::harness::compare::SplitMix(seed);
+            // A plateau, then a slope rising to -x with a few pits (most
+            // slides there do not fall), then rough ground with holes.
+            let mixed: Vec<f64> = (0..spec.len())
+                .map(|n| {
+                    let (i, r) = (n % spec.nx, rng.next());
+                    match (i, r % 17) {
+                        (..25, _) => 1.0,
+                        (25..55, 0) => -4.0,
+                        (25..55, _) => -0.1 * i as f64,
+                        (_, 0) => f64::INFINITY,
+                        (_, _) => ((r >> 8) % 13) as f64 * 0.5 - 2.0,
+                    }
+                })
+                .collect();
+            // A low row with pits in high ground: a start whose footprint's
+            // tip row of no node lies on the row meets a pit at the high
+            // level, the other starts meeting it at the row's low level.
+            let ridge: Vec<f64> = (0..spec.len())
+                .map(|n| match (n / spec.nx, n % spec.nx % 9) {
+                    (25, 4) => -4.0,
+                    (25, _) => 1.0,
+                    _ => 5.0,
+                })
+                .collect();
+            for h in [mixed, ridge] {
+                let grid = HeightGrid { spec, h };
+                let probes: Vec<Probe> = (0..spec.nz - 1)
+                    .step_by(3)
+                    .flat_map(|j| (0..spec.nx - 1).step_by(2).map(move |i| (i, j)))
+                    .map(|cell| Probe { cell, y: 0.5 })
+                    .collect();
+                let rows: Vec<usize> = (0..spec.nz).collect();
+                for &angle in angles {
+                    let fp = GridFootprint::new(&knee, angle, &spec);
+                    empty_rows += fp.rows.iter().filter(|r| r.khi < r.klo).count();
+                    let padded = PaddedGrid::new(&grid, std::slice::from_ref(&fp));
+                    let ranked = RankedGrid::new(&padded);
+                    let visits = ProbeVisits::new(&padded, &fp, &rows, 0, &probes);
+                    let run = |skip_still: bool, f: BandFn| {
+                        let mut fast = Fast::new(&padded, &ranked, 64, &StrikeRule::default());
+                        fast.skip_still = skip_still;
+                        let mut reach = vec![NEVER; padded.h.len()];
+                        let placed = f(&padded, &fast, &fp, &rows, 0, &visits, &mut reach);
+                        let above: Vec<Rank> = (reach.iter().zip(&ranked.ranks))
+                            .map(|(&r, &own)| if r > own { r } else { NEVER })
+                            .collect();
+                        let levels = probe_levels(&padded, 0, &reach, &probes);
+                        (reach, above, levels, placed)
+                    };
+                    let all = run(false, fast_band_impl::<16>);
+                    assert!(all.2.iter().any(|&l| l != NEVER));
+                    // Narrow blocks: many first lanes, whose left neighbour's
+                    // push is the next block's.
+                    for f in [
+                        fast_band_impl::<2> as BandFn,
+                        fast_band_impl::<8>,
+                        fast_band_impl::<16>,
+                    ] {
+                        let skip = run(true, f);
+                        assert!(all.1 == skip.1, "seed {seed}, angle {angle}: reach above");
+                        assert!(all.2 == skip.2, "seed {seed}, angle {angle}: probes");
+                        assert_eq!(all.3, skip.3);
+                        skipped += usize::from(all.0 != skip.0);
+                    }
+                }
+            }
+        }
+        // The cases the skip must get right did occur.
+        assert!(empty_rows > 0 && skipped > 0, "{empty_rows} {skipped}");
     }
 
     /// Bands of start rows, their reach windows and the thread count are
@@ -619,7 +996,8 @@ mod tests {
             .iter()
             .map(|fp| {
                 let mut reach = vec![NEVER; padded.h.len()];
-                let placed = fast_band(&padded, &fast, fp, &rows, 0, &mut reach);
+                let visits = ProbeVisits::new(&padded, fp, &rows, 0, &probes);
+                let placed = fast_band(&padded, &fast, fp, &rows, 0, &visits, &mut reach);
                 let mask = padded.unpad(&strike_mask(&fast.thresholds, &reach));
                 let met = probe_levels(&padded, 0, &reach, &probes)
                     .iter()

@@ -136,13 +136,59 @@ impl PushRows {
     /// The rows that fall on the grid's real rows for a start in row `j0`
     /// of a grid of `nz` rows (the others lie on `+inf` padding).
     pub fn within(&self, j0: usize, nz: usize) -> &[PushRow] {
+        &self.rows[self.within_range(j0, nz)]
+    }
+
+    /// The indices of [`PushRows::within`]'s rows.
+    fn within_range(&self, j0: usize, nz: usize) -> std::ops::Range<usize> {
         let j0 = j0 as i64;
         let lo = self.dj.partition_point(|&dj| j0 + i64::from(dj) < 0);
         let hi = self
             .dj
             .partition_point(|&dj| j0 + i64::from(dj) < nz as i64);
-        &self.rows[lo..hi.max(lo)]
+        lo..hi.max(lo)
     }
+}
+
+/// [`push_block`] for the starts of `T` consecutive start rows from `j0`
+/// at once, in a grid of `nz` rows whose rows are `stride` nodes apart:
+/// `base` is the node index of the first row's first start. The rows are
+/// taken footprint row by footprint row, each for the `T` start rows in
+/// turn, so the grid rows they read are read again by the next footprint
+/// row (one grid row up for one start row down), while still in the
+/// first-level cache.
+#[inline(always)]
+pub fn push_tile<const W: usize, const T: usize>(
+    table: &WindowMin,
+    rows: &PushRows,
+    j0: usize,
+    nz: usize,
+    stride: usize,
+    base: usize,
+) -> [[Rank; W]; T] {
+    let mut yr = [[OFF; W]; T];
+    let base = base - table.first;
+    let ranges: [std::ops::Range<usize>; T] =
+        std::array::from_fn(|t| rows.within_range(j0 + t, nz));
+    let lo = ranges.iter().map(|r| r.start).min().unwrap_or(0);
+    let hi = ranges.iter().map(|r| r.end).max().unwrap_or(0);
+    for e in lo..hi {
+        let (offset, level, second) = rows.rows[e];
+        let t_level = table.level(level as usize);
+        for (t, yr) in yr.iter_mut().enumerate() {
+            if !ranges[t].contains(&e) {
+                continue;
+            }
+            let a = (base + t * stride).wrapping_add_signed(offset);
+            let first: &[Rank; W] = t_level[a..a + W].try_into().expect("W values");
+            let b = a + second as usize;
+            let last: &[Rank; W] = t_level[b..b + W].try_into().expect("W values");
+            for w in 0..W {
+                yr[w] = yr[w].min(first[w].min(last[w]));
+            }
+        }
+    }
+    yr
 }
 
 /// Face levels (ranks) of `W` consecutive starts whose node index (in the

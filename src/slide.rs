@@ -38,6 +38,10 @@ pub struct LayerRows {
     groups: Vec<std::ops::Range<usize>>,
     /// Each offset's footprint row `dj`.
     dj: Vec<i32>,
+    /// Whether each offset's footprint row has nodes inside the footprint.
+    /// Where it does, the first node in front (`kf = klo - 1`) is inside
+    /// the footprint of the start one column to -x.
+    inside: Vec<bool>,
 }
 
 impl LayerRows {
@@ -48,7 +52,25 @@ impl LayerRows {
             offsets: rows().map(|row| grid.offset(row.dj, row.kf)).collect(),
             groups: fp.groups.clone(),
             dj: rows().map(|row| row.dj).collect(),
+            inside: rows().map(|row| row.khi >= row.klo).collect(),
         }
+    }
+
+    /// The offsets of the first nodes in front in footprint rows with no
+    /// node inside: the layer's nodes that are not inside the footprint of
+    /// the start one column to -x.
+    pub fn outside(&self) -> impl Iterator<Item = isize> + '_ {
+        self.offsets
+            .iter()
+            .zip(&self.inside)
+            .filter(|&(_, &inside)| !inside)
+            .map(|(&offset, _)| offset)
+    }
+
+    /// Each footprint row `dj` of the layer with the offset of its first
+    /// node in front.
+    pub fn rows(&self) -> impl Iterator<Item = (i32, isize)> + '_ {
+        self.dj.iter().copied().zip(self.offsets.iter().copied())
     }
 
     /// The layer of a start in row `j0` of a grid of `nz` rows without the
@@ -64,12 +86,14 @@ impl LayerRows {
             offsets: Vec::new(),
             groups: Vec::new(),
             dj: Vec::new(),
+            inside: Vec::new(),
         };
         for g in &self.groups {
             let start = layer.offsets.len();
             for n in g.clone().filter(|&n| real(self.dj[n])) {
                 layer.offsets.push(self.offsets[n]);
                 layer.dj.push(self.dj[n]);
+                layer.inside.push(self.inside[n]);
             }
             if layer.offsets.len() > start {
                 layer.groups.push(start..layer.offsets.len());
