@@ -422,7 +422,9 @@ fn fast_band_impl<const W: usize>(
         // The block may reach below `lo`: those starts do nothing, and the
         // padding's slack keeps them inside the array.
         let block = block_end - W as i64;
-        let inside = |k: usize| !(block >= active[k].end || block_end <= active[k].start);
+        let inside = |k: usize| {
+            !(active[k].is_empty() || block >= active[k].end || block_end <= active[k].start)
+        };
         let mut k = 0;
         while k < band.len() {
             let base = rows[k].first.wrapping_add_signed(block as isize);
@@ -614,14 +616,17 @@ impl ProbeVisits {
     ) -> ProbeVisits {
         let layer = LayerRows::new(padded, fp);
         let nz = padded.spec.nz as i64;
-        let corners: Vec<(i64, i64)> = probes
+        // Sorted by row, to find a row's corners by bisection.
+        let mut corners: Vec<(i64, i64)> = probes
             .iter()
             .flat_map(|probe| {
                 let (i, j) = (probe.cell.0 as i64, probe.cell.1 as i64);
-                [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]
+                [(j, i), (j, i + 1), (j + 1, i), (j + 1, i + 1)]
             })
-            .filter(|&(_, j)| j < nz)
+            .filter(|&(j, _)| j < nz)
             .collect();
+        corners.sort_unstable();
+        corners.dedup();
         let rows = band
             .iter()
             .map(|&j0| {
@@ -631,7 +636,9 @@ impl ProbeVisits {
                 }
                 for (dj, offset) in layer.rows() {
                     let j = j0 as i64 + i64::from(dj);
-                    for &(i, _) in corners.iter().filter(|&&(_, cj)| cj == j) {
+                    let from = corners.partition_point(|&(cj, _)| cj < j);
+                    let row = corners[from..].iter().take_while(|&&(cj, _)| cj == j);
+                    for &(_, i) in row {
                         let node = padded.index(j, i as i32);
                         visits.push((node.wrapping_add_signed(-offset), node));
                     }
