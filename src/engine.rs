@@ -15,7 +15,7 @@ use crate::grid::{GridSpec, HeightGrid};
 use crate::kneeform::GridFootprint;
 use crate::padded::PaddedGrid;
 use crate::paper::{PaperCounts, PaperScratch, paper_row};
-use crate::push::{PushRows, WindowMin, push_block, push_tile};
+use crate::push::{PushRows, WindowMin, WindowOf, push_block, push_tile};
 use crate::ranked::{NEVER, OFF, Rank, RankedGrid};
 use crate::simd::dispatch;
 use crate::slide::{LayerRows, slide_block, slide_carried};
@@ -403,6 +403,7 @@ fn fast_band_impl<const W: usize>(
     let layers: Vec<_> = band.iter().map(|&j0| layer.within(j0, nz)).collect();
     let slider = Slider {
         skip_still: fast.skip_still,
+        still: fast.table.windows_of(W),
         h: &fast.ranked.ranks[window..],
         window,
         nx: padded.spec.nx as i64,
@@ -507,6 +508,9 @@ struct Slider<'a> {
     visits: &'a ProbeVisits,
     /// [`Fast::skip_still`].
     skip_still: bool,
+    /// The minima over a block's width of nodes, where the table holds
+    /// that width ([`slide_block`]).
+    still: Option<WindowOf<'a>>,
 }
 
 impl Slider<'_> {
@@ -537,7 +541,13 @@ impl Slider<'_> {
             }
         }
         let after = if self.moves(layer, base, left, &yr, &level) {
-            slide_block(self.h, reach, layer, base, level)
+            // Rows of the layer that change nothing are passed over, where
+            // no probe needs their reach.
+            let still = (self.skip_still && !self.visits.any(k, base + self.window, W))
+                .then_some(self.still)
+                .flatten()
+                .map(|minima| (minima, self.window));
+            slide_block(self.h, reach, layer, base, level, still)
         } else {
             self.visits.record(k, base + self.window, &level, reach);
             level
@@ -648,6 +658,16 @@ impl ProbeVisits {
             })
             .collect();
         ProbeVisits { rows, window }
+    }
+
+    /// Whether a start of the `k`-th start row's block of `width` starts
+    /// from the padded node `first` meets a probed node.
+    fn any(&self, k: usize, first: usize, width: usize) -> bool {
+        let visits = &self.rows[k];
+        let from = visits.partition_point(|&(start, _)| start < first);
+        visits
+            .get(from)
+            .is_some_and(|&(start, _)| start < first + width)
     }
 
     /// Raises the reach of the probed nodes met by the `k`-th start row's
@@ -852,6 +872,8 @@ mod tests {
     /// above the node (where the strike rule can be met) and every probe's
     /// level are those of sliding every start. Probes on the plateau, below
     /// it, are met only by slides that do not fall, the skipped ones.
+    /// Without probes, the rows of a sliding block's layer that change
+    /// nothing are passed over as well ([`slide_block`]).
     #[test]
     fn skipped_slides_lose_nothing() {
         let knee = KneeForm {
@@ -859,7 +881,7 @@ mod tests {
             radius: 6.0,
             thickness: 100.0,
         };
-        let (mut empty_rows, mut skipped) = (0, 0);
+        let (mut empty_rows, mut skipped, mut passed_over) = (0, 0, 0);
         // Pitches and angles with rows of no node at the footprint's tips
         // (found by laying this knee-form at every whole angle).
         let cases: [(u64, f64, &[f64]); 4] = [
@@ -915,17 +937,21 @@ mod tests {
                     let padded = PaddedGrid::new(&grid, std::slice::from_ref(&fp));
                     let ranked = RankedGrid::new(&padded);
                     let visits = ProbeVisits::new(&padded, &fp, &rows, 0, &probes);
-                    let run = |skip_still: bool, f: BandFn| {
+                    // Without probes, the rows of a layer that change
+                    // nothing are passed over too.
+                    let unprobed = ProbeVisits::new(&padded, &fp, &rows, 0, &[]);
+                    let run_with = |skip_still: bool, f: BandFn, visits: &ProbeVisits| {
                         let mut fast = Fast::new(&padded, &ranked, 64, &StrikeRule::default());
                         fast.skip_still = skip_still;
                         let mut reach = vec![NEVER; padded.h.len()];
-                        let placed = f(&padded, &fast, &fp, &rows, 0, &visits, &mut reach);
+                        let placed = f(&padded, &fast, &fp, &rows, 0, visits, &mut reach);
                         let above: Vec<Rank> = (reach.iter().zip(&ranked.ranks))
                             .map(|(&r, &own)| if r > own { r } else { NEVER })
                             .collect();
                         let levels = probe_levels(&padded, 0, &reach, &probes);
                         (reach, above, levels, placed)
                     };
+                    let run = |skip_still: bool, f: BandFn| run_with(skip_still, f, &visits);
                     let all = run(false, fast_band_impl::<16>);
                     assert!(all.2.iter().any(|&l| l != NEVER));
                     // Narrow blocks: many first lanes, whose left neighbour's
@@ -940,12 +966,19 @@ mod tests {
                         assert!(all.2 == skip.2, "seed {seed}, angle {angle}: probes");
                         assert_eq!(all.3, skip.3);
                         skipped += usize::from(all.0 != skip.0);
+                        let unprobed = run_with(true, f, &unprobed);
+                        assert!(all.1 == unprobed.1, "seed {seed}, angle {angle}: rows");
+                        assert_eq!(all.3, unprobed.3);
+                        passed_over += usize::from(skip.0 != unprobed.0);
                     }
                 }
             }
         }
         // The cases the skip must get right did occur.
-        assert!(empty_rows > 0 && skipped > 0, "{empty_rows} {skipped}");
+        assert!(
+            empty_rows > 0 && skipped > 0 && passed_over > 0,
+            "{empty_rows} {skipped} {passed_over}"
+        );
     }
 
     /// Bands of start rows, their reach windows and the thread count are

@@ -91,12 +91,39 @@ impl<'a> WindowMin<'a> {
         }
     }
 
+    /// The minima over `width` consecutive nodes of the real rows, for a
+    /// power-of-two `width` the table holds, as [`WindowOf`].
+    pub fn windows_of(&self, width: usize) -> Option<WindowOf<'_>> {
+        let l = width.checked_ilog2()? as usize;
+        (width.is_power_of_two() && l <= self.levels.len()).then(|| WindowOf {
+            minima: self.level(l),
+            first: self.first,
+        })
+    }
+
     /// Memory held (bytes), level 0 aside (it is the grid's).
     pub fn bytes(&self) -> usize {
         self.levels
             .iter()
             .map(|l| l.len() * size_of::<Rank>())
             .sum()
+    }
+}
+
+/// A level of [`WindowMin`]: the minimum over a fixed number of
+/// consecutive nodes of a real row, from any node.
+#[derive(Debug, Clone, Copy)]
+pub struct WindowOf<'a> {
+    minima: &'a [Rank],
+    first: usize,
+}
+
+impl WindowOf<'_> {
+    /// The minimum over the window beginning at the padded node `node`, on
+    /// a real row.
+    #[inline(always)]
+    pub fn at(&self, node: usize) -> Rank {
+        self.minima[node - self.first]
     }
 }
 

@@ -26,7 +26,8 @@
 
 use crate::kneeform::GridFootprint;
 use crate::padded::PaddedGrid;
-use crate::ranked::{OFF, Rank};
+use crate::push::WindowOf;
+use crate::ranked::{NEVER, OFF, Rank};
 
 /// The first layer of one footprint, ready for [`slide_block`]: the offset
 /// from a start's node to the first node in front in each footprint row, in
@@ -111,6 +112,15 @@ impl LayerRows {
 /// struck is decided once at the end by SPEC's strike rule applied to that
 /// reach (the rule is monotone in the level). Returns the levels after the
 /// layer.
+///
+/// With `still`, the minima of the `W` nodes from each node of a real row
+/// (whose padded index is `still.1` more than its index in `h`), a layer
+/// row whose `W` nodes are none below any start's level is passed over: it
+/// lowers no level, and it meets each node at a level no higher than the
+/// node's own height, below its strike threshold
+/// ([`crate::ranked::RankedGrid::thresholds`]), so it decides no strike.
+/// Its reach stays as it was, so a caller that reads the reach at levels
+/// below the nodes (the engine's probes) passes `None`.
 #[inline(always)]
 pub fn slide_block<const W: usize>(
     h: &[Rank],
@@ -118,11 +128,20 @@ pub fn slide_block<const W: usize>(
     layer: &LayerRows,
     base: usize,
     mut level: [Rank; W],
+    still: Option<(WindowOf, usize)>,
 ) -> [Rank; W] {
+    // Levels only fall along the slide: the highest at the start bounds
+    // them all.
+    let top = level.iter().copied().max().unwrap_or(NEVER);
     for g in &layer.groups {
         let before = level;
         for &offset in &layer.offsets[g.clone()] {
             let a = base.wrapping_add_signed(offset);
+            if let Some((minima, shift)) = still
+                && minima.at(a + shift) >= top
+            {
+                continue;
+            }
             let hv: &[Rank; W] = h[a..a + W].try_into().expect("W values");
             let r: &mut [Rank; W] = (&mut reach[a..a + W]).try_into().expect("W values");
             for w in 0..W {
