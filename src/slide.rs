@@ -107,7 +107,7 @@ impl LayerRows {
 /// Slides `W` consecutive starts over their first layers. `h` are the
 /// height ranks, `base` the padded node index of the first start,
 /// `level[w]` the level it enters with (`yr` if placed,
-/// [`NEVER`](crate::ranked::NEVER) if not). Every node of the layer
+/// [`NEVER`] if not). Every node of the layer
 /// records in `reach` the highest face level that met it; whether it is
 /// struck is decided once at the end by SPEC's strike rule applied to that
 /// reach (the rule is monotone in the level). Returns the levels after the
