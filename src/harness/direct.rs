@@ -590,15 +590,6 @@ pub struct DirectVerification {
     pub summary: DirectVerifySummary,
 }
 
-fn starts_text(selection: &StartSelection) -> (String, u64) {
-    match *selection {
-        StartSelection::All => ("all".into(), 0),
-        StartSelection::Sample { count, seed } => (count.to_string(), seed),
-        StartSelection::Strip { z } => (format!("strip:{}:{}", z[0], z[1]), 0),
-        StartSelection::At(ref starts) => (format!("{} given", starts.len()), 0),
-    }
-}
-
 /// The direct verification of `shard`'s share of the positions (all of
 /// them without a shard): the study, the share's pairs, the seconds of
 /// their grid side and of the oracle.
@@ -631,7 +622,7 @@ impl DirectVerifySummary {
     /// comparison: no pass, no statistics, no counts, no seconds
     /// ([`DirectVerifySummary::set_comparison`] sets them).
     fn new(input: &PartFile, setup: &Setup, options: &VerifyOptions) -> DirectVerifySummary {
-        let (starts, seed) = starts_text(&options.selection);
+        let (starts, seed) = super::verify::selection_words(&options.selection);
         DirectVerifySummary {
             approach: "direct".into(),
             kneeform_version: env!("CARGO_PKG_VERSION").into(),
@@ -894,7 +885,7 @@ impl DirectConvergeSummary {
         starts: usize,
         oracle_s: f64,
     ) -> DirectConvergeSummary {
-        let (_, seed) = starts_text(&options.selection);
+        let (_, seed) = super::verify::selection_words(&options.selection);
         DirectConvergeSummary {
             approach: "direct".into(),
             kneeform_version: env!("CARGO_PKG_VERSION").into(),
