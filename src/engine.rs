@@ -443,8 +443,8 @@ fn fast_band_impl<const W: usize>(
                 }
                 k += TILE;
             } else {
-                let yr = inside(k)
-                    .then(|| push_block::<W>(&fast.table, push_rows.within(band[k], nz), base));
+                let yr =
+                    inside(k).then(|| push_block::<W>(&fast.table, &push_rows, band[k], nz, base));
                 placed += rows[k].advance(&slider, reach, &layers[k], k, block, yr);
                 k += 1;
             }
@@ -754,7 +754,9 @@ pub fn for_each_push_levels(
                 // The padding's slack covers the lanes past the last column.
                 let levels: [Rank; LANES] = push_block(
                     &table,
-                    rows.within(j0, grid.spec.nz),
+                    &rows,
+                    j0,
+                    grid.spec.nz,
                     padded.index(j0 as i64, 0) + block * LANES,
                 );
                 for (y, &r) in out.iter_mut().zip(&levels) {

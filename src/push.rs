@@ -21,7 +21,7 @@ use crate::ranked::{OFF, Rank};
 ///
 /// Level 0 is the grid's own height ranks (borrowed, not copied), and the
 /// padding rows above and below the grid are left out: they hold only
-/// `+inf`, which never lowers a minimum, so [`PushRows::within`] skips the
+/// `+inf`, which never lowers a minimum, so the push skips the
 /// footprint rows that fall on them. That keeps the table at `levels - 1`
 /// copies of the real rows, the largest item of an analysis's memory.
 #[derive(Debug)]
@@ -160,14 +160,10 @@ impl PushRows {
         }
     }
 
-    /// The rows that fall on the grid's real rows for a start in row `j0`
-    /// of a grid of `nz` rows (the others lie on `+inf` padding).
-    pub fn within(&self, j0: usize, nz: usize) -> &[PushRow] {
-        &self.rows[self.within_range(j0, nz)]
-    }
-
-    /// The indices of [`PushRows::within`]'s rows.
-    fn within_range(&self, j0: usize, nz: usize) -> std::ops::Range<usize> {
+    /// The indices of the rows that fall on the grid's real rows for a
+    /// start in row `j0` of a grid of `nz` rows (the others lie on `+inf`
+    /// padding).
+    fn within(&self, j0: usize, nz: usize) -> std::ops::Range<usize> {
         let j0 = j0 as i64;
         let lo = self.dj.partition_point(|&dj| j0 + i64::from(dj) < 0);
         let hi = self
@@ -195,8 +191,7 @@ pub fn push_tile<const W: usize, const T: usize>(
 ) -> [[Rank; W]; T] {
     let mut yr = [[OFF; W]; T];
     let base = base - table.first;
-    let ranges: [std::ops::Range<usize>; T] =
-        std::array::from_fn(|t| rows.within_range(j0 + t, nz));
+    let ranges: [std::ops::Range<usize>; T] = std::array::from_fn(|t| rows.within(j0 + t, nz));
     let lo = ranges.iter().map(|r| r.start).min().unwrap_or(0);
     let hi = ranges.iter().map(|r| r.end).max().unwrap_or(0);
     for e in lo..hi {
@@ -218,24 +213,19 @@ pub fn push_tile<const W: usize, const T: usize>(
     yr
 }
 
-/// Face levels (ranks) of `W` consecutive starts whose node index (in the
-/// padded grid) begins at `base`: the minimum height over the nodes inside
-/// each footprint, [`OFF`] where none is finite. `rows` are the
-/// footprint's rows [`PushRows::within`] the grid for the starts' row.
+/// Face levels (ranks) of `W` consecutive starts of start row `j0`, in a
+/// grid of `nz` rows, whose node index (in the padded grid) begins at
+/// `base`: the minimum height over the nodes inside each footprint,
+/// [`OFF`] where none is finite. [`push_tile`] of one start row.
 #[inline(always)]
-pub fn push_block<const W: usize>(table: &WindowMin, rows: &[PushRow], base: usize) -> [Rank; W] {
-    let mut yr = [OFF; W];
-    let base = base - table.first;
-    for &(offset, level, second) in rows {
-        let t = table.level(level as usize);
-        let a = base.wrapping_add_signed(offset);
-        let first: &[Rank; W] = t[a..a + W].try_into().expect("W values");
-        let b = a + second as usize;
-        let last: &[Rank; W] = t[b..b + W].try_into().expect("W values");
-        for w in 0..W {
-            yr[w] = yr[w].min(first[w].min(last[w]));
-        }
-    }
+pub fn push_block<const W: usize>(
+    table: &WindowMin,
+    rows: &PushRows,
+    j0: usize,
+    nz: usize,
+    base: usize,
+) -> [Rank; W] {
+    let [yr] = push_tile::<W, 1>(table, rows, j0, nz, 0, base);
     yr
 }
 
