@@ -31,12 +31,14 @@ use crate::ranked::{NEVER, OFF, Rank};
 
 /// The first layer of one footprint, ready for [`slide_block`]: the offset
 /// from a start's node to the first node in front in each footprint row, in
-/// slide order, and the tie groups (ranges of that order whose distances
+/// slide order, and the tie groups (runs of that order whose distances
 /// agree within [`NODE_TOL`](crate::kneeform::NODE_TOL)).
 #[derive(Debug, Clone)]
 pub struct LayerRows {
     offsets: Vec<isize>,
-    groups: Vec<std::ops::Range<usize>>,
+    /// Each offset's tie group, numbered in slide order: a group is the
+    /// run of offsets with one number.
+    group: Vec<u32>,
     /// Each offset's footprint row `dj`.
     dj: Vec<i32>,
     /// Whether each offset's footprint row has nodes inside the footprint.
@@ -51,7 +53,12 @@ impl LayerRows {
         let rows = || fp.slide_order.iter().map(|&r| &fp.rows[r as usize]);
         LayerRows {
             offsets: rows().map(|row| grid.offset(row.dj, row.kf)).collect(),
-            groups: fp.groups.clone(),
+            group: fp
+                .groups
+                .iter()
+                .zip(0..)
+                .flat_map(|(g, n)| g.clone().map(move |_| n))
+                .collect(),
             dj: rows().map(|row| row.dj).collect(),
             inside: rows().map(|row| row.khi >= row.klo).collect(),
         }
@@ -85,20 +92,15 @@ impl LayerRows {
         }
         let mut layer = LayerRows {
             offsets: Vec::new(),
-            groups: Vec::new(),
+            group: Vec::new(),
             dj: Vec::new(),
             inside: Vec::new(),
         };
-        for g in &self.groups {
-            let start = layer.offsets.len();
-            for n in g.clone().filter(|&n| real(self.dj[n])) {
-                layer.offsets.push(self.offsets[n]);
-                layer.dj.push(self.dj[n]);
-                layer.inside.push(self.inside[n]);
-            }
-            if layer.offsets.len() > start {
-                layer.groups.push(start..layer.offsets.len());
-            }
+        for n in (0..self.offsets.len()).filter(|&n| real(self.dj[n])) {
+            layer.offsets.push(self.offsets[n]);
+            layer.group.push(self.group[n]);
+            layer.dj.push(self.dj[n]);
+            layer.inside.push(self.inside[n]);
         }
         std::borrow::Cow::Owned(layer)
     }
@@ -133,15 +135,32 @@ pub fn slide_block<const W: usize>(
     // Levels only fall along the slide: the highest at the start bounds
     // them all.
     let top = level.iter().copied().max().unwrap_or(NEVER);
-    for g in &layer.groups {
-        let before = level;
-        for &offset in &layer.offsets[g.clone()] {
-            let a = base.wrapping_add_signed(offset);
-            if let Some((minima, shift)) = still
-                && minima.at(a + shift) >= top
-            {
-                continue;
+    // The level before the current tie group: its nodes are all met at it.
+    let mut group = None;
+    let mut before = level;
+    // The layer's rows by chunks of 64: first which of them to slide over,
+    // with no branch between the minima's loads (they mostly miss the
+    // cache, and a branch on each made them wait on one another), then
+    // those rows in slide order.
+    for (chunk, offsets) in layer.offsets.chunks(64).enumerate() {
+        let mut slid = match still {
+            Some((minima, shift)) => offsets.iter().enumerate().fold(0u64, |slid, (n, &offset)| {
+                let a = base.wrapping_add_signed(offset);
+                slid | u64::from(minima.at(a + shift) < top) << n
+            }),
+            None => u64::MAX >> (64 - offsets.len()),
+        };
+        while slid != 0 {
+            let n = slid.trailing_zeros() as usize;
+            slid &= slid - 1;
+            let e = chunk * 64 + n;
+            // Passed-over rows change no level, so the level on entering a
+            // group's first slid row is the level before the group.
+            if group != Some(layer.group[e]) {
+                group = Some(layer.group[e]);
+                before = level;
             }
+            let a = base.wrapping_add_signed(offsets[n]);
             let hv: &[Rank; W] = h[a..a + W].try_into().expect("W values");
             let r: &mut [Rank; W] = (&mut reach[a..a + W]).try_into().expect("W values");
             for w in 0..W {
@@ -168,13 +187,16 @@ pub fn slide_carried(
     if layer.offsets.iter().all(|o| h[at(o)] == OFF) {
         return carry;
     }
-    for g in &layer.groups {
-        let before = carry;
-        for offset in &layer.offsets[g.clone()] {
-            let a = at(offset);
-            reach[a] = reach[a].max(before);
-            carry = carry.min(h[a]);
+    let mut group = None;
+    let mut before = carry;
+    for (offset, &g) in layer.offsets.iter().zip(&layer.group) {
+        if group != Some(g) {
+            group = Some(g);
+            before = carry;
         }
+        let a = at(offset);
+        reach[a] = reach[a].max(before);
+        carry = carry.min(h[a]);
     }
     carry
 }
