@@ -139,7 +139,38 @@ pub fn micrometres(v: f64) -> String {
     s
 }
 
-fn push_micrometres(s: &mut String, v: f64) {
+/// [`micrometres`] appended to `s`.
+pub(super) fn push_micrometres(s: &mut String, v: f64) {
+    // Most values are rounded here with integers. `m` is the product
+    // rounded to the nearest double; that rounding is monotone and every
+    // half below 2^52 is a double, so `m` lies on the same side of each
+    // half as the exact product, or on it. Off the halves, rounding `m` to
+    // the nearest integer therefore gives the exact product's rounding. On
+    // a half (a tie, or a product just beside one), and for huge or
+    // non-finite values, `{:.3}` decides: the definition.
+    let m = v * 1000.0;
+    if m.abs() < 4e15 && m - m.floor() != 0.5 {
+        let n = m.round() as i64;
+        if n < 0 {
+            s.push('-');
+        }
+        let n = n.unsigned_abs();
+        write!(s, "{}", n / 1000).expect("writing to a String cannot fail");
+        let (mut fraction, mut digits) = (n % 1000, MICROMETRE_DIGITS);
+        if fraction != 0 {
+            while fraction % 10 == 0 {
+                fraction /= 10;
+                digits -= 1;
+            }
+            write!(s, ".{fraction:0digits$}").expect("writing to a String cannot fail");
+        }
+        return;
+    }
+    push_micrometres_exact(s, v);
+}
+
+/// [`micrometres`] by its definition: `{:.3}`, trimmed.
+fn push_micrometres_exact(s: &mut String, v: f64) {
     let start = s.len();
     write!(s, "{v:.MICROMETRE_DIGITS$}").expect("writing to a String cannot fail");
     if s[start..].contains('.') {
@@ -313,6 +344,36 @@ mod tests {
                 m => format!("-{m}"),
             };
             assert_eq!(micrometres(-v.abs()), negated, "{v}");
+        }
+    }
+
+    #[test]
+    fn micrometres_agree_with_their_definition() {
+        let exact = |v: f64| {
+            let mut s = String::new();
+            push_micrometres_exact(&mut s, v);
+            s
+        };
+        // Halves and their neighbours (where the shortcut must step
+        // aside), grid-like coordinates, and values from tiny to huge.
+        let mut values = vec![0.0, -0.0, 0.0005, -0.0005, 2.5e-4, 1e9, -1e12, 1.0 / 3.0];
+        for k in -3000..3000 {
+            let half = (f64::from(k) + 0.5) / 1000.0;
+            values.extend([half, half.next_up(), half.next_down(), f64::from(k) * 0.124]);
+        }
+        let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
+        for _ in 0..100_000 {
+            // xorshift64: spread over magnitudes 1e-4 .. 1e7, both signs.
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let unit = (x >> 11) as f64 / (1u64 << 53) as f64;
+            let v = 10f64.powf(unit * 11.0 - 4.0);
+            values.push(if x & 1 == 0 { v } else { -v });
+        }
+        values.extend([f64::INFINITY, f64::NEG_INFINITY, f64::NAN]);
+        for v in values {
+            assert_eq!(micrometres(v), exact(v), "{v:e}");
         }
     }
 

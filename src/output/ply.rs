@@ -12,13 +12,14 @@
 //! its own colour. ASCII PLY, so the file can be read and diffed as text;
 //! coordinates to 1 um, as in `composite.csv`.
 
+use std::fmt::Write as _;
 use std::io::{self, Write};
 
 use crate::frame::Placement;
 use crate::grid::HeightGrid;
 
 use super::count_colour;
-use super::csv::micrometres;
+use super::csv::push_micrometres;
 use super::surface::{AreaSurface, to_part, wound};
 
 /// Writes the composite area (nodes with `composite > 0`) as an ASCII PLY
@@ -57,21 +58,18 @@ pub fn write_colliding_area_ply<W: Write>(
     writeln!(w, "element face {}", mesh.faces.len())?;
     writeln!(w, "property list uchar int vertex_indices")?;
     writeln!(w, "end_header")?;
+    // To 1 um, as composite.csv (-0 as 0: mirroring a zero height must not
+    // change the file).
+    let mut line = String::new();
     for &(v, count) in &mesh.vertices {
-        let [x, y, z] = to_part(v, placement);
+        line.clear();
+        for coordinate in to_part(v, placement) {
+            push_micrometres(&mut line, coordinate);
+            line.push(' ');
+        }
         let c = count_colour(usize::from(count), n);
-        // To 1 um, as composite.csv (-0 as 0: mirroring a zero height must
-        // not change the file).
-        writeln!(
-            w,
-            "{} {} {} {} {} {} {count}",
-            micrometres(x),
-            micrometres(y),
-            micrometres(z),
-            c.0,
-            c.1,
-            c.2
-        )?;
+        writeln!(line, "{} {} {} {count}", c.0, c.1, c.2).expect("writing to a String cannot fail");
+        w.write_all(line.as_bytes())?;
     }
     for &f in &mesh.faces {
         let [a, b, c] = wound(f, placement.side);
