@@ -52,7 +52,7 @@ pub struct Timings {
     pub blind_s: f64,
     /// Writing the output files.
     pub write_s: f64,
-    /// Everything.
+    /// Every stage above, the blind spots' included.
     pub total_s: f64,
 }
 
