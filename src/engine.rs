@@ -99,10 +99,12 @@ const LANES: usize = 16;
 /// flat in the thread count. Deciding strikes per window costs one pass
 /// over `(BAND_ROWS + footprint rows) / BAND_ROWS` times the grid per
 /// angle. Within a band every block of starts is swept over all its start
-/// rows, so the footprint rows they share stay in cache: 128 rows measured
-/// a little faster than 64 on the benchmark (and than 256; within the
-/// machine's noise, about 10%).
-pub const BAND_ROWS: usize = 128;
+/// rows, so the footprint rows they share stay in cache. On the README run
+/// (2 threads, median of 3), 512 rows took 4.72 s of processor time
+/// against 4.91 for 128 (wall 2.77 s against 2.88), the window's passes
+/// being fewer; 1024 was a little faster again but held 401 MiB at 16
+/// threads (issue 11 allows 400), 512 held 311.
+pub const BAND_ROWS: usize = 512;
 
 /// Start rows pushed at once ([`push_tile`]).
 const TILE: usize = 4;
