@@ -67,8 +67,6 @@ impl MemoryEstimate {
         let n = spec.nx as f64 * spec.nz as f64;
         let padding = Padding::of(spec, footprints);
         let padded = padding.nodes(spec) as f64;
-        let real_rows = padding.stride as f64 * spec.nz as f64;
-        let levels = WindowMin::levels(WindowMin::max_width(footprints)) as f64;
         let angles = footprints.len() as f64;
         let threads = threads.max(1);
         let angles_in_flight = threads.min(footprints.len().max(1)) as f64;
@@ -92,7 +90,11 @@ impl MemoryEstimate {
                 // The ranks, the strike thresholds and the distinct heights
                 // (at most one per node).
                 ("ranks", 4.0 * padded + 4.0 * padded + 8.0 * n),
-                ("push table", 4.0 * (levels - 1.0) * real_rows),
+                (
+                    "push table",
+                    WindowMin::bytes_for(spec.nz, padding.stride, WindowMin::max_width(footprints))
+                        as f64,
+                ),
                 // A rank of reach and a strike byte per window node.
                 ("bands running", tasks * (5.0 * window).max(padded)),
                 ("angles in flight", angles_in_flight * n),

@@ -9,12 +9,27 @@
 //! costs two loads and two comparisons. [`push_block`] does a block of
 //! consecutive starts at once, their levels held in vector registers.
 //!
+//! **Most footprint rows are never read.** The rows are taken in groups of
+//! sixteen, and a second table (`GroupMin`: minima over blocks of eight
+//! grid rows) gives, in a few loads, a lower bound of every
+//! height a group covers for the whole block of starts. The groups are
+//! read lowest bound first, and once a group's bound is no lower than the
+//! highest level found so far among the block's starts, neither it nor any
+//! group after it can lower a level: the minimum is already exact. On a
+//! part's surface the lowest node of a footprint lies near one edge, and
+//! the groups far from it are passed over: the README run took 3.5 s of
+//! processor time against 4.8 reading every row, and the console at
+//! 0.5 mm (640 footprint rows) 20 s against 43 s end to end. Where no
+//! group can be passed over (a rough surface, a block of starts with one
+//! that meets no node), the bounds add a few scalar loads to the 64
+//! vector loads each group's row costs a tile.
+//!
 //! Heights are taken as their ranks ([`crate::ranked`]): minima of ranks
 //! are the ranks of minima, exactly.
 
 use crate::kneeform::GridFootprint;
-use crate::padded::{PaddedGrid, fmin};
-use crate::ranked::{OFF, Rank};
+use crate::padded::{LANE_SLACK, PaddedGrid, fmin};
+use crate::ranked::{NEVER, OFF, Rank};
 
 /// Row window minima of a padded height grid's real rows, for every
 /// power-of-two width.
@@ -33,6 +48,10 @@ pub struct WindowMin<'a> {
     levels: Vec<Vec<Rank>>,
     /// Padded index of the first real row's first node.
     first: usize,
+    /// The length of a row.
+    stride: usize,
+    /// Lower bounds over blocks of rows, for the pruned push.
+    groups: GroupMin,
 }
 
 impl<'a> WindowMin<'a> {
@@ -78,6 +97,8 @@ impl<'a> WindowMin<'a> {
             heights,
             levels,
             first,
+            stride,
+            groups: GroupMin::new(heights, stride, max_width + LANE_SLACK),
         }
     }
 
@@ -105,8 +126,99 @@ impl<'a> WindowMin<'a> {
     pub fn bytes(&self) -> usize {
         self.levels
             .iter()
+            .chain(&self.groups.levels)
             .map(|l| l.len() * size_of::<Rank>())
             .sum()
+    }
+
+    /// The bytes [`WindowMin::bytes`] will be for a grid of `nz` real rows
+    /// of `stride` nodes and windows up to `max_width` nodes.
+    pub fn bytes_for(nz: usize, stride: usize, max_width: usize) -> usize {
+        let rows = (WindowMin::levels(max_width) - 1) * nz;
+        let group_rows = WindowMin::levels(max_width + LANE_SLACK) * nz.div_ceil(GROUP_ROWS);
+        (rows + group_rows) * stride * size_of::<Rank>()
+    }
+}
+
+/// Grid rows per block of [`GroupMin`].
+const GROUP_ROWS: usize = 8;
+
+/// Footprint rows per group of the pruned push ([`push_tile`]).
+const PUSH_GROUP: usize = 16;
+
+/// The minima over blocks of [`GROUP_ROWS`] real rows and power-of-two
+/// runs of columns: a lower bound, in a few loads, of the heights in any
+/// rectangle of the grid (exact in its columns, its rows rounded out to
+/// whole blocks).
+#[derive(Debug)]
+struct GroupMin {
+    /// `levels[l][b * stride + x]` = min of the ranks over the real rows
+    /// `GROUP_ROWS * b ..` (the block `b`) and the columns `x .. x + 2^l`
+    /// ([`OFF`] past the row's end).
+    levels: Vec<Vec<Rank>>,
+    stride: usize,
+    /// Real rows.
+    nz: usize,
+}
+
+impl GroupMin {
+    /// The blocks of `heights` (real rows of `stride` nodes) for runs of
+    /// columns up to `max_width` wide.
+    fn new(heights: &[Rank], stride: usize, max_width: usize) -> GroupMin {
+        let nz = heights.len() / stride;
+        let mut level0 = vec![OFF; nz.div_ceil(GROUP_ROWS) * stride];
+        for (dst, rows) in level0
+            .chunks_exact_mut(stride)
+            .zip(heights.chunks(GROUP_ROWS * stride))
+        {
+            for row in rows.chunks_exact(stride) {
+                for (d, &h) in dst.iter_mut().zip(row) {
+                    *d = (*d).min(h);
+                }
+            }
+        }
+        let mut levels = vec![level0];
+        let mut width = 1;
+        for _ in 1..WindowMin::levels(max_width) {
+            let prev = levels.last().expect("level 0 is there");
+            let mut next = vec![OFF; prev.len()];
+            for (dst, src) in next.chunks_exact_mut(stride).zip(prev.chunks_exact(stride)) {
+                let n = stride - width;
+                for x in 0..n {
+                    dst[x] = src[x].min(src[x + width]);
+                }
+                dst[n..].copy_from_slice(&src[n..]);
+            }
+            levels.push(next);
+            width *= 2;
+        }
+        GroupMin { levels, stride, nz }
+    }
+
+    /// A lower bound of the ranks in the real rows `rows` (any, clipped to
+    /// the grid) and the columns `x_lo ..= x_hi` of a row.
+    #[inline(always)]
+    fn below(&self, rows: std::ops::RangeInclusive<i64>, x_lo: usize, x_hi: usize) -> Rank {
+        let lo = (*rows.start()).max(0);
+        let hi = (*rows.end()).min(self.nz as i64 - 1);
+        if lo > hi {
+            return OFF;
+        }
+        // Runs of the widest level the width allows, the last ending at
+        // `x_hi`: two, unless the width is past the table's widest.
+        let l = ((x_hi - x_lo + 1).ilog2() as usize).min(self.levels.len() - 1);
+        let (level, run) = (&self.levels[l], 1 << l);
+        let mut bound = OFF;
+        for block in lo as usize / GROUP_ROWS..=hi as usize / GROUP_ROWS {
+            let row = &level[block * self.stride..];
+            let mut x = x_lo;
+            while x + run <= x_hi {
+                bound = bound.min(row[x]);
+                x += run;
+            }
+            bound = bound.min(row[x_hi + 1 - run]);
+        }
+        bound
     }
 }
 
@@ -139,6 +251,19 @@ pub struct PushRows {
     rows: Vec<PushRow>,
     /// Each row's `dj`, ascending.
     dj: Vec<i32>,
+    /// The rows in runs of [`PUSH_GROUP`], in order.
+    groups: Vec<PushGroup>,
+}
+
+/// A run of consecutive rows of [`PushRows`] and the rectangle (relative to
+/// a start) that holds their nodes inside the footprint.
+#[derive(Debug, Clone)]
+struct PushGroup {
+    rows: std::ops::Range<usize>,
+    /// The first and last row's `dj`.
+    dj: (i32, i32),
+    /// The lowest `klo` and highest `khi` of the rows.
+    k: (i32, i32),
 }
 
 impl PushRows {
@@ -154,9 +279,24 @@ impl PushRows {
                 (grid.offset(r.dj, r.klo), level, width - (1 << level))
             })
             .collect();
+        let groups = (0..inside.len())
+            .step_by(PUSH_GROUP)
+            .map(|first| {
+                let run = &inside[first..(first + PUSH_GROUP).min(inside.len())];
+                PushGroup {
+                    rows: first..first + run.len(),
+                    dj: (run[0].dj, run[run.len() - 1].dj),
+                    k: (
+                        run.iter().map(|r| r.klo).min().expect("a run has rows"),
+                        run.iter().map(|r| r.khi).max().expect("a run has rows"),
+                    ),
+                }
+            })
+            .collect();
         PushRows {
             rows,
             dj: inside.iter().map(|r| r.dj).collect(),
+            groups,
         }
     }
 
@@ -179,7 +319,8 @@ impl PushRows {
 /// taken footprint row by footprint row, each for the `T` start rows in
 /// turn, so the grid rows they read are read again by the next footprint
 /// row (one grid row up for one start row down), while still in the
-/// first-level cache.
+/// first-level cache; and group by group, lowest bound first, until no
+/// group left can lower a level (the module's doc).
 #[inline(always)]
 pub fn push_tile<const W: usize, const T: usize>(
     table: &WindowMin,
@@ -194,19 +335,49 @@ pub fn push_tile<const W: usize, const T: usize>(
     let ranges: [std::ops::Range<usize>; T] = std::array::from_fn(|t| rows.within(j0 + t, nz));
     let lo = ranges.iter().map(|r| r.start).min().unwrap_or(0);
     let hi = ranges.iter().map(|r| r.end).max().unwrap_or(0);
-    for e in lo..hi {
-        let (offset, level, second) = rows.rows[e];
-        let t_level = table.level(level as usize);
-        for (t, yr) in yr.iter_mut().enumerate() {
-            if !ranges[t].contains(&e) {
-                continue;
+    // The groups of footprint rows, lowest bound first: a group whose
+    // bound is no lower than every level found so far cannot lower one.
+    let x = base - j0 * table.stride;
+    let mut order: Vec<(Rank, u32)> = rows
+        .groups
+        .iter()
+        .zip(0..)
+        .filter(|(g, _)| g.rows.start < hi && g.rows.end > lo)
+        .map(|(g, n)| {
+            let rows = j0 as i64 + i64::from(g.dj.0)..=(j0 + T - 1) as i64 + i64::from(g.dj.1);
+            let x_lo = x.wrapping_add_signed(g.k.0 as isize);
+            let x_hi = x.wrapping_add_signed((W - 1) as isize + g.k.1 as isize);
+            (table.groups.below(rows, x_lo, x_hi), n)
+        })
+        .collect();
+    order.sort_unstable();
+    let live: [bool; T] = std::array::from_fn(|t| !ranges[t].is_empty());
+    let mut top = OFF;
+    for (bound, n) in order {
+        if bound >= top {
+            break;
+        }
+        let group = rows.groups[n as usize].rows.clone();
+        for e in group.start.max(lo)..group.end.min(hi) {
+            let (offset, level, second) = rows.rows[e];
+            let t_level = table.level(level as usize);
+            for (t, yr) in yr.iter_mut().enumerate() {
+                if !ranges[t].contains(&e) {
+                    continue;
+                }
+                let a = (base + t * stride).wrapping_add_signed(offset);
+                let first: &[Rank; W] = t_level[a..a + W].try_into().expect("W values");
+                let b = a + second as usize;
+                let last: &[Rank; W] = t_level[b..b + W].try_into().expect("W values");
+                for w in 0..W {
+                    yr[w] = yr[w].min(first[w].min(last[w]));
+                }
             }
-            let a = (base + t * stride).wrapping_add_signed(offset);
-            let first: &[Rank; W] = t_level[a..a + W].try_into().expect("W values");
-            let b = a + second as usize;
-            let last: &[Rank; W] = t_level[b..b + W].try_into().expect("W values");
-            for w in 0..W {
-                yr[w] = yr[w].min(first[w].min(last[w]));
+        }
+        top = NEVER;
+        for (yr, _) in yr.iter().zip(live).filter(|&(_, live)| live) {
+            for &level in yr {
+                top = top.max(level);
             }
         }
     }
@@ -242,4 +413,123 @@ pub fn push_start_literal(grid: &PaddedGrid, fp: &GridFootprint, i0: usize, j0: 
         }
     }
     yr
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::{GridSpec, HeightGrid};
+    use crate::kneeform::KneeForm;
+    use crate::ranked::RankedGrid;
+
+    /// The pruned push ([`push_tile`] passing over groups of footprint
+    /// rows whose lower bound cannot lower a level) gives every start the
+    /// paper's push, the minimum over every node of its footprint, on
+    /// surfaces where the lowest node lies anywhere: a bowl, slopes both
+    /// ways with pits, a plateau of equal heights, rough ground with holes
+    /// and islands in a part mostly off.
+    #[test]
+    fn pruned_push_is_the_minimum_over_the_footprint() {
+        let knee = KneeForm {
+            triangle_side: 40.0,
+            radius: 8.0,
+            thickness: 100.0,
+        };
+        let spec = GridSpec {
+            pitch: 0.9,
+            i_origin: -30,
+            j_origin: -20,
+            nx: 120,
+            nz: 70,
+        };
+        let mut rng = crate::harness::compare::SplitMix(11);
+        let mut noise = move || (rng.next() >> 11) as f64 / (1u64 << 53) as f64;
+        let surfaces: Vec<Vec<f64>> = vec![
+            // A bowl: the lowest node in the footprint's middle.
+            (0..spec.len())
+                .map(|n| {
+                    let (x, z) = (spec.x(n % spec.nx), spec.z(n / spec.nx));
+                    0.01 * ((x - 40.0).powi(2) + (z - 10.0).powi(2))
+                })
+                .collect(),
+            // Slopes along x and z with sparse pits deeper than the slope.
+            (0..spec.len())
+                .map(|n| {
+                    let (i, j) = (n % spec.nx, n / spec.nx);
+                    let pit = noise() < 0.01;
+                    0.3 * i as f64 - 0.2 * j as f64 - if pit { 30.0 } else { 0.0 }
+                })
+                .collect(),
+            // A plateau: every level ties.
+            vec![2.5; spec.len()],
+            // Rough ground with holes.
+            (0..spec.len())
+                .map(|_| {
+                    let r = noise();
+                    if r < 0.1 {
+                        f64::INFINITY
+                    } else {
+                        (r * 40.0).floor()
+                    }
+                })
+                .collect(),
+            // Islands in a part mostly off: many footprints meet none.
+            (0..spec.len())
+                .map(|n| {
+                    let (i, j) = (n % spec.nx, n / spec.nx);
+                    if i % 37 < 3 && j % 23 < 4 {
+                        -(i as f64) - j as f64
+                    } else {
+                        f64::INFINITY
+                    }
+                })
+                .collect(),
+        ];
+        for h in surfaces {
+            let grid = HeightGrid { spec, h };
+            for angle in [-30.0, -7.0, 0.0, 13.0, 30.0] {
+                let fp = GridFootprint::new(&knee, angle, &spec);
+                assert!(fp.rows.len() > 2 * PUSH_GROUP, "several groups of rows");
+                let padded = PaddedGrid::new(&grid, std::slice::from_ref(&fp));
+                let ranked = RankedGrid::new(&padded);
+                let table = WindowMin::new(
+                    &padded,
+                    &ranked.ranks,
+                    WindowMin::max_width(std::slice::from_ref(&fp)),
+                );
+                let rows = PushRows::new(&padded, &fp);
+                let nz = spec.nz;
+                let check = |j0: usize, block: i64, yr: &[Rank]| {
+                    for (w, &yr) in yr.iter().enumerate() {
+                        let i0 = block + w as i64;
+                        if (0..spec.nx as i64).contains(&i0) {
+                            let literal = push_start_literal(&padded, &fp, i0 as usize, j0);
+                            assert_eq!(
+                                ranked.height(yr),
+                                literal,
+                                "start ({i0}, {j0}) at {angle} degrees"
+                            );
+                        }
+                    }
+                };
+                for block in (-16..spec.nx as i64).step_by(16) {
+                    for j0 in 0..nz {
+                        let base = padded
+                            .index(j0 as i64, 0)
+                            .wrapping_add_signed(block as isize);
+                        check(j0, block, &push_block::<16>(&table, &rows, j0, nz, base));
+                    }
+                    for j0 in 0..nz - 3 {
+                        let base = padded
+                            .index(j0 as i64, 0)
+                            .wrapping_add_signed(block as isize);
+                        let tile = push_tile::<16, 4>(&table, &rows, j0, nz, padded.stride, base);
+                        for (t, yr) in tile.iter().enumerate() {
+                            check(j0 + t, block, yr);
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
