@@ -50,6 +50,9 @@ fi
 
 if [[ "$what" == all || "$what" == bench ]]; then
   "$bin" bench --runs 5 --markdown results/bench.md
+  # One binary's figures under the load of the moment; a change's ratio
+  # needs both binaries in one run.
+  printf '\n%s\n' "Before and after a change, both binaries alternating in one run: [ab.md](ab.md) (\`bash results/regenerate.sh ab REV\`)." >> results/bench.md
 fi
 
 # The before/after of a change, end to end and measured in one run (the
@@ -103,8 +106,8 @@ PY
 fi
 
 # The fine pitches on the bundled console (`scenarios/console.toml`, 600 x
-# 300 mm class): 0.5 mm with SPEC's 61 angles, and 0.25 mm with 3 (its 61
-# would take about half an hour here): time by stage, peak RSS against the
+# 300 mm class): 0.5 mm and 0.25 mm with SPEC's 61 angles (about 4 minutes
+# in all here, 5 GiB at the finer): time by stage, peak RSS against the
 # memory estimate.
 if [[ "$what" == pitch ]]; then
   work=$(mktemp -d)
@@ -119,7 +122,7 @@ if [[ "$what" == pitch ]]; then
     echo
     echo "| pitch mm | angles | grid | push+slide s | per angle s | total s | write s | peak MiB | estimate MiB |"
     echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
-    for run in "0.5 -30:30:1" "0.25 -30,0,30"; do
+    for run in "0.5 -30:30:1" "0.25 -30:30:1"; do
       set -- $run
       rm -rf "$work/out"
       "$bin" analyze scenarios/console.toml --pitch "$1" --angles="$2" --threads 2 \
