@@ -79,19 +79,9 @@ impl<'a> WindowMin<'a> {
         let first = grid.pad_rows * stride;
         let heights = &ranks[first..first + grid.spec.nz * stride];
         let mut levels: Vec<Vec<Rank>> = Vec::new();
-        let mut width = 1;
-        for _ in 1..WindowMin::levels(max_width) {
+        for l in 1..WindowMin::levels(max_width) {
             let prev = levels.last().map_or(heights, Vec::as_slice);
-            let mut next = vec![OFF; prev.len()];
-            for (dst, src) in next.chunks_exact_mut(stride).zip(prev.chunks_exact(stride)) {
-                let n = stride - width;
-                for x in 0..n {
-                    dst[x] = src[x].min(src[x + width]);
-                }
-                dst[n..].copy_from_slice(&src[n..]);
-            }
-            levels.push(next);
-            width *= 2;
+            levels.push(doubled(prev, stride, 1 << (l - 1)));
         }
         WindowMin {
             heights,
@@ -140,6 +130,22 @@ impl<'a> WindowMin<'a> {
     }
 }
 
+/// The next level of a table of row window minima: from the minima over
+/// `width` nodes in `prev` (rows of `stride` nodes), the minima over
+/// `2 * width`. A window running past its row's end takes only the nodes
+/// in the row (the rest would be `+inf`).
+fn doubled(prev: &[Rank], stride: usize, width: usize) -> Vec<Rank> {
+    let mut next = vec![OFF; prev.len()];
+    for (dst, src) in next.chunks_exact_mut(stride).zip(prev.chunks_exact(stride)) {
+        let n = stride - width;
+        for x in 0..n {
+            dst[x] = src[x].min(src[x + width]);
+        }
+        dst[n..].copy_from_slice(&src[n..]);
+    }
+    next
+}
+
 /// Grid rows per block of [`GroupMin`].
 const GROUP_ROWS: usize = 8;
 
@@ -178,19 +184,9 @@ impl GroupMin {
             }
         }
         let mut levels = vec![level0];
-        let mut width = 1;
-        for _ in 1..WindowMin::levels(max_width) {
+        for l in 1..WindowMin::levels(max_width) {
             let prev = levels.last().expect("level 0 is there");
-            let mut next = vec![OFF; prev.len()];
-            for (dst, src) in next.chunks_exact_mut(stride).zip(prev.chunks_exact(stride)) {
-                let n = stride - width;
-                for x in 0..n {
-                    dst[x] = src[x].min(src[x + width]);
-                }
-                dst[n..].copy_from_slice(&src[n..]);
-            }
-            levels.push(next);
-            width *= 2;
+            levels.push(doubled(prev, stride, 1 << (l - 1)));
         }
         GroupMin { levels, stride, nz }
     }
