@@ -295,7 +295,7 @@ fn fast_window(
     let start = first_row * padded.stride;
     let end = (last_row + 1) * padded.stride;
     let mut reach = vec![NEVER; end - start];
-    let visits = ProbeVisits::new(padded, fp, band, start, &options.probes);
+    let visits = ProbeVisits::new(padded, fp, band, start, end - start, &options.probes);
     let placed = fast_band(padded, fast, fp, band, start, &visits, &mut reach);
     let strikes = strike_mask(&fast.thresholds[start..end], &reach);
     let probe_levels = probe_levels(padded, start, &reach, &options.probes)
@@ -551,7 +551,8 @@ impl Slider<'_> {
                 .map(|minima| (minima, self.window));
             slide_block(self.h, reach, layer, base, level, still)
         } else {
-            self.visits.record(k, base + self.window, &level, reach);
+            self.visits
+                .record(k, base + self.window, layer, &level, reach);
             level
         };
         // Starts that are not placed continue the slide of the start on
@@ -605,96 +606,175 @@ impl Slider<'_> {
     }
 }
 
-/// The probed nodes the slides of a band meet: per start row of the band,
-/// `(start, node)` for every start whose first layer holds a corner node
-/// of a probe, as padded indices, sorted. A skipped block of slides
+/// The probed nodes the slides of a band meet. A skipped block of slides
 /// ([`fast_band_impl`]) still raises their reach to the level that met
 /// them, so that the probes see every level, as without the skip.
+///
+/// Two bitmaps, so that neither time nor memory grows with the probes
+/// beyond one pass over their corners: the probes' corner nodes over the
+/// band's reach window, and per start row of the band the starts whose
+/// first layer holds one (a part with tens of thousands of blind spots
+/// once made sorted lists of these visits take most of an analysis's time
+/// and eight times its memory estimate).
 struct ProbeVisits {
-    rows: Vec<Vec<(usize, usize)>>,
+    /// A bit per node of the reach window: the probes' corner nodes.
+    corners: Vec<u64>,
+    /// Per start row of the band, a bit per column of its padded row: the
+    /// starts whose first layer holds a corner. Empty without probes.
+    starts: Vec<Vec<u64>>,
+    /// Per start row of the band, the padded index of its row's first node.
+    row_first: Vec<usize>,
     /// The padded index of the reach window's first node.
     window: usize,
 }
 
 impl ProbeVisits {
     /// The visits of `probes` by the slides of `band` at the angle of `fp`,
-    /// with the reach window beginning at the padded node `window`.
+    /// with the reach window the `len` padded nodes from `window`.
     fn new(
         padded: &PaddedGrid,
         fp: &GridFootprint,
         band: &[usize],
         window: usize,
+        len: usize,
         probes: &[Probe],
     ) -> ProbeVisits {
-        let layer = LayerRows::new(padded, fp);
+        let stride = padded.stride;
+        let row_first: Vec<usize> = band
+            .iter()
+            .map(|&j0| padded.index(j0 as i64, 0) - padded.pad_lo)
+            .collect();
         let nz = padded.spec.nz as i64;
-        // Sorted by row, to find a row's corners by bisection.
-        let mut corners: Vec<(i64, i64)> = probes
+        let corners: Vec<usize> = probes
             .iter()
             .flat_map(|probe| {
                 let (i, j) = (probe.cell.0 as i64, probe.cell.1 as i64);
                 [(j, i), (j, i + 1), (j + 1, i), (j + 1, i + 1)]
             })
             .filter(|&(j, _)| j < nz)
+            .map(|(j, i)| padded.index(j, i as i32))
+            .filter(|node| (window..window + len).contains(node))
             .collect();
-        corners.sort_unstable();
-        corners.dedup();
-        let rows = band
-            .iter()
-            .map(|&j0| {
-                let mut visits: Vec<(usize, usize)> = Vec::new();
-                if corners.is_empty() {
-                    return visits;
+        if corners.is_empty() || band.is_empty() {
+            return ProbeVisits {
+                corners: Vec::new(),
+                starts: Vec::new(),
+                row_first,
+                window,
+            };
+        }
+        let mut corner_bits = vec![0u64; len.div_ceil(64)];
+        for &node in &corners {
+            set_bit(&mut corner_bits, node - window);
+        }
+        // The band's start rows by row (a band need not be consecutive rows).
+        let lo = *band.iter().min().expect("a band has rows");
+        let hi = *band.iter().max().expect("a band has rows");
+        let mut k_of = vec![usize::MAX; hi - lo + 1];
+        for (k, &j0) in band.iter().enumerate() {
+            k_of[j0 - lo] = k;
+        }
+        let layer = LayerRows::new(padded, fp);
+        let mut starts = vec![vec![0u64; stride.div_ceil(64)]; band.len()];
+        for &node in &corners {
+            let (row, column) = ((node / stride) as i64, (node % stride) as i64);
+            for (dj, offset) in layer.rows() {
+                // The start `node - offset`: `dj` rows and `kf` columns back.
+                let kf = offset as i64 - i64::from(dj) * stride as i64;
+                let j0 = row - padded.pad_rows as i64 - i64::from(dj);
+                let start = column - kf;
+                let Some(&k) = usize::try_from(j0 - lo as i64)
+                    .ok()
+                    .and_then(|r| k_of.get(r))
+                else {
+                    continue;
+                };
+                if k != usize::MAX && (0..stride as i64).contains(&start) {
+                    set_bit(&mut starts[k], start as usize);
                 }
-                for (dj, offset) in layer.rows() {
-                    let j = j0 as i64 + i64::from(dj);
-                    let from = corners.partition_point(|&(cj, _)| cj < j);
-                    let row = corners[from..].iter().take_while(|&&(cj, _)| cj == j);
-                    for &(_, i) in row {
-                        let node = padded.index(j, i as i32);
-                        visits.push((node.wrapping_add_signed(-offset), node));
-                    }
-                }
-                visits.sort_unstable();
-                visits
-            })
-            .collect();
-        ProbeVisits { rows, window }
+            }
+        }
+        ProbeVisits {
+            corners: corner_bits,
+            starts,
+            row_first,
+            window,
+        }
     }
 
     /// Whether a start of the `k`-th start row's block of `width` starts
     /// from the padded node `first` meets a probed node.
     fn any(&self, k: usize, first: usize, width: usize) -> bool {
-        let visits = &self.rows[k];
-        let from = visits.partition_point(|&(start, _)| start < first);
-        visits
-            .get(from)
-            .is_some_and(|&(start, _)| start < first + width)
+        self.starts
+            .get(k)
+            .is_some_and(|starts| any_bit(starts, first - self.row_first[k], width))
     }
 
     /// Raises the reach of the probed nodes met by the `k`-th start row's
     /// block of starts from the padded node `first`, whose levels, unchanged
-    /// across their first layers, are `level`.
+    /// across their first layers (`layer`), are `level`.
     fn record<const W: usize>(
         &self,
         k: usize,
         first: usize,
+        layer: &LayerRows,
         level: &[Rank; W],
         reach: &mut [Rank],
     ) {
-        let visits = &self.rows[k];
-        if visits.is_empty() {
+        if !self.any(k, first, W) {
             return;
         }
-        let from = visits.partition_point(|&(start, _)| start < first);
-        for &(start, node) in visits[from..]
-            .iter()
-            .take_while(|&&(start, _)| start < first + W)
-        {
-            let r = &mut reach[node - self.window];
-            *r = (*r).max(level[start - first]);
+        for (_, offset) in layer.rows() {
+            let a = first.wrapping_add_signed(offset) - self.window;
+            for n in set_bits(&self.corners, a, W) {
+                reach[n] = reach[n].max(level[n - a]);
+            }
         }
     }
+}
+
+/// Sets bit `n` of `bits`.
+fn set_bit(bits: &mut [u64], n: usize) {
+    bits[n / 64] |= 1 << (n % 64);
+}
+
+/// The bits `from .. from + len` of `bits`, a word at a time: each word's
+/// part as `(first bit, its bits shifted down)`.
+fn bit_runs(bits: &[u64], from: usize, len: usize) -> impl Iterator<Item = (usize, u64)> + '_ {
+    let end = from + len;
+    std::iter::successors(Some(from).filter(|&n| n < end), move |&n| {
+        Some(n + 64 - n % 64).filter(|&n| n < end)
+    })
+    .map(move |n| {
+        let take = (64 - n % 64).min(end - n);
+        let word = bits.get(n / 64).copied().unwrap_or(0) >> (n % 64);
+        (
+            n,
+            if take == 64 {
+                word
+            } else {
+                word & ((1 << take) - 1)
+            },
+        )
+    })
+}
+
+/// Whether any of the bits `from .. from + len` of `bits` is set.
+fn any_bit(bits: &[u64], from: usize, len: usize) -> bool {
+    bit_runs(bits, from, len).any(|(_, word)| word != 0)
+}
+
+/// The set bits among `from .. from + len` of `bits`, ascending.
+fn set_bits(bits: &[u64], from: usize, len: usize) -> impl Iterator<Item = usize> + '_ {
+    bit_runs(bits, from, len).flat_map(|(n, mut word)| {
+        std::iter::from_fn(move || {
+            (word != 0).then(|| {
+                let bit = word.trailing_zeros() as usize;
+                word &= word - 1;
+                n + bit
+            })
+        })
+    })
 }
 
 /// SPEC's strike rule applied once per node to its reach, the highest face
@@ -837,7 +917,7 @@ mod tests {
                     y: -1.0 + 0.02 * (cell.0 + cell.1) as f64,
                 })
                 .collect();
-            let visits = ProbeVisits::new(&padded, &fp, &rows, 0, &probes);
+            let visits = ProbeVisits::new(&padded, &fp, &rows, 0, padded.h.len(), &probes);
             let mut still = Fast::new(&padded, &ranked, 512, &StrikeRule::default());
             still.skip_still = false;
             let run_with = |fast: &Fast, f: BandFn| {
@@ -940,10 +1020,10 @@ mod tests {
                     empty_rows += fp.rows.iter().filter(|r| r.khi < r.klo).count();
                     let padded = PaddedGrid::new(&grid, std::slice::from_ref(&fp));
                     let ranked = RankedGrid::new(&padded);
-                    let visits = ProbeVisits::new(&padded, &fp, &rows, 0, &probes);
+                    let visits = ProbeVisits::new(&padded, &fp, &rows, 0, padded.h.len(), &probes);
                     // Without probes, the rows of a layer that change
                     // nothing are passed over too.
-                    let unprobed = ProbeVisits::new(&padded, &fp, &rows, 0, &[]);
+                    let unprobed = ProbeVisits::new(&padded, &fp, &rows, 0, padded.h.len(), &[]);
                     let run_with = |skip_still: bool, f: BandFn, visits: &ProbeVisits| {
                         let mut fast = Fast::new(&padded, &ranked, 64, &StrikeRule::default());
                         fast.skip_still = skip_still;
@@ -1040,7 +1120,7 @@ mod tests {
             .iter()
             .map(|fp| {
                 let mut reach = vec![NEVER; padded.h.len()];
-                let visits = ProbeVisits::new(&padded, fp, &rows, 0, &probes);
+                let visits = ProbeVisits::new(&padded, fp, &rows, 0, padded.h.len(), &probes);
                 let placed = fast_band(&padded, &fast, fp, &rows, 0, &visits, &mut reach);
                 let mask = padded.unpad(&strike_mask(&fast.thresholds, &reach));
                 let met = probe_levels(&padded, 0, &reach, &probes)

@@ -8,11 +8,13 @@
 //! reach window, `n` triangles):
 //!
 //! * the part: `72 n` (three f64 vertices per triangle);
-//! * the height grid `8 N`, its padded copy `8 Np` and the window-minimum
-//!   table `8 (L - 1) Nr` (level 0 is the padded grid itself);
+//! * the height grid `8 N`, its padded copy `8 Np`, the ranks and
+//!   thresholds, and the push's tables: the window minima `4 (L - 1) Nr`
+//!   (level 0 is the ranks themselves) and the group bounds
+//!   ([`WindowMin::bytes_for`]);
 //! * per band task running (at most `T`, and at most the bands there
-//!   are): its reach window and strikes (`9 Nw`; the paper path's band mask
-//!   `Np` where that is larger);
+//!   are): its reach window, strikes and probe-corner bits (`5.125 Nw`;
+//!   the paper path's band mask `Np` where that is larger);
 //! * per angle in flight (at most `min(T, A)`): its mask (`N`);
 //! * every finished angle's mask (`A N`, with the allocator's holes
 //!   between them: [`MASK_BYTES_PER_NODE`]) and the composite (`2 N`);
@@ -95,8 +97,9 @@ impl MemoryEstimate {
                     WindowMin::bytes_for(spec.nz, padding.stride, WindowMin::max_width(footprints))
                         as f64,
                 ),
-                // A rank of reach and a strike byte per window node.
-                ("bands running", tasks * (5.0 * window).max(padded)),
+                // A rank of reach, a strike byte and a probe-corner bit
+                // per window node.
+                ("bands running", tasks * (5.125 * window).max(padded)),
                 ("angles in flight", angles_in_flight * n),
                 ("masks", MASK_BYTES_PER_NODE * angles * n + 2.0 * n),
                 ("writers", WRITE_BYTES_PER_NODE * n),
