@@ -18,7 +18,7 @@ use crate::paper::{PaperCounts, PaperScratch, paper_row};
 use crate::push::{PushRows, WindowMin, WindowOf, push_block, push_tile};
 use crate::ranked::{NEVER, OFF, Rank, RankedGrid};
 use crate::simd::dispatch;
-use crate::slide::{LayerRows, slide_block, slide_carried};
+use crate::slide::{LayerRows, ones, slide_block, slide_carried};
 use crate::strike::StrikeRule;
 
 /// Which implementation of push and slide to run. Both give identical masks.
@@ -57,6 +57,19 @@ pub struct Probe {
     pub cell: (usize, usize),
     /// The height (mm).
     pub y: f64,
+}
+
+impl Probe {
+    /// The padded indices of the cell's corner nodes that lie on `padded`'s
+    /// grid (a cell of the last row has only two).
+    fn corner_nodes<'a>(&self, padded: &'a PaddedGrid) -> impl Iterator<Item = usize> + 'a {
+        let (i, j) = (self.cell.0 as i64, self.cell.1 as i64);
+        let nz = padded.spec.nz as i64;
+        [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]
+            .into_iter()
+            .filter(move |&(_, jj)| jj < nz)
+            .map(|(ii, jj)| padded.index(jj, ii as i32))
+    }
 }
 
 impl Default for EngineOptions {
@@ -314,18 +327,12 @@ fn fast_window(
 /// corners in a band whose reach window begins at padded index `start`
 /// ([`NEVER`] where none did).
 fn probe_levels(padded: &PaddedGrid, start: usize, reach: &[Rank], probes: &[Probe]) -> Vec<Rank> {
-    let nz = padded.spec.nz as i64;
     probes
         .iter()
         .map(|probe| {
-            let (i, j) = (probe.cell.0 as i64, probe.cell.1 as i64);
-            [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]
-                .into_iter()
-                .filter(|&(_, jj)| jj < nz)
-                .filter_map(|(ii, jj)| {
-                    let n = padded.index(jj, ii as i32).checked_sub(start)?;
-                    reach.get(n).copied()
-                })
+            probe
+                .corner_nodes(padded)
+                .filter_map(|node| reach.get(node.checked_sub(start)?).copied())
                 .fold(NEVER, Rank::max)
         })
         .collect()
@@ -644,15 +651,9 @@ impl ProbeVisits {
             .iter()
             .map(|&j0| padded.index(j0 as i64, 0) - padded.pad_lo)
             .collect();
-        let nz = padded.spec.nz as i64;
         let corners: Vec<usize> = probes
             .iter()
-            .flat_map(|probe| {
-                let (i, j) = (probe.cell.0 as i64, probe.cell.1 as i64);
-                [(j, i), (j, i + 1), (j + 1, i), (j + 1, i + 1)]
-            })
-            .filter(|&(j, _)| j < nz)
-            .map(|(j, i)| padded.index(j, i as i32))
+            .flat_map(|probe| probe.corner_nodes(padded))
             .filter(|node| (window..window + len).contains(node))
             .collect();
         if corners.is_empty() || band.is_empty() {
@@ -670,9 +671,9 @@ impl ProbeVisits {
         // The band's start rows by row (a band need not be consecutive rows).
         let lo = *band.iter().min().expect("a band has rows");
         let hi = *band.iter().max().expect("a band has rows");
-        let mut k_of = vec![usize::MAX; hi - lo + 1];
+        let mut k_of = vec![None; hi - lo + 1];
         for (k, &j0) in band.iter().enumerate() {
-            k_of[j0 - lo] = k;
+            k_of[j0 - lo] = Some(k);
         }
         let layer = LayerRows::new(padded, fp);
         let mut starts = vec![vec![0u64; stride.div_ceil(64)]; band.len()];
@@ -683,13 +684,12 @@ impl ProbeVisits {
                 let kf = offset as i64 - i64::from(dj) * stride as i64;
                 let j0 = row - padded.pad_rows as i64 - i64::from(dj);
                 let start = column - kf;
-                let Some(&k) = usize::try_from(j0 - lo as i64)
+                let k = usize::try_from(j0 - lo as i64)
                     .ok()
-                    .and_then(|r| k_of.get(r))
-                else {
-                    continue;
-                };
-                if k != usize::MAX && (0..stride as i64).contains(&start) {
+                    .and_then(|r| k_of.get(r).copied().flatten());
+                if let Some(k) = k
+                    && (0..stride as i64).contains(&start)
+                {
                     set_bit(&mut starts[k], start as usize);
                 }
             }
@@ -766,15 +766,7 @@ fn any_bit(bits: &[u64], from: usize, len: usize) -> bool {
 
 /// The set bits among `from .. from + len` of `bits`, ascending.
 fn set_bits(bits: &[u64], from: usize, len: usize) -> impl Iterator<Item = usize> + '_ {
-    bit_runs(bits, from, len).flat_map(|(n, mut word)| {
-        std::iter::from_fn(move || {
-            (word != 0).then(|| {
-                let bit = word.trailing_zeros() as usize;
-                word &= word - 1;
-                n + bit
-            })
-        })
-    })
+    bit_runs(bits, from, len).flat_map(|(n, word)| ones(word).map(move |bit| n + bit))
 }
 
 /// SPEC's strike rule applied once per node to its reach, the highest face

@@ -88,7 +88,7 @@ impl<'a> WindowMin<'a> {
             levels,
             first,
             stride,
-            groups: GroupMin::new(heights, stride, max_width + LANE_SLACK),
+            groups: GroupMin::new(heights, stride, max_width),
         }
     }
 
@@ -125,7 +125,7 @@ impl<'a> WindowMin<'a> {
     /// of `stride` nodes and windows up to `max_width` nodes.
     pub fn bytes_for(nz: usize, stride: usize, max_width: usize) -> usize {
         let rows = (WindowMin::levels(max_width) - 1) * nz;
-        let group_rows = WindowMin::levels(max_width + LANE_SLACK) * nz.div_ceil(GROUP_ROWS);
+        let group_rows = GroupMin::levels(max_width) * nz.div_ceil(GROUP_ROWS);
         (rows + group_rows) * stride * size_of::<Rank>()
     }
 }
@@ -168,8 +168,15 @@ struct GroupMin {
 }
 
 impl GroupMin {
-    /// The blocks of `heights` (real rows of `stride` nodes) for runs of
-    /// columns up to `max_width` wide.
+    /// The levels the table holds for footprint rows up to `max_width`
+    /// nodes wide: runs as wide as a group's rectangle for the widest
+    /// block of starts ([`LANE_SLACK`] lanes) on top.
+    fn levels(max_width: usize) -> usize {
+        WindowMin::levels(max_width + LANE_SLACK)
+    }
+
+    /// The blocks of `heights` (real rows of `stride` nodes) for footprint
+    /// rows up to `max_width` nodes wide ([`GroupMin::levels`]).
     fn new(heights: &[Rank], stride: usize, max_width: usize) -> GroupMin {
         let nz = heights.len() / stride;
         let mut level0 = vec![OFF; nz.div_ceil(GROUP_ROWS) * stride];
@@ -184,7 +191,7 @@ impl GroupMin {
             }
         }
         let mut levels = vec![level0];
-        for l in 1..WindowMin::levels(max_width) {
+        for l in 1..GroupMin::levels(max_width) {
             let prev = levels.last().expect("level 0 is there");
             levels.push(doubled(prev, stride, 1 << (l - 1)));
         }

@@ -143,16 +143,14 @@ pub fn slide_block<const W: usize>(
     // cache, and a branch on each made them wait on one another), then
     // those rows in slide order.
     for (chunk, offsets) in layer.offsets.chunks(64).enumerate() {
-        let mut slid = match still {
+        let slid = match still {
             Some((minima, shift)) => offsets.iter().enumerate().fold(0u64, |slid, (n, &offset)| {
                 let a = base.wrapping_add_signed(offset);
                 slid | u64::from(minima.at(a + shift) < top) << n
             }),
             None => u64::MAX >> (64 - offsets.len()),
         };
-        while slid != 0 {
-            let n = slid.trailing_zeros() as usize;
-            slid &= slid - 1;
+        for n in ones(slid) {
             let e = chunk * 64 + n;
             // Passed-over rows change no level, so the level on entering a
             // group's first slid row is the level before the group.
@@ -170,6 +168,17 @@ pub fn slide_block<const W: usize>(
         }
     }
     level
+}
+
+/// The set bits of `word`, lowest first.
+pub(crate) fn ones(mut word: u64) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (word != 0).then(|| {
+            let bit = word.trailing_zeros() as usize;
+            word &= word - 1;
+            bit
+        })
+    })
 }
 
 /// The scalar slide of one start that is not placed but carries the level

@@ -10,7 +10,7 @@ use std::process::{Command, Output};
 use kneeform::output::DirLock;
 
 use crate::cli::kneeform;
-use crate::util::{scenario, scratch_dir};
+use crate::util::{Rng, SEEDS, scenario, scratch_dir};
 
 /// Everything in `dir` whose name says it is staged or set aside.
 fn leftovers(dir: &Path) -> Vec<String> {
@@ -461,15 +461,10 @@ fn the_memory_estimate_bounds_the_measured_peak() {
 /// every 2 mm.
 fn rough_ground() -> Vec<kneeform::mesh::Triangle> {
     let (nx, nz, step) = (300, 150, 2.0);
-    let mut state: u64 = 3;
-    let mut heights = vec![0.0; (nx + 1) * (nz + 1)];
-    for h in &mut heights {
-        // xorshift64
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        *h = (state >> 11) as f64 / (1u64 << 53) as f64 * 20.0;
-    }
+    let mut rng = Rng::new(SEEDS[0]);
+    let heights: Vec<f64> = (0..(nx + 1) * (nz + 1))
+        .map(|_| rng.unit() * 20.0)
+        .collect();
     let at = |i: usize, j: usize| [i as f64 * step, heights[i * (nz + 1) + j], j as f64 * step];
     (0..nx)
         .flat_map(|i| (0..nz).map(move |j| (i, j)))

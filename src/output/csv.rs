@@ -361,12 +361,10 @@ mod tests {
             let half = (f64::from(k) + 0.5) / 1000.0;
             values.extend([half, half.next_up(), half.next_down(), f64::from(k) * 0.124]);
         }
-        let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut rng = crate::harness::compare::SplitMix(7);
         for _ in 0..100_000 {
-            // xorshift64: spread over magnitudes 1e-4 .. 1e7, both signs.
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            // Spread over magnitudes 1e-4 .. 1e7, both signs.
+            let x = rng.next();
             let unit = (x >> 11) as f64 / (1u64 << 53) as f64;
             let v = 10f64.powf(unit * 11.0 - 4.0);
             values.push(if x & 1 == 0 { v } else { -v });
