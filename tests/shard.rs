@@ -6,6 +6,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use kneeform::output::DirLock;
+
 use crate::cli::kneeform;
 use crate::util::{ok, scenario, scratch_dir};
 
@@ -686,6 +688,23 @@ fn a_killed_batch_resumes_and_ends_with_a_clean_batch_s_outputs() {
         .unwrap();
     assert!(killed.success());
     child.wait().unwrap();
+    // The batch is gone, but its item's run may not be yet: a process
+    // killed inside a sync to disk dies when the sync returns, holding its
+    // directory's lock until then (a CI run resumed too early and was
+    // rightly refused). Wait for every item's lock to be free, as a
+    // scheduler waits for a killed job's processes to end.
+    for item in ["wave", "bump-right", "wave-fine"] {
+        let run = dir.join("runs").join(item);
+        loop {
+            match DirLock::take(&run) {
+                Ok(_released_at_once) => break,
+                Err(e) if e.kind() == std::io::ErrorKind::ResourceBusy => {
+                    std::thread::sleep(std::time::Duration::from_millis(20));
+                }
+                Err(e) => panic!("{}: {e}", run.display()),
+            }
+        }
+    }
     let first = dir.join("runs/wave/summary.json");
     let inode = std::fs::metadata(&first).unwrap().ino();
     // Again: the finished items are skipped, the killed one is run whole.
