@@ -130,7 +130,7 @@ pub enum SetupError {
     #[error("the {field} must be a number from {} to {}, got {}", short(*min), short(*max), short(*value))]
     OutOfRange {
         /// The field (`pitch`, `triangle_side`, `radius`, `thickness`,
-        /// `blind_depth`, `scale`).
+        /// `blind_depth`, `scale`, `window`).
         field: &'static str,
         /// The value given.
         value: f64,
@@ -248,6 +248,10 @@ impl Setup {
         if !(self.rule.e0.is_finite() && (0.0..=0.01).contains(&self.rule.e0)) {
             return Err(SetupError::E0(self.rule.e0));
         }
+        if self.rule.window_mm().is_some() {
+            let longest = limits::MAX_WINDOW_MM.min(limits::MAX_WINDOW_PITCHES * self.pitch);
+            within("window", self.rule.window, limits::MIN_PITCH_MM, longest)?;
+        }
         if let GridPlacement::Explicit { origin, size } = self.grid {
             if !origin
                 .iter()
@@ -309,6 +313,7 @@ impl Setup {
         MemoryEstimate::analysis(
             spec,
             &self.footprints(spec),
+            &self.rule,
             triangles,
             rayon::current_num_threads(),
         )
@@ -815,6 +820,7 @@ impl Analysis {
             sigma: setup.rule.sigma,
             e0_mm: setup.rule.e0,
             rate: setup.rule.rate.name().into(),
+            window_mm: setup.rule.window_mm(),
             algorithm: setup.algorithm,
             approach: setup.approach,
             threads: rayon::current_num_threads(),

@@ -18,7 +18,10 @@ use crate::paper::{PaperCounts, PaperScratch, paper_row};
 use crate::push::{PushRows, WindowMin, WindowOf, push_block, push_tile};
 use crate::ranked::{NEVER, OFF, Rank, RankedGrid};
 use crate::simd::dispatch;
-use crate::slide::{LayerRows, ones, slide_block, slide_carried};
+use crate::slide::{
+    Extension, LayerRows, WindowLayers, WindowSlide, ones, slide_block, slide_block_window,
+    slide_carried, window_depth,
+};
 use crate::strike::StrikeRule;
 
 /// Which implementation of push and slide to run. Both give identical masks.
@@ -142,7 +145,7 @@ pub fn colliding_masks(
     on_angle: &(dyn Fn() + Sync),
 ) -> Vec<AngleMask> {
     assert_same_pitch(grid, footprints);
-    let padded = PaddedGrid::new(grid, footprints);
+    let padded = PaddedGrid::deep(grid, footprints, window_depth(&options.rule, grid.spec.pitch));
     let ranked = match options.algorithm {
         Algorithm::Fast => Some(RankedGrid::new(&padded)),
         Algorithm::Paper => None,
@@ -215,7 +218,12 @@ pub fn colliding_masks(
 struct Fast<'a> {
     ranked: &'a RankedGrid,
     table: WindowMin<'a>,
+    /// Per node, the lowest level that strikes it (under the window rule:
+    /// that makes it a contact).
     thresholds: Vec<Rank>,
+    /// Under the window rule, its `W` (mm) and per node the lowest level
+    /// `W` back that passes its deflection test.
+    window: Option<(f64, Vec<Rank>)>,
     /// Whether the slides that change nothing are skipped
     /// ([`fast_band_impl`]): always, except in the tests that compare the
     /// results with and without.
@@ -235,6 +243,9 @@ impl<'a> Fast<'a> {
             ranked,
             table: WindowMin::new(padded, &ranked.ranks, max_width),
             thresholds: ranked.thresholds(padded, rule),
+            window: rule
+                .window_mm()
+                .map(|w| (w, ranked.window_thresholds(padded, rule))),
             skip_still: true,
         }
     }
@@ -309,8 +320,16 @@ fn fast_window(
     let end = (last_row + 1) * padded.stride;
     let mut reach = vec![NEVER; end - start];
     let visits = ProbeVisits::new(padded, fp, band, start, end - start, &options.probes);
-    let placed = fast_band(padded, fast, fp, band, start, &visits, &mut reach);
-    let strikes = strike_mask(&fast.thresholds[start..end], &reach);
+    // Under the window rule the slides mark their strikes themselves.
+    let mut struck = match fast.window {
+        Some(_) => vec![0u8; end - start],
+        None => Vec::new(),
+    };
+    let placed = fast_band(padded, fast, fp, band, start, &visits, &mut reach, &mut struck);
+    let strikes = match fast.window {
+        Some(_) => struck,
+        None => strike_mask(&fast.thresholds[start..end], &reach),
+    };
     let probe_levels = probe_levels(padded, start, &reach, &options.probes)
         .into_iter()
         .map(|r| fast.ranked.height(r))
@@ -364,7 +383,7 @@ dispatch! {
     /// about 5% faster than 32 and level with 128 (the noise is about
     /// 10%); 16 slower. [`LANE_SLACK`](crate::padded::LANE_SLACK) covers the
     /// widest block.
-    fn fast_band(padded: &PaddedGrid, fast: &Fast, fp: &GridFootprint, band: &[usize], window: usize, visits: &ProbeVisits, reach: &mut [Rank]) -> usize => fast_band_impl::<128, 64, 16>
+    fn fast_band(padded: &PaddedGrid, fast: &Fast, fp: &GridFootprint, band: &[usize], window: usize, visits: &ProbeVisits, reach: &mut [Rank], struck: &mut [u8]) -> usize => fast_band_impl::<128, 64, 16>
 }
 
 /// The band's work in blocks of `W` starts.
@@ -383,6 +402,7 @@ dispatch! {
 /// start left of a block's first lane is the last lane of the next block,
 /// so each row's block waits for its left neighbour's push before it
 /// slides.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn fast_band_impl<const W: usize>(
     padded: &PaddedGrid,
@@ -392,6 +412,7 @@ fn fast_band_impl<const W: usize>(
     window: usize,
     visits: &ProbeVisits,
     reach: &mut [Rank],
+    struck: &mut [u8],
 ) -> usize {
     let push_rows = PushRows::new(padded, fp);
     let nz = padded.spec.nz;
@@ -410,6 +431,14 @@ fn fast_band_impl<const W: usize>(
         return 0;
     };
     let layers: Vec<_> = band.iter().map(|&j0| layer.within(j0, nz)).collect();
+    let window_layers = fast
+        .window
+        .as_ref()
+        .map(|(w, _)| WindowLayers::new(padded, fp, *w));
+    let window_layers: Vec<_> = band
+        .iter()
+        .filter_map(|&j0| Some(window_layers.as_ref()?.within(j0, nz)))
+        .collect();
     let slider = Slider {
         skip_still: fast.skip_still,
         still: fast.table.windows_of(W),
@@ -417,6 +446,19 @@ fn fast_band_impl<const W: usize>(
         window,
         nx: padded.spec.nx as i64,
         visits,
+        rule: fast.window.as_ref().map(|(w, deflected)| WindowRule {
+            window: *w,
+            pitch: padded.spec.pitch,
+            contact: &fast.thresholds[window..],
+            deflected: &deflected[window..],
+        }),
+    };
+    let mut slid = Vec::new();
+    let mut sink = Sink {
+        reach,
+        struck,
+        slid: &mut slid,
+        window_layers: None,
     };
     let mut rows: Vec<RowState<W>> = band
         .iter()
@@ -424,6 +466,7 @@ fn fast_band_impl<const W: usize>(
             first: padded.index(j0 as i64, 0),
             carry: NEVER,
             pending: None,
+            extensions: Vec::new(),
         })
         .collect();
     let mut placed = 0;
@@ -448,13 +491,16 @@ fn fast_band_impl<const W: usize>(
                     .then(|| push_tile(&fast.table, &push_rows, tile[0], nz, padded.stride, base));
                 for t in 0..TILE {
                     let yr = yr.filter(|_| inside(k + t)).map(|yr| yr[t]);
-                    placed += rows[k + t].advance(&slider, reach, &layers[k + t], k + t, block, yr);
+                    sink.window_layers = window_layers.get(k + t).map(|l| &**l);
+                    placed +=
+                        rows[k + t].advance(&slider, &mut sink, &layers[k + t], k + t, block, yr);
                 }
                 k += TILE;
             } else {
                 let yr =
                     inside(k).then(|| push_block::<W>(&fast.table, &push_rows, band[k], nz, base));
-                placed += rows[k].advance(&slider, reach, &layers[k], k, block, yr);
+                sink.window_layers = window_layers.get(k).map(|l| &**l);
+                placed += rows[k].advance(&slider, &mut sink, &layers[k], k, block, yr);
                 k += 1;
             }
         }
@@ -463,10 +509,33 @@ fn fast_band_impl<const W: usize>(
     for (k, row) in rows.iter_mut().enumerate() {
         if let Some((right, yr_right)) = row.pending.take() {
             // Left of the last block lie no active starts.
-            placed += slider.slide(reach, &layers[k], k, row, right, yr_right, OFF);
+            sink.window_layers = window_layers.get(k).map(|l| &**l);
+            placed += slider.slide(&mut sink, &layers[k], k, row, right, yr_right, [OFF; W]);
         }
     }
     placed
+}
+
+/// What the slides of a band write, and the window rule's slide list of
+/// the row at hand.
+struct Sink<'a, 'b> {
+    reach: &'a mut [Rank],
+    struck: &'a mut [u8],
+    slid: &'a mut Vec<u32>,
+    window_layers: Option<&'b WindowLayers>,
+}
+
+/// The window rule as the slides of a band read it.
+struct WindowRule<'a> {
+    /// `W` (mm).
+    window: f64,
+    pitch: f64,
+    /// Per node from the reach window's first, the lowest level that makes
+    /// it a contact ([`RankedGrid::thresholds`]).
+    contact: &'a [Rank],
+    /// ... and the lowest level `W` back that passes the deflection test
+    /// ([`RankedGrid::window_thresholds`]).
+    deflected: &'a [Rank],
 }
 
 /// One start row's state in [`fast_band_impl`].
@@ -478,6 +547,9 @@ struct RowState<const W: usize> {
     /// The block pushed but not yet slid: its first start column and the
     /// starts' push levels.
     pending: Option<(i64, [Rank; W])>,
+    /// Under the window rule, the slides of placed starts that go on past
+    /// starts that are not placed ([`Extension`]).
+    extensions: Vec<Extension>,
 }
 
 impl<const W: usize> RowState<W> {
@@ -489,7 +561,7 @@ impl<const W: usize> RowState<W> {
     fn advance(
         &mut self,
         slider: &Slider,
-        reach: &mut [Rank],
+        sink: &mut Sink,
         layer: &LayerRows,
         k: usize,
         block: i64,
@@ -499,8 +571,8 @@ impl<const W: usize> RowState<W> {
         if let Some((right, yr_right)) = self.pending.take() {
             // Outside the row's active starts, no start is placed: no
             // finite height lies inside its footprint.
-            let left = yr.map_or(OFF, |yr| yr[W - 1]);
-            placed = slider.slide(reach, layer, k, self, right, yr_right, left);
+            let left = yr.unwrap_or([OFF; W]);
+            placed = slider.slide(sink, layer, k, self, right, yr_right, left);
         }
         self.pending = yr.map(|yr| (block, yr));
         placed
@@ -520,24 +592,31 @@ struct Slider<'a> {
     /// The minima over a block's width of nodes, where the table holds
     /// that width ([`slide_block`]).
     still: Option<WindowOf<'a>>,
+    /// The window rule, when it is the rule (else the reach decides).
+    rule: Option<WindowRule<'a>>,
 }
 
 impl Slider<'_> {
     /// Slides the block of starts from column `block` (push levels `yr`) of
-    /// the band's `k`-th start row, whose start one column to -x of the
-    /// first has the push level `left`; returns the starts placed.
+    /// the band's `k`-th start row, whose next block to -x has the push
+    /// levels `left`; returns the starts placed.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn slide<const W: usize>(
         &self,
-        reach: &mut [Rank],
+        sink: &mut Sink,
         layer: &LayerRows,
         k: usize,
         row: &mut RowState<W>,
         block: i64,
         yr: [Rank; W],
-        left: Rank,
+        left: [Rank; W],
     ) -> usize {
+        if let (Some(rule), Some(layers)) = (&self.rule, sink.window_layers) {
+            return self.slide_window(rule, layers, sink, layer, k, row, block, yr, left);
+        }
+        let reach = &mut *sink.reach;
+        let left = left[W - 1];
         let base = row.first.wrapping_add_signed(block as isize) - self.window;
         // Only real starts are placed.
         let mut level = [NEVER; W];
@@ -574,6 +653,125 @@ impl Slider<'_> {
         }
         row.carry = c;
         placed
+    }
+
+    /// [`Slider::slide`] under the window rule: each placed start of the
+    /// block slides over its [`WindowLayers`], deciding its strikes as it
+    /// goes, and a placed start whose start one column to -x is not placed
+    /// slides on past it, one column at a time ([`Extension`]), until a
+    /// placed start has travelled far enough to decide for it.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn slide_window<const W: usize>(
+        &self,
+        rule: &WindowRule,
+        layers: &WindowLayers,
+        sink: &mut Sink,
+        layer: &LayerRows,
+        k: usize,
+        row: &mut RowState<W>,
+        block: i64,
+        yr: [Rank; W],
+        left: [Rank; W],
+    ) -> usize {
+        let base = row.first.wrapping_add_signed(block as isize) - self.window;
+        let real = |lane: i64| (0..self.nx).contains(&(block + lane));
+        // Only real starts are placed.
+        let mut level = [NEVER; W];
+        let mut placed = 0;
+        for w in 0..W {
+            if real(w as i64) && yr[w] != OFF {
+                level[w] = yr[w];
+                placed += 1;
+            }
+        }
+        let mut out = WindowSlide {
+            contact: rule.contact,
+            deflected: rule.deflected,
+            reach: sink.reach,
+            struck: sink.struck,
+            slid: sink.slid,
+        };
+        if self.moves_window(layer, layers.depth(), base, &left, &yr, &level) {
+            let still = (self.skip_still && !self.visits.any(k, base + self.window, W))
+                .then_some(self.still)
+                .flatten()
+                .map(|minima| (minima, self.window));
+            slide_block_window(self.h, &mut out, layers, base, level, still);
+        } else {
+            self.visits
+                .record(k, base + self.window, layer, &level, out.reach);
+        }
+        // From +x to -x: the slides that go on past starts not placed.
+        let placed_at = |w: i64| match w {
+            0.. => level[w as usize] != NEVER,
+            _ => real(w) && left[(W as i64 + w) as usize] != OFF,
+        };
+        for w in (0..W).rev() {
+            let column = block + w as i64;
+            let here = placed_at(w as i64);
+            row.extensions.retain_mut(|e| {
+                let shift = (e.column - column) as f64 * rule.pitch;
+                let on = e.goes_on(shift, here, rule.window, rule.pitch);
+                if on {
+                    e.advance(self.h, &mut out, layer, base + w, shift, rule.window);
+                }
+                on
+            });
+            if here && !placed_at(w as i64 - 1) {
+                let mut e = Extension::new(column, level[w]);
+                e.advance(self.h, &mut out, layer, base + w, 0.0, rule.window);
+                row.extensions.push(e);
+            }
+        }
+        placed
+    }
+
+    /// [`Slider::moves`] over a placed start's [`WindowLayers`]: its first
+    /// `depth + 1` columns' first layers. The first layer of the start `c`
+    /// columns to -x of a lane lies, in rows with nodes inside, inside the
+    /// footprint of the start one column further, so at or above that
+    /// start's push level; the other rows are read.
+    #[inline(always)]
+    fn moves_window<const W: usize>(
+        &self,
+        layer: &LayerRows,
+        depth: usize,
+        base: usize,
+        left: &[Rank; W],
+        yr: &[Rank; W],
+        level: &[Rank; W],
+    ) -> bool {
+        if !self.skip_still || depth >= W {
+            return true;
+        }
+        let mut lower = 0u32;
+        for c in 0..=depth {
+            // The push level of the start c + 1 columns to -x of each lane.
+            let mut beside = [OFF; W];
+            for w in 0..W {
+                let at = w as i64 - c as i64 - 1;
+                beside[w] = if at >= 0 {
+                    yr[at as usize]
+                } else {
+                    left[(W as i64 + at) as usize]
+                };
+            }
+            for w in 0..W {
+                lower |= u32::from(beside[w] < level[w]);
+            }
+            for offset in layer.outside() {
+                let a = base.wrapping_add_signed(offset - c as isize);
+                let hv: &[Rank; W] = self.h[a..a + W].try_into().expect("W values");
+                for w in 0..W {
+                    lower |= u32::from(hv[w] < level[w]);
+                }
+            }
+            if lower != 0 {
+                return true;
+            }
+        }
+        false
     }
 
     /// Whether the first layer of some placed start of the block (levels
@@ -861,8 +1059,44 @@ mod tests {
     use crate::kneeform::KneeForm;
 
     /// [`fast_band`]'s signature.
-    type BandFn =
-        fn(&PaddedGrid, &Fast, &GridFootprint, &[usize], usize, &ProbeVisits, &mut [Rank]) -> usize;
+    type BandFn = fn(
+        &PaddedGrid,
+        &Fast,
+        &GridFootprint,
+        &[usize],
+        usize,
+        &ProbeVisits,
+        &mut [Rank],
+        &mut [u8],
+    ) -> usize;
+
+    /// Both rules: the window (the default) and the x-slope.
+    fn rules() -> [StrikeRule; 2] {
+        [
+            StrikeRule::default(),
+            StrikeRule::default().with_rate(crate::strike::RateEstimate::XSlope),
+        ]
+    }
+
+    /// The fast path over `rows` with one reach and one strike array over
+    /// the whole padded grid: the strikes, the reach and the starts placed.
+    fn whole_band(
+        f: BandFn,
+        padded: &PaddedGrid,
+        fast: &Fast,
+        fp: &GridFootprint,
+        rows: &[usize],
+        visits: &ProbeVisits,
+    ) -> (Vec<u8>, Vec<Rank>, usize) {
+        let mut reach = vec![NEVER; padded.h.len()];
+        let mut struck = vec![0u8; padded.h.len()];
+        let placed = f(padded, fast, fp, rows, 0, visits, &mut reach, &mut struck);
+        let mask = match fast.window {
+            Some(_) => struck,
+            None => strike_mask(&fast.thresholds, &reach),
+        };
+        (mask, reach, placed)
+    }
 
     /// The block width is a tuning knob per instruction set: every width
     /// gives the same strikes, probe answers and placed count (the tests
@@ -896,11 +1130,15 @@ mod tests {
             thickness: 100.0,
         };
         let rows: Vec<usize> = (0..spec.nz).collect();
-        for angle in [-30.0, 0.0, 17.0] {
+        for (angle, rule) in [-30.0, 0.0, 17.0]
+            .into_iter()
+            .flat_map(|a| rules().map(|r| (a, r)))
+        {
             let fp = GridFootprint::new(&knee, angle, &spec);
-            let padded = PaddedGrid::new(&grid, std::slice::from_ref(&fp));
+            let depth = window_depth(&rule, spec.pitch);
+            let padded = PaddedGrid::deep(&grid, std::slice::from_ref(&fp), depth);
             let ranked = RankedGrid::new(&padded);
-            let fast = Fast::new(&padded, &ranked, 512, &StrikeRule::default());
+            let fast = Fast::new(&padded, &ranked, 512, &rule);
             let probes: Vec<Probe> = (0..spec.nz - 1)
                 .step_by(7)
                 .flat_map(|j| (0..spec.nx - 1).step_by(13).map(move |i| (i, j)))
@@ -910,12 +1148,10 @@ mod tests {
                 })
                 .collect();
             let visits = ProbeVisits::new(&padded, &fp, &rows, 0, padded.h.len(), &probes);
-            let mut still = Fast::new(&padded, &ranked, 512, &StrikeRule::default());
+            let mut still = Fast::new(&padded, &ranked, 512, &rule);
             still.skip_still = false;
             let run_with = |fast: &Fast, f: BandFn| {
-                let mut reach = vec![NEVER; padded.h.len()];
-                let placed = f(&padded, fast, &fp, &rows, 0, &visits, &mut reach);
-                let mask = strike_mask(&fast.thresholds, &reach);
+                let (mask, reach, placed) = whole_band(f, &padded, fast, &fp, &rows, &visits);
                 (mask, probe_levels(&padded, 0, &reach, &probes), placed)
             };
             let run = |f: BandFn| run_with(&fast, f);
@@ -1007,25 +1243,26 @@ mod tests {
                     .map(|cell| Probe { cell, y: 0.5 })
                     .collect();
                 let rows: Vec<usize> = (0..spec.nz).collect();
-                for &angle in angles {
+                for (&angle, rule) in angles.iter().flat_map(|a| rules().map(|r| (a, r))) {
                     let fp = GridFootprint::new(&knee, angle, &spec);
                     empty_rows += fp.rows.iter().filter(|r| r.khi < r.klo).count();
-                    let padded = PaddedGrid::new(&grid, std::slice::from_ref(&fp));
+                    let depth = window_depth(&rule, spec.pitch);
+                    let padded = PaddedGrid::deep(&grid, std::slice::from_ref(&fp), depth);
                     let ranked = RankedGrid::new(&padded);
                     let visits = ProbeVisits::new(&padded, &fp, &rows, 0, padded.h.len(), &probes);
                     // Without probes, the rows of a layer that change
                     // nothing are passed over too.
                     let unprobed = ProbeVisits::new(&padded, &fp, &rows, 0, padded.h.len(), &[]);
                     let run_with = |skip_still: bool, f: BandFn, visits: &ProbeVisits| {
-                        let mut fast = Fast::new(&padded, &ranked, 64, &StrikeRule::default());
+                        let mut fast = Fast::new(&padded, &ranked, 64, &rule);
                         fast.skip_still = skip_still;
-                        let mut reach = vec![NEVER; padded.h.len()];
-                        let placed = f(&padded, &fast, &fp, &rows, 0, visits, &mut reach);
+                        let (mask, reach, placed) =
+                            whole_band(f, &padded, &fast, &fp, &rows, visits);
                         let above: Vec<Rank> = (reach.iter().zip(&ranked.ranks))
                             .map(|(&r, &own)| if r > own { r } else { NEVER })
                             .collect();
                         let levels = probe_levels(&padded, 0, &reach, &probes);
-                        (reach, above, levels, placed)
+                        (reach, (above, mask), levels, placed)
                     };
                     let run = |skip_still: bool, f: BandFn| run_with(skip_still, f, &visits);
                     let all = run(false, fast_band_impl::<16>);
@@ -1103,18 +1340,17 @@ mod tests {
             ..EngineOptions::default()
         };
         // The reference: one band of every start row, one whole-grid reach.
-        let padded = PaddedGrid::new(&grid, &footprints);
         let rule = StrikeRule::default();
+        let padded = PaddedGrid::deep(&grid, &footprints, window_depth(&rule, spec.pitch));
         let ranked = RankedGrid::new(&padded);
         let fast = Fast::new(&padded, &ranked, WindowMin::max_width(&footprints), &rule);
         let rows: Vec<usize> = (0..spec.nz).collect();
         let expected: Vec<(Vec<u8>, usize, Vec<bool>)> = footprints
             .iter()
             .map(|fp| {
-                let mut reach = vec![NEVER; padded.h.len()];
                 let visits = ProbeVisits::new(&padded, fp, &rows, 0, padded.h.len(), &probes);
-                let placed = fast_band(&padded, &fast, fp, &rows, 0, &visits, &mut reach);
-                let mask = padded.unpad(&strike_mask(&fast.thresholds, &reach));
+                let (mask, reach, placed) = whole_band(fast_band, &padded, &fast, fp, &rows, &visits);
+                let mask = padded.unpad(&mask);
                 let met = probe_levels(&padded, 0, &reach, &probes)
                     .iter()
                     .zip(&probes)

@@ -10,6 +10,15 @@
 //! beyond are set by a flag (`--max-memory`), the others are documented
 //! here and in `--help`.
 
+/// The longest deflection window (mm): half the knee-form's default
+/// triangle side; a window longer than the knee-form measures a deflection
+/// it has long left behind.
+pub const MAX_WINDOW_MM: f64 = 100.0;
+
+/// The most pitches a deflection window may span: each start's slide list
+/// under the window rule holds that many columns of its footprint's rows.
+pub const MAX_WINDOW_PITCHES: f64 = 1024.0;
+
 /// The finest pitch (mm): 1 um, a hundredth of the finest pitch any study
 /// here needed (0.25 mm).
 pub const MIN_PITCH_MM: f64 = 1e-3;

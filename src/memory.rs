@@ -30,6 +30,8 @@ use crate::grid::GridSpec;
 use crate::kneeform::GridFootprint;
 use crate::padded::Padding;
 use crate::push::WindowMin;
+use crate::slide::window_depth;
+use crate::strike::StrikeRule;
 
 /// The program before any part is read: code, the font, the thread pool.
 pub const BASE_BYTES: f64 = 10.0 * MIB;
@@ -63,11 +65,12 @@ impl MemoryEstimate {
     pub fn analysis(
         spec: &GridSpec,
         footprints: &[GridFootprint],
+        rule: &StrikeRule,
         triangles: usize,
         threads: usize,
     ) -> MemoryEstimate {
         let n = spec.nx as f64 * spec.nz as f64;
-        let padding = Padding::of(spec, footprints);
+        let padding = Padding::deep(spec, footprints, window_depth(rule, spec.pitch));
         let padded = padding.nodes(spec) as f64;
         let angles = footprints.len() as f64;
         let threads = threads.max(1);
@@ -84,14 +87,18 @@ impl MemoryEstimate {
         let window = (padding.stride * (band - 1 + span)) as f64;
         let bands = footprints.len().max(1) * spec.nz.div_ceil(band).max(1);
         let tasks = threads.min(bands) as f64;
+        let thresholds = if rule.window_mm().is_some() { 2.0 } else { 1.0 };
         MemoryEstimate {
             items: vec![
                 ("program", BASE_BYTES),
                 ("part", BYTES_PER_TRIANGLE * triangles as f64),
                 ("height grid", 8.0 * n + 8.0 * padded),
-                // The ranks, the strike thresholds and the distinct heights
-                // (at most one per node).
-                ("ranks", 4.0 * padded + 4.0 * padded + 8.0 * n),
+                // The ranks, the strike thresholds (two under the window
+                // rule) and the distinct heights (at most one per node).
+                (
+                    "ranks",
+                    4.0 * padded + 4.0 * thresholds * padded + 8.0 * n,
+                ),
                 (
                     "push table",
                     WindowMin::bytes_for(spec.nz, padding.stride, WindowMin::max_width(footprints))

@@ -52,6 +52,13 @@ pub struct Padding {
 impl Padding {
     /// The padding of `spec` for all of `footprints`.
     pub fn of(spec: &GridSpec, footprints: &[GridFootprint]) -> Padding {
+        Padding::deep(spec, footprints, 0)
+    }
+
+    /// The padding of `spec` for all of `footprints`, for slides that
+    /// reach `depth` columns past their first layer (the window rule's,
+    /// [`crate::slide::window_depth`]).
+    pub fn deep(spec: &GridSpec, footprints: &[GridFootprint], depth: usize) -> Padding {
         let nx = spec.nx;
         let (mut lo, mut hi, mut dj_max) = (0i64, 0i64, 0i64);
         for fp in footprints {
@@ -64,7 +71,7 @@ impl Padding {
                 .max(i64::from(dj_lo).abs())
                 .max(i64::from(dj_hi).abs());
         }
-        let pad_lo = (-lo) as usize + LANE_SLACK;
+        let pad_lo = (-lo) as usize + depth + LANE_SLACK;
         Padding {
             pad_lo,
             pad_rows: dj_max as usize,
@@ -81,12 +88,18 @@ impl Padding {
 impl PaddedGrid {
     /// Pads `grid` for all of `footprints`.
     pub fn new(grid: &HeightGrid, footprints: &[GridFootprint]) -> PaddedGrid {
+        PaddedGrid::deep(grid, footprints, 0)
+    }
+
+    /// Pads `grid` for all of `footprints` and slides `depth` columns past
+    /// their first layer ([`Padding::deep`]).
+    pub fn deep(grid: &HeightGrid, footprints: &[GridFootprint], depth: usize) -> PaddedGrid {
         let GridSpec { nx, nz, .. } = grid.spec;
         let Padding {
             pad_lo,
             pad_rows,
             stride,
-        } = Padding::of(&grid.spec, footprints);
+        } = Padding::deep(&grid.spec, footprints, depth);
         let mut h = vec![f64::INFINITY; stride * (nz + 2 * pad_rows)];
         for (dst, src) in h[pad_rows * stride..]
             .chunks_exact_mut(stride)

@@ -7,11 +7,15 @@
 //! each start to its left reuses that list with its first layer dropped; a
 //! slide that reaches a point already found (struck) by an earlier slide of
 //! the same start row and angle finishes that point's tie group and is
-//! cancelled: both slides see the same groups from there on, the earlier
-//! one dropped to the group's lowest height there (it struck a node of it),
-//! so this one's face level is at or below the earlier one's, and the
-//! strike rule is monotone in the level: the rest would strike nothing new. A slide that meets no colliding point scans
-//! to the end of the grid, so this is slow on flat parts by design.
+//! cancelled: both slides see the same groups from there on, and both
+//! levels drop to the group's lowest height there (the earlier one struck a
+//! node of it, and this one's level is at or above the earlier one's), so
+//! the rest would strike nothing new. Under the window rule the strikes
+//! also read the level `W` mm back, where the two slides still differ, so
+//! the cancellation waits until every window looks back past that group
+//! (SPEC: the two slides' levels must agree over the last `W` mm). A slide
+//! that meets no colliding point scans to the end of the grid, so this is
+//! slow on flat parts by design.
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -19,7 +23,7 @@ use std::collections::BinaryHeap;
 use crate::kneeform::{GridFootprint, NODE_TOL};
 use crate::padded::{PaddedGrid, fmin};
 use crate::push::push_start_literal;
-use crate::strike::StrikeRule;
+use crate::strike::{LevelHistory, Meeting, RateEstimate, StrikeRule};
 
 /// One node of the merged list: its padded index, the layer it belongs to
 /// counted from the row's first start (`nx - 1`), and its tie group.
@@ -28,6 +32,8 @@ struct Entry {
     node: usize,
     layer: usize,
     group: u32,
+    /// Slide distance (mm) from the row's first start.
+    d: f64,
 }
 
 /// Marks of the nodes found in the current start row: a node is found when
@@ -100,6 +106,7 @@ pub fn paper_row(
                 node: grid.index(j as i64, 0) + i as usize,
                 layer,
                 group,
+                d,
             });
         }
         let next = layer + 1;
@@ -119,10 +126,22 @@ pub fn paper_row(
             continue;
         }
         placed += 1;
+        // Distances from this start: the row's first start's, less the
+        // columns between them.
+        let shift = dropped as f64 * p;
         let mut f = yr;
+        let mut history = LevelHistory::new(yr);
+        // The travel past which the slide repeats an earlier one's.
+        let mut cancel_at = f64::INFINITY;
         let mut k = head;
         while k < scratch.list.len() {
             let g = scratch.list[k].group;
+            let s = scratch.list[k].d - shift;
+            if s >= cancel_at {
+                counts.cancelled += 1;
+                break;
+            }
+            let earlier = history.earlier(s, rule.window);
             let mut gmin = f64::INFINITY;
             let mut reached_found = false;
             while k < scratch.list.len() && scratch.list[k].group == g {
@@ -131,7 +150,14 @@ pub fn paper_row(
                 reached_found |= scratch.found[node] == stamp;
                 // The node behind is the next column (padding past the
                 // grid's +x edge is `+inf`).
-                if rule.strikes(h, grid.h[node + 1], f, p) {
+                let met = Meeting {
+                    h,
+                    behind: grid.h[node + 1],
+                    level: f,
+                    earlier,
+                    pitch: p,
+                };
+                if rule.strikes(met) {
                     mask[node] = 1;
                     scratch.found[node] = stamp;
                 }
@@ -140,9 +166,20 @@ pub fn paper_row(
                 counts.visited += 1;
             }
             f = fmin(f, gmin);
-            if reached_found {
-                counts.cancelled += 1;
-                break;
+            history.push(s, f);
+            if reached_found && cancel_at == f64::INFINITY {
+                cancel_at = match rule.rate {
+                    // Both slides now hold one level: what is left repeats.
+                    RateEstimate::XSlope => s,
+                    // The rest repeats once the windows of both look back
+                    // past this group only, with a pitch to spare for the
+                    // rounding of the two slides' travels.
+                    RateEstimate::Window => s + rule.window + p,
+                };
+                if cancel_at == s {
+                    counts.cancelled += 1;
+                    break;
+                }
             }
         }
     }

@@ -21,7 +21,7 @@
 use rayon::prelude::*;
 
 use crate::padded::PaddedGrid;
-use crate::strike::StrikeRule;
+use crate::strike::{Meeting, RateEstimate, StrikeRule};
 
 /// A height's rank: `NEVER` below every height, `1..=n` for the grid's `n`
 /// distinct finite heights in increasing order, [`OFF`] for `+inf`.
@@ -88,9 +88,11 @@ impl RankedGrid {
 
     /// Per node of `padded` (ranked as `self`), the lowest rank whose
     /// height, as the face level that meets the node, makes it a strike by
-    /// `rule` on a grid of pitch `pitch`; [`OFF`] where no height does.
-    /// The node behind `n` is `n + 1`: the next column, or past a row's
-    /// last real column the padding's `+inf`; the last node is padding.
+    /// `rule` on a grid of pitch `pitch` (under the window rule: a
+    /// contact, the deflection test being [`RankedGrid::window_thresholds`]);
+    /// [`OFF`] where no height does. The node behind `n` is `n + 1`: the
+    /// next column, or past a row's last real column the padding's `+inf`;
+    /// the last node is padding.
     ///
     /// A level strikes only above the node's own height, so the search
     /// runs over the heights above it, and it is a binary search because
@@ -98,6 +100,34 @@ impl RankedGrid {
     /// is most often a few heights above the node's own (`h + e0`).
     pub fn thresholds(&self, padded: &PaddedGrid, rule: &StrikeRule) -> Vec<Rank> {
         let pitch = padded.spec.pitch;
+        self.per_node(padded, |own, behind, f| match rule.rate {
+            RateEstimate::Window => rule.is_contact(own, f),
+            RateEstimate::XSlope => rule.strikes(Meeting {
+                h: own,
+                behind,
+                level: f,
+                earlier: f,
+                pitch,
+            }),
+        })
+    }
+
+    /// Per node of `padded`, the lowest rank whose height, as the level
+    /// `W` mm of travel before the node, passes the window rule's
+    /// deflection test ([`StrikeRule::window_strikes`]); [`OFF`] where no
+    /// height does. Monotone in that level, so a binary search again.
+    pub fn window_thresholds(&self, padded: &PaddedGrid, rule: &StrikeRule) -> Vec<Rank> {
+        self.per_node(padded, |own, _, earlier| rule.window_strikes(own, earlier))
+    }
+
+    /// Per node, the lowest rank above the node's own height for which
+    /// `passes(h, behind, level)` holds, `passes` being monotone in the
+    /// level.
+    fn per_node(
+        &self,
+        padded: &PaddedGrid,
+        passes: impl Fn(f64, f64, f64) -> bool + Sync,
+    ) -> Vec<Rank> {
         let h = &padded.h;
         let mut out = vec![OFF; h.len()];
         out.par_chunks_mut(padded.stride)
@@ -114,7 +144,7 @@ impl RankedGrid {
                     }
                     let above = self.ranks[n] as usize;
                     let higher = &self.heights[above..];
-                    let lowest = first_true(higher, |f| rule.strikes(own, behind, f, pitch));
+                    let lowest = first_true(higher, |f| passes(own, behind, f));
                     if lowest < higher.len() {
                         *t = (above + lowest) as Rank + 1;
                     }
@@ -225,18 +255,31 @@ mod tests {
             StrikeRule::new(0.0, 1e-6),
             StrikeRule::new(0.5, 1e-6),
             StrikeRule::new(30.0, 0.0),
-            StrikeRule::new(3.0, 0.05).with_rate(crate::strike::RateEstimate::Capped),
+            StrikeRule::new(3.0, 0.05).with_rate(RateEstimate::XSlope),
+            StrikeRule::new(0.0, 1e-6).with_rate(RateEstimate::XSlope),
         ] {
             let thr = ranked.thresholds(&grid, &rule);
+            let thr_w = ranked.window_thresholds(&grid, &rule);
             let mut struck = 0;
-            for (n, &t) in thr.iter().enumerate().take(grid.h.len() - 1) {
+            for (n, (&t, &tw)) in thr.iter().zip(&thr_w).enumerate().take(grid.h.len() - 1) {
                 for r in (0..=ranked.heights.len() as Rank).chain([OFF]) {
                     let level = ranked.height(r);
                     if !level.is_finite() && r != NEVER {
                         continue;
                     }
-                    let want = rule.strikes(grid.h[n], grid.h[n + 1], level, 0.5);
+                    let h = grid.h[n];
+                    let want = match rule.rate {
+                        RateEstimate::Window => rule.is_contact(h, level),
+                        RateEstimate::XSlope => rule.strikes(Meeting {
+                            h,
+                            behind: grid.h[n + 1],
+                            level,
+                            earlier: level,
+                            pitch: 0.5,
+                        }),
+                    };
                     assert_eq!(r >= t, want, "node {n}, rank {r}");
+                    assert_eq!(r >= tw, rule.window_strikes(h, level), "node {n}, rank {r}");
                     struck += usize::from(want);
                 }
             }

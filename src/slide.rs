@@ -24,10 +24,11 @@
 //! Heights and levels are taken as their ranks ([`crate::ranked`]), and
 //! the rule as each node's threshold rank: the same comparisons, exactly.
 
-use crate::kneeform::GridFootprint;
+use crate::kneeform::{GridFootprint, NODE_TOL};
 use crate::padded::PaddedGrid;
 use crate::push::WindowOf;
 use crate::ranked::{NEVER, OFF, Rank};
+use crate::strike::{LevelHistory, StrikeRule};
 
 /// The first layer of one footprint, ready for [`slide_block`]: the offset
 /// from a start's node to the first node in front in each footprint row, in
@@ -45,6 +46,9 @@ pub struct LayerRows {
     /// Where it does, the first node in front (`kf = klo - 1`) is inside
     /// the footprint of the start one column to -x.
     inside: Vec<bool>,
+    /// Each offset's slide distance `d0` (mm): the travel at which the
+    /// start meets it.
+    d: Vec<f64>,
 }
 
 impl LayerRows {
@@ -61,6 +65,7 @@ impl LayerRows {
                 .collect(),
             dj: rows().map(|row| row.dj).collect(),
             inside: rows().map(|row| row.khi >= row.klo).collect(),
+            d: rows().map(|row| row.d0).collect(),
         }
     }
 
@@ -95,12 +100,14 @@ impl LayerRows {
             group: Vec::new(),
             dj: Vec::new(),
             inside: Vec::new(),
+            d: Vec::new(),
         };
         for n in (0..self.offsets.len()).filter(|&n| real(self.dj[n])) {
             layer.offsets.push(self.offsets[n]);
             layer.group.push(self.group[n]);
             layer.dj.push(self.dj[n]);
             layer.inside.push(self.inside[n]);
+            layer.d.push(self.d[n]);
         }
         std::borrow::Cow::Owned(layer)
     }
@@ -208,4 +215,316 @@ pub fn slide_carried(
         carry = carry.min(h[a]);
     }
     carry
+}
+
+/// How far (mm) a placed start must be slid under the window rule before
+/// the start one column to -x, if placed, decides everything it would:
+/// `W` and a pitch (the newer start's window must look back past its own
+/// entry), and a pitch to spare for where its first nodes in front lie
+/// (`d0 <= p`) and for rounding.
+pub fn window_reach(window: f64, pitch: f64) -> f64 {
+    window + 2.0 * pitch
+}
+
+/// Columns beyond the first layer that [`WindowLayers`] reach: what the
+/// padding must add before column 0 for the virtual starts' deepest nodes.
+pub fn window_depth(rule: &StrikeRule, pitch: f64) -> usize {
+    match rule.window_mm() {
+        Some(window) => (window_reach(window, pitch) / pitch).ceil() as usize + 1,
+        None => 0,
+    }
+}
+
+/// The window rule's slide list of one footprint: every node in front of a
+/// start up to [`window_reach`] of travel, in slide order, with its tie
+/// groups and, per group, which earlier groups lie the window `W` behind
+/// it. Under the window rule a start's strike reads its level `W` back, so
+/// a placed start is no longer decided by its first layer alone: the
+/// newer start one column to -x dominates it (its level is at least as
+/// high at both travels) only once that start has itself travelled `W`.
+/// So each placed start slides this far, and further where the starts to
+/// its -x are not placed ([`Extension`]).
+#[derive(Debug, Clone)]
+pub struct WindowLayers {
+    /// Each entry's offset from the start's node, in slide order.
+    offsets: Vec<isize>,
+    /// Each entry's tie group, numbered in slide order.
+    group: Vec<u32>,
+    /// Each entry's footprint row, an index into `rows`.
+    row: Vec<u32>,
+    /// Per group: the number of groups that lie `W` behind it (travel
+    /// `<= s - W + 1e-9`); its window level is the level after them.
+    behind: Vec<u32>,
+    /// Per footprint row: the offset of its deepest entry, the columns its
+    /// entries span past that one, and whether the row is a real one
+    /// (entries on padding rows are dropped by [`WindowLayers::within`]).
+    rows: Vec<(isize, usize, bool)>,
+    /// Each row's `dj`.
+    dj: Vec<i32>,
+}
+
+impl WindowLayers {
+    /// Lays out `fp`'s slide list on `grid` for the window `window` (mm).
+    /// Each entry's distance is `d0 + m p`, exactly as the per-start
+    /// trace computes it, and groups are chained within
+    /// [`NODE_TOL`](crate::kneeform::NODE_TOL) as there.
+    pub fn new(grid: &PaddedGrid, fp: &GridFootprint, window: f64) -> WindowLayers {
+        let p = fp.pitch;
+        let reach = window_reach(window, p);
+        // (distance, dj, row, offset)
+        let mut entries: Vec<(f64, i32, u32, isize)> = Vec::new();
+        let mut rows = Vec::with_capacity(fp.rows.len());
+        for (r, row) in fp.rows.iter().enumerate() {
+            let mut m = 0;
+            loop {
+                let d = row.d0 + m as f64 * p;
+                if m > 0 && d > reach {
+                    break;
+                }
+                entries.push((d, row.dj, r as u32, grid.offset(row.dj, row.kf - m)));
+                m += 1;
+            }
+            rows.push((grid.offset(row.dj, row.kf - (m - 1)), (m - 1) as usize, true));
+        }
+        entries.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let mut group = Vec::with_capacity(entries.len());
+        let mut travel: Vec<f64> = Vec::new();
+        for (e, entry) in entries.iter().enumerate() {
+            if e == 0 || entry.0 - entries[e - 1].0 > NODE_TOL {
+                travel.push(entry.0);
+            }
+            group.push(travel.len() as u32 - 1);
+        }
+        let mut behind = Vec::with_capacity(travel.len());
+        let mut n = 0;
+        for (g, &s) in travel.iter().enumerate() {
+            let limit = s - window + StrikeRule::WINDOW_TOL;
+            while n < g && travel[n] <= limit {
+                n += 1;
+            }
+            behind.push(n as u32);
+        }
+        WindowLayers {
+            offsets: entries.iter().map(|e| e.3).collect(),
+            group,
+            row: entries.iter().map(|e| e.2).collect(),
+            behind,
+            rows,
+            dj: fp.rows.iter().map(|r| r.dj).collect(),
+        }
+    }
+
+    /// The list of a start in row `j0` of a grid of `nz` rows without the
+    /// entries on the `+inf` padding rows (as [`LayerRows::within`]).
+    pub fn within(&self, j0: usize, nz: usize) -> std::borrow::Cow<'_, WindowLayers> {
+        let real = |dj: i32| (0..nz as i64).contains(&(j0 as i64 + i64::from(dj)));
+        if self.dj.iter().all(|&dj| real(dj)) {
+            return std::borrow::Cow::Borrowed(self);
+        }
+        let keep: Vec<usize> = (0..self.offsets.len())
+            .filter(|&e| real(self.dj[self.row[e] as usize]))
+            .collect();
+        std::borrow::Cow::Owned(WindowLayers {
+            offsets: keep.iter().map(|&e| self.offsets[e]).collect(),
+            group: keep.iter().map(|&e| self.group[e]).collect(),
+            row: keep.iter().map(|&e| self.row[e]).collect(),
+            behind: self.behind.clone(),
+            rows: self
+                .rows
+                .iter()
+                .zip(&self.dj)
+                .map(|(&(offset, span, _), &dj)| (offset, span, real(dj)))
+                .collect(),
+            dj: self.dj.clone(),
+        })
+    }
+
+    /// The columns the deepest entry lies past the first layer.
+    pub fn depth(&self) -> usize {
+        self.rows.iter().map(|r| r.1).max().unwrap_or(0)
+    }
+}
+
+/// What [`slide_block_window`] reads and writes besides the heights.
+pub struct WindowSlide<'a> {
+    /// Per node, the lowest level (rank) at which it is a contact.
+    pub contact: &'a [Rank],
+    /// Per node, the lowest level (rank) `W` back at which it passes the
+    /// window's deflection test.
+    pub deflected: &'a [Rank],
+    /// Per node, the highest level that met it (for the probes).
+    pub reach: &'a mut [Rank],
+    /// Per node, 1 where a slide struck it.
+    pub struck: &'a mut [u8],
+    /// Scratch: the entries slid over.
+    pub slid: &'a mut Vec<u32>,
+}
+
+/// Slides `B` consecutive starts over their [`WindowLayers`], each with
+/// its own level and its own level `W` back, and marks every node a start
+/// strikes by the window rule in `out.struck` (the strike is decided at
+/// each visit: it reads two levels, so no single reach per node decides
+/// it). `level[w]` is the level start `w` enters with (`yr`, or [`NEVER`]
+/// where not placed: it meets nothing).
+///
+/// With `still` (as in [`slide_block`]), a footprint row whose nodes over
+/// the block's lanes and the row's span are none below every start's level
+/// is passed over: it lowers no level, so it moves no window level, and no
+/// node of it is a contact.
+#[inline(always)]
+pub fn slide_block_window<const B: usize>(
+    h: &[Rank],
+    out: &mut WindowSlide,
+    layers: &WindowLayers,
+    base: usize,
+    level: [Rank; B],
+    still: Option<(WindowOf, usize)>,
+) {
+    let top = level.iter().copied().max().unwrap_or(NEVER);
+    if top == NEVER {
+        return;
+    }
+    let row_slid: Vec<bool> = layers
+        .rows
+        .iter()
+        .map(|&(offset, span, real)| {
+            real && match still {
+                Some((minima, shift)) => {
+                    let first = base.wrapping_add_signed(offset) + shift;
+                    let last = first + span;
+                    let mut at = first;
+                    loop {
+                        if minima.at(at.min(last)) < top {
+                            break true;
+                        }
+                        if at >= last {
+                            break false;
+                        }
+                        at += B;
+                    }
+                }
+                None => true,
+            }
+        })
+        .collect();
+    out.slid.clear();
+    out.slid.extend(
+        (0..layers.offsets.len() as u32).filter(|&e| row_slid[layers.row[e as usize] as usize]),
+    );
+    let mut level = level;
+    let mut before = level;
+    let mut earlier = level;
+    let mut group = None;
+    // The slid entries the window levels have taken in.
+    let mut trail = 0;
+    for k in 0..out.slid.len() {
+        let e = out.slid[k] as usize;
+        let g = layers.group[e];
+        if group != Some(g) {
+            group = Some(g);
+            before = level;
+            let behind = layers.behind[g as usize];
+            while trail < k && layers.group[out.slid[trail] as usize] < behind {
+                let a = base.wrapping_add_signed(layers.offsets[out.slid[trail] as usize]);
+                let hv: &[Rank; B] = h[a..a + B].try_into().expect("B values");
+                for w in 0..B {
+                    earlier[w] = earlier[w].min(hv[w]);
+                }
+                trail += 1;
+            }
+        }
+        let a = base.wrapping_add_signed(layers.offsets[e]);
+        let hv: &[Rank; B] = h[a..a + B].try_into().expect("B values");
+        let contact: &[Rank; B] = out.contact[a..a + B].try_into().expect("B values");
+        let deflected: &[Rank; B] = out.deflected[a..a + B].try_into().expect("B values");
+        let r: &mut [Rank; B] = (&mut out.reach[a..a + B]).try_into().expect("B values");
+        for w in 0..B {
+            r[w] = r[w].max(before[w]);
+        }
+        let s: &mut [u8; B] = (&mut out.struck[a..a + B]).try_into().expect("B values");
+        for w in 0..B {
+            s[w] |= u8::from(before[w] >= contact[w]) & u8::from(earlier[w] >= deflected[w]);
+            level[w] = level[w].min(hv[w]);
+        }
+    }
+}
+
+/// The scalar slide of one placed start past its [`WindowLayers`]: where
+/// the starts on its -x side are not placed, no newer start dominates it
+/// there, so it slides on, one column's first layer at a time, until the
+/// first placed start past them has itself travelled [`window_reach`].
+#[derive(Debug, Clone)]
+pub struct Extension {
+    /// The start's column.
+    pub column: i64,
+    level: Rank,
+    history: LevelHistory<Rank>,
+    /// The travel (mm) past which a newer placed start decides for it.
+    stop: Option<f64>,
+}
+
+impl Extension {
+    /// The slide of the start in `column`, pushed to `yr`.
+    pub fn new(column: i64, yr: Rank) -> Extension {
+        Extension {
+            column,
+            level: yr,
+            history: LevelHistory::new(yr),
+            stop: None,
+        }
+    }
+
+    /// Whether the column `shift` mm of travel on still matters, and if a
+    /// placed start stands there (`placed`), from when on it no longer
+    /// will.
+    pub fn goes_on(&mut self, shift: f64, placed: bool, window: f64, pitch: f64) -> bool {
+        if self.stop.is_some_and(|stop| shift > stop) {
+            return false;
+        }
+        if placed && self.stop.is_none() {
+            self.stop = Some(shift + window_reach(window, pitch));
+        }
+        true
+    }
+
+    /// Slides over the first layer `layer` of the column whose node is
+    /// `node` (in `h`'s indexing), `shift` mm of this start's travel past
+    /// its own node, judging each node by the window rule (`window` mm).
+    #[allow(clippy::too_many_arguments)]
+    pub fn advance(
+        &mut self,
+        h: &[Rank],
+        out: &mut WindowSlide,
+        layer: &LayerRows,
+        node: usize,
+        shift: f64,
+        window: f64,
+    ) {
+        let at = |offset: &isize| node.wrapping_add_signed(*offset);
+        if layer.offsets.iter().all(|o| h[at(o)] == OFF) {
+            return;
+        }
+        let mut group = None;
+        let mut before = self.level;
+        let mut earlier = self.level;
+        let mut travel = 0.0;
+        for ((offset, &g), &d) in layer.offsets.iter().zip(&layer.group).zip(&layer.d) {
+            if group != Some(g) {
+                if group.is_some() && self.level < before {
+                    self.history.push(travel, self.level);
+                }
+                group = Some(g);
+                before = self.level;
+                travel = d + shift;
+                earlier = self.history.earlier(travel, window);
+            }
+            let a = at(offset);
+            out.reach[a] = out.reach[a].max(before);
+            out.struck[a] |= u8::from(before >= out.contact[a]) & u8::from(earlier >= out.deflected[a]);
+            self.level = self.level.min(h[a]);
+        }
+        if group.is_some() && self.level < before {
+            self.history.push(travel, self.level);
+        }
+    }
 }

@@ -3,63 +3,85 @@
 //!
 //! A node met by the knee-form at face level `f` is a **contact** when it
 //! sticks out past the face by more than the rounding tolerance `e0`
-//! (`h < f - e0`), and a contact is a **strike** when its **deflection
-//! rate** exceeds `sigma = tan(delta)`:
+//! (`h < f - e0`), and a contact is a **strike** when the knee-form is
+//! turned aside by more than `delta` (`sigma = tan(delta)`), measured by
+//! one of two rules:
 //!
-//! * `r = (h[i+1][j] - h) / p`, the rise of the surface from the node one
-//!   pitch behind it in the same row (the node the knee-form met just
-//!   before);
-//! * `r = (f - h) / p` where that node is `+inf` (off the part).
+//! * **window** (SPEC's default): the level dropped by more than
+//!   `sigma * W` over the last `W` mm of travel, `f(s - W) - h > sigma W`,
+//!   where `f(s - W)` is the start's own level after every earlier group
+//!   whose travel is `<= s - W + 1e-9` (the pushed level `yr` where there
+//!   is none) and `W` the **deflection window** (`--window`, mm);
+//! * **x-slope** (SPEC's former baseline, kept so that implementations can
+//!   be compared node for node): `r = (h[i+1][j] - h) / p`, the rise of
+//!   the surface from the node one pitch behind it in the same row, or
+//!   `(f - h) / p` where that node is `+inf` (off the part), above `sigma`.
 //!
-//! The knee-form strikes a surface that turns it aside by more than
-//! `delta`; one it merely brushes, nearly parallel to its motion, is not a
-//! strike. Both conditions are monotone in `f` (a higher level strikes at
-//! least what a lower one does), which is what lets the fast path keep each
-//! node's highest level ("reach") and decide once per angle.
+//! The knee-form strikes a surface that turns it aside; one it merely
+//! brushes, nearly parallel to its motion, is not a strike. Every test is
+//! monotone in each level it reads (the level at the node, and under the
+//! window the level `W` earlier): a higher level strikes at least what a
+//! lower one does, which is what lets the fast path keep per node the
+//! highest level that met it, and per start the newest level only.
 //!
 //! Every implementation (fast, paper-literal, the harness's per-start
-//! trace) evaluates the rule through [`StrikeRule::strikes`], so the same
+//! trace) evaluates the rule through [`StrikeRule::is_contact`],
+//! [`StrikeRule::window_strikes`] and [`StrikeRule::strikes`], so the same
 //! floating-point expression decides everywhere; the integration tests
 //! compare them with an independent transcription.
 
 use serde::{Deserialize, Serialize};
 
-/// How a grid contact's deflection rate is estimated.
+/// How a grid contact's deflection is measured.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum RateEstimate {
-    /// SPEC's baseline (the default, comparable node for node with any
-    /// implementation of SPEC): the rise of the surface from the node one
+    /// SPEC's default: the drop of the start's own level over the last
+    /// `W` mm of travel (the deflection window), against `sigma * W`. A
+    /// fixed length, independent of the pitch, so the grid's level error
+    /// moves the measured rate by about `p / W` and the grid converges to
+    /// the exact rule.
+    #[default]
+    Window,
+    /// SPEC's former baseline, comparable node for node with any
+    /// implementation of it: the rise of the surface from the node one
     /// pitch behind the contact, `(h[i+1][j] - h) / p` (`(f - h) / p`
     /// where that node is off the part).
-    #[default]
     XSlope,
-    /// The x-slope, capped by how far the contact turns the knee-form
-    /// aside over one pitch: `min(x-slope, (f - h) / p)`. A node that
-    /// sticks out past the level only a little is no strike however steep
-    /// the surface behind it (a crest the knee-form crosses nearly level, a
-    /// crease its edge rides along); on a steady slope and at a riser both
-    /// are the same. Still monotone in `f`. Measured (`results/README.md`):
-    /// it removes the near-level false alarms of the tilted wave but delays
-    /// strikes where footprint rows interleave (each node then sticks out
-    /// past a level its neighbour rows just set by less than `sigma p`),
-    /// so it is not the default.
-    Capped,
 }
 
 impl RateEstimate {
     /// The name, as `--rate` takes it and `summary.json` records it.
     pub fn name(self) -> &'static str {
         match self {
+            RateEstimate::Window => "window",
             RateEstimate::XSlope => "x-slope",
-            RateEstimate::Capped => "capped",
         }
     }
 }
 
+/// What the rule reads of one node met by a slide.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Meeting {
+    /// The node's height `h` (mm, analysis y).
+    pub h: f64,
+    /// The height of the node one pitch behind it (+x) in its row, `+inf`
+    /// off the part or past the grid (read by `x-slope` only).
+    pub behind: f64,
+    /// The face level `f` the node is met at: the level before its tie
+    /// group (mm).
+    pub level: f64,
+    /// The start's level `W` mm of travel earlier, `f(s - W)` (mm; read by
+    /// `window` only).
+    pub earlier: f64,
+    /// The grid pitch `p` (mm).
+    pub pitch: f64,
+}
+
 /// SPEC's strike rule: the rounding tolerance `e0`, the deflection
-/// threshold `sigma = tan(delta)` and how a contact's rate is estimated.
+/// threshold `sigma = tan(delta)`, how the deflection is measured and over
+/// which window.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct StrikeRule {
     /// Rounding tolerance (mm, >= 0): a node is a contact when it sticks
@@ -68,8 +90,15 @@ pub struct StrikeRule {
     /// Deflection threshold as a rate, `tan(delta)` (>= 0): a contact is a
     /// strike when the surface turns the knee-form aside faster than this.
     pub sigma: f64,
-    /// The rate estimate.
+    /// How the deflection is measured.
     pub rate: RateEstimate,
+    /// The deflection window `W` (mm, > 0) of [`RateEstimate::Window`].
+    #[serde(default = "default_window")]
+    pub window: f64,
+}
+
+fn default_window() -> f64 {
+    StrikeRule::DEFAULT_WINDOW_MM
 }
 
 impl StrikeRule {
@@ -77,20 +106,36 @@ impl StrikeRule {
     pub const DEFAULT_DEFLECTION_DEG: f64 = 0.5;
     /// SPEC's default rounding tolerance `e0` (mm).
     pub const DEFAULT_E0: f64 = 1e-6;
+    /// SPEC's default deflection window `W` (mm): the smallest of 2, 5 and
+    /// 10 mm that tamed the tilted wave's undecided strikes (SPEC, "Why a
+    /// window").
+    pub const DEFAULT_WINDOW_MM: f64 = 5.0;
+    /// How far (mm) a group's travel may lie past `s - W` and still count
+    /// as `W` behind: SPEC's tolerance, so that travels equal in exact
+    /// arithmetic (a window that is a multiple of the pitch) agree whatever
+    /// their rounding.
+    pub const WINDOW_TOL: f64 = 1e-9;
 
-    /// The rule for a deflection threshold of `deflection_deg` degrees
-    /// (in `[0, 90)`) and a rounding tolerance of `e0` mm.
+    /// The window rule for a deflection threshold of `deflection_deg`
+    /// degrees (in `[0, 90)`), a rounding tolerance of `e0` mm and SPEC's
+    /// default window.
     pub fn new(deflection_deg: f64, e0: f64) -> StrikeRule {
         StrikeRule {
             e0,
             sigma: deflection_deg.to_radians().tan(),
             rate: RateEstimate::default(),
+            window: Self::DEFAULT_WINDOW_MM,
         }
     }
 
-    /// The same rule with the rate estimated by `rate`.
+    /// The same rule with the deflection measured by `rate`.
     pub fn with_rate(self, rate: RateEstimate) -> StrikeRule {
         StrikeRule { rate, ..self }
+    }
+
+    /// The same rule with the deflection window `window` (mm).
+    pub fn with_window(self, window: f64) -> StrikeRule {
+        StrikeRule { window, ..self }
     }
 
     /// The deflection threshold `delta` (degrees).
@@ -98,9 +143,31 @@ impl StrikeRule {
         self.sigma.atan().to_degrees()
     }
 
-    /// SPEC's baseline rate of a contact: the rise `behind - h` of the
-    /// surface over one pitch `p` from the node behind it, or `level - h`
-    /// over `p` where that node is off the part (`+inf`).
+    /// The window in mm as recorded (`window_mm`): the window rule's `W`,
+    /// `None` under `x-slope`, which has none.
+    pub fn window_mm(&self) -> Option<f64> {
+        (self.rate == RateEstimate::Window).then_some(self.window)
+    }
+
+    /// Whether the node of height `h`, met at face level `level`, is a
+    /// contact: it sticks out past the face by more than `e0`. Monotone in
+    /// `level`.
+    #[inline(always)]
+    pub fn is_contact(&self, h: f64, level: f64) -> bool {
+        h < level - self.e0
+    }
+
+    /// Under the window rule, whether a node of height `h` passes the
+    /// deflection test against the level `earlier`, `W` mm of travel
+    /// before it: `f(s - W) - h > sigma W`. Monotone in `earlier`.
+    #[inline(always)]
+    pub fn window_strikes(&self, h: f64, earlier: f64) -> bool {
+        earlier - h > self.sigma * self.window
+    }
+
+    /// SPEC's former baseline rate of a contact: the rise `behind - h` of
+    /// the surface over one pitch `p` from the node behind it, or
+    /// `level - h` over `p` where that node is off the part (`+inf`).
     #[inline(always)]
     pub fn x_slope(h: f64, behind: f64, level: f64, p: f64) -> f64 {
         let from = if behind == f64::INFINITY {
@@ -111,23 +178,15 @@ impl StrikeRule {
         (from - h) / p
     }
 
-    /// The rate of a contact under this rule's estimate.
+    /// Whether the node met as `m` is a strike. Monotone in `m.level` and
+    /// in `m.earlier`.
     #[inline(always)]
-    pub fn rate(&self, h: f64, behind: f64, level: f64, p: f64) -> f64 {
-        let x_slope = Self::x_slope(h, behind, level, p);
-        match self.rate {
-            RateEstimate::XSlope => x_slope,
-            RateEstimate::Capped => x_slope.min((level - h) / p),
-        }
-    }
-
-    /// Whether the node of height `h`, with `behind` the height of the node
-    /// one pitch behind it in its row (`+inf` off the part), met by the
-    /// knee-form at face level `level` on a grid of pitch `p`, is a strike.
-    /// Monotone in `level` (both rates are non-decreasing in it).
-    #[inline(always)]
-    pub fn strikes(&self, h: f64, behind: f64, level: f64, p: f64) -> bool {
-        h < level - self.e0 && self.rate(h, behind, level, p) > self.sigma
+    pub fn strikes(&self, m: Meeting) -> bool {
+        self.is_contact(m.h, m.level)
+            && match self.rate {
+                RateEstimate::Window => self.window_strikes(m.h, m.earlier),
+                RateEstimate::XSlope => Self::x_slope(m.h, m.behind, m.level, m.pitch) > self.sigma,
+            }
     }
 }
 
@@ -137,60 +196,148 @@ impl Default for StrikeRule {
     }
 }
 
+/// A start's level history along its slide, for the window rule's
+/// `f(s - W)`: the level after each tie group (or after each that lowered
+/// it), by increasing travel. What the per-start implementations (the
+/// paper-literal path, the harness's trace, the fast path's scalar
+/// slides) share. `L` is a level: a height in mm or its rank.
+#[derive(Debug, Clone, Default)]
+pub struct LevelHistory<L = f64> {
+    /// `(travel, level after the group)` per group so far.
+    groups: Vec<(f64, L)>,
+    /// How many of `groups` lie at least `W` behind the last group asked.
+    behind: usize,
+    /// The pushed level `yr`.
+    pushed: L,
+}
+
+impl<L: Copy> LevelHistory<L> {
+    /// An empty history of a start pushed to `yr`.
+    pub fn new(yr: L) -> LevelHistory<L> {
+        LevelHistory {
+            groups: Vec::new(),
+            behind: 0,
+            pushed: yr,
+        }
+    }
+
+    /// SPEC's `f(s - W)` for the group at travel `s` (asked by
+    /// non-decreasing travel): the level after every earlier group whose
+    /// travel is `<= s - W + 1e-9`, `yr` where there is none.
+    pub fn earlier(&mut self, s: f64, window: f64) -> L {
+        let limit = s - window + StrikeRule::WINDOW_TOL;
+        while self.behind < self.groups.len() && self.groups[self.behind].0 <= limit {
+            self.behind += 1;
+        }
+        match self.behind {
+            0 => self.pushed,
+            n => self.groups[n - 1].1,
+        }
+    }
+
+    /// Records the group at travel `s` that left the level at `level`.
+    pub fn push(&mut self, s: f64, level: L) {
+        self.groups.push((s, level));
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    #[test]
-    fn rate_is_the_rise_from_the_node_behind_or_from_the_level_off_the_part() {
-        let x_slope = StrikeRule::default().with_rate(RateEstimate::XSlope);
-        assert_eq!(x_slope.rate(1.0, 3.0, 10.0, 2.0), 1.0);
-        assert_eq!(x_slope.rate(1.0, f64::INFINITY, 10.0, 2.0), 4.5);
-        // Capped: a node 0.1 mm past the level, however steep behind it.
-        assert_eq!(StrikeRule::default().rate, RateEstimate::XSlope);
-        let capped = StrikeRule::default().with_rate(RateEstimate::Capped);
-        assert!((capped.rate(1.0, 3.0, 1.1, 2.0) - 0.05).abs() < 1e-12);
-        assert_eq!(capped.rate(1.0, 3.0, 10.0, 2.0), 1.0);
-        assert_eq!(capped.rate(1.0, f64::INFINITY, 10.0, 2.0), 4.5);
+    fn met(h: f64, behind: f64, level: f64, earlier: f64, pitch: f64) -> Meeting {
+        Meeting {
+            h,
+            behind,
+            level,
+            earlier,
+            pitch,
+        }
     }
 
     #[test]
-    fn a_contact_strikes_only_above_the_threshold() {
+    fn x_slope_is_the_rise_from_the_node_behind_or_from_the_level_off_the_part() {
+        assert_eq!(StrikeRule::x_slope(1.0, 3.0, 10.0, 2.0), 1.0);
+        assert_eq!(StrikeRule::x_slope(1.0, f64::INFINITY, 10.0, 2.0), 4.5);
+        assert_eq!(StrikeRule::default().rate, RateEstimate::Window);
+        assert_eq!(StrikeRule::default().window, 5.0);
+    }
+
+    #[test]
+    fn an_x_slope_contact_strikes_only_above_the_threshold() {
         let rule = StrikeRule::new(45.0, 1e-6).with_rate(RateEstimate::XSlope);
         assert!((rule.sigma - 1.0).abs() < 1e-12);
         // Rise 2 over pitch 1: rate 2 > 1.
-        assert!(rule.strikes(0.0, 2.0, 5.0, 1.0));
+        assert!(rule.strikes(met(0.0, 2.0, 5.0, 5.0, 1.0)));
         // Rise 0.5 over pitch 1: a contact, but too gentle.
-        assert!(!rule.strikes(0.0, 0.5, 5.0, 1.0));
+        assert!(!rule.strikes(met(0.0, 0.5, 5.0, 5.0, 1.0)));
         // Not below the level by more than e0: no contact at all.
-        assert!(!rule.strikes(5.0 - 1e-7, 100.0, 5.0, 1.0));
+        assert!(!rule.strikes(met(5.0 - 1e-7, 100.0, 5.0, 5.0, 1.0)));
         // Off the part behind: the drop from the level decides.
-        assert!(rule.strikes(0.0, f64::INFINITY, 1.5, 1.0));
-        assert!(!rule.strikes(0.0, f64::INFINITY, 0.5, 1.0));
+        assert!(rule.strikes(met(0.0, f64::INFINITY, 1.5, 1.5, 1.0)));
+        assert!(!rule.strikes(met(0.0, f64::INFINITY, 0.5, 0.5, 1.0)));
     }
 
     #[test]
-    fn zero_deflection_strikes_any_rise() {
-        let rule = StrikeRule::new(0.0, 1e-6).with_rate(RateEstimate::XSlope);
-        assert!(rule.strikes(0.0, 1e-9, 1.0, 1.0));
-        assert!(!rule.strikes(0.0, 0.0, 1.0, 1.0));
+    fn a_window_contact_strikes_when_the_level_dropped_more_than_sigma_w() {
+        // sigma 0.1 over W = 5: a drop of more than 0.5 mm.
+        let rule = StrikeRule {
+            e0: 1e-6,
+            sigma: 0.1,
+            rate: RateEstimate::Window,
+            window: 5.0,
+        };
+        assert!(rule.strikes(met(0.0, 0.0, 0.2, 0.6, 1.0)));
+        assert!(!rule.strikes(met(0.0, 0.0, 0.2, 0.4, 1.0)));
+        // The x-slope is not read: a steep rise behind changes nothing.
+        assert!(!rule.strikes(met(0.0, 100.0, 0.2, 0.4, 1.0)));
+        // A contact is still needed, however far the level dropped.
+        assert!(!rule.strikes(met(0.0, 0.0, 0.0, 9.0, 1.0)));
+        assert_eq!(rule.window_mm(), Some(5.0));
+        assert_eq!(rule.with_rate(RateEstimate::XSlope).window_mm(), None);
+    }
+
+    #[test]
+    fn zero_deflection_strikes_any_contact_under_the_window() {
+        let rule = StrikeRule::new(0.0, 1e-6);
+        assert!(rule.strikes(met(0.0, 0.0, 1e-5, 1e-5, 1.0)));
+        assert!(!rule.strikes(met(0.0, 0.0, 1e-7, 1.0, 1.0)));
         assert!((StrikeRule::default().deflection_deg() - 0.5).abs() < 1e-12);
     }
 
     #[test]
-    fn strikes_are_monotone_in_the_level() {
-        let rules = [RateEstimate::XSlope, RateEstimate::Capped]
+    fn the_level_w_earlier_is_read_after_the_last_group_that_far_behind() {
+        let mut history = LevelHistory::new(10.0);
+        // Before W of travel: the pushed level.
+        assert_eq!(history.earlier(1.0, 5.0), 10.0);
+        history.push(1.0, 9.0);
+        history.push(3.0, 7.0);
+        assert_eq!(history.earlier(5.9, 5.0), 10.0);
+        // Exactly W behind (within 1e-9) counts as behind.
+        assert_eq!(history.earlier(6.0 - 5e-10, 5.0), 9.0);
+        history.push(6.0, 6.0);
+        assert_eq!(history.earlier(7.5, 5.0), 9.0);
+        assert_eq!(history.earlier(8.0, 5.0), 7.0);
+        assert_eq!(history.earlier(100.0, 5.0), 6.0);
+    }
+
+    #[test]
+    fn strikes_are_monotone_in_both_levels() {
+        let rules = [RateEstimate::XSlope, RateEstimate::Window]
             .map(|r| StrikeRule::default().with_rate(r));
         for (rule, behind) in rules
             .iter()
             .flat_map(|r| [f64::INFINITY, 0.0, 0.004, 0.02].map(|b| (r, b)))
         {
-            let mut struck = false;
-            for k in 0..2000 {
-                let level = k as f64 * 1e-4;
-                let s = rule.strikes(0.0, behind, level, 1.0);
-                assert!(s || !struck, "struck at a lower level only");
-                struck |= s;
+            for earlier_k in [0, 100, 500, 2000] {
+                let mut struck = false;
+                for k in 0..2000 {
+                    let level = k as f64 * 1e-4;
+                    let earlier = level.max(earlier_k as f64 * 1e-4);
+                    let s = rule.strikes(met(0.0, behind, level, earlier, 1.0));
+                    assert!(s || !struck, "struck at a lower level only");
+                    struck |= s;
+                }
             }
         }
     }

@@ -117,11 +117,14 @@ pub struct Summary {
     /// Rounding tolerance e0 (mm): a point is a contact when it sticks out
     /// past the face level by more than this.
     pub e0_mm: f64,
-    /// How a contact's deflection rate is estimated: `x-slope` (the
-    /// default, SPEC's baseline: the rise from the node one pitch behind
-    /// it) or `capped` (that rise capped by the node's drop below the face
-    /// level over one pitch).
+    /// How a contact's deflection is measured: `window` (the default,
+    /// SPEC's rule: the level's drop over the last `window_mm` of travel)
+    /// or `x-slope` (the rise from the node one pitch behind it).
     pub rate: String,
+    /// The deflection window `W` (mm) of the `window` rule; absent under
+    /// `x-slope` and in runs of earlier versions (which had no window).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub window_mm: Option<f64>,
     /// `fast` or `paper`.
     pub algorithm: crate::Algorithm,
     /// `slide` (push-and-slide, SPEC) or `direct` (the direct approach,

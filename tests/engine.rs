@@ -8,7 +8,7 @@ use kneeform::{
 };
 
 use crate::util::{
-    SEEDS, brute_force_rules, distance_to_triangle, mask_diff, random_grid_quantised,
+    BruteRule, SEEDS, brute_force_rules, distance_to_triangle, mask_diff, random_grid_quantised,
 };
 
 /// A knee-form smaller than the test grids.
@@ -48,18 +48,21 @@ const DEFLECTIONS_DEG: [f64; 3] = [0.0, 0.5, 3.0];
 /// grid shape, seed, angle and deflection threshold (rounding tolerance
 /// SPEC's default).
 fn check_against_brute_force(nx: usize, nz: usize, pitch: f64, knee: &KneeForm) -> Vec<usize> {
-    check_rules(nx, nz, pitch, knee, &default_rules())
+    check_rules(nx, nz, pitch, knee, &default_rules(pitch))
 }
 
-/// SPEC's three thresholds with the default rounding tolerance, under
-/// SPEC's baseline rate and the capped one.
-fn default_rules() -> Vec<StrikeRule> {
-    [RateEstimate::XSlope, RateEstimate::Capped]
-        .iter()
-        .flat_map(|&r| {
-            DEFLECTIONS_DEG.map(|d| StrikeRule::new(d, StrikeRule::DEFAULT_E0).with_rate(r))
-        })
-        .collect()
+/// SPEC's three thresholds with the default rounding tolerance, under the
+/// x-slope rule and the window rule, the window from below one pitch
+/// (0.6 p) through SPEC's default (5 mm) to many pitches (4.5 p).
+fn default_rules(pitch: f64) -> Vec<StrikeRule> {
+    let x_slope = DEFLECTIONS_DEG.map(|d| {
+        StrikeRule::new(d, StrikeRule::DEFAULT_E0).with_rate(RateEstimate::XSlope)
+    });
+    let windows = [0.6 * pitch, StrikeRule::DEFAULT_WINDOW_MM, 4.5 * pitch];
+    let window = DEFLECTIONS_DEG.into_iter().flat_map(|d| {
+        windows.map(|w| StrikeRule::new(d, StrikeRule::DEFAULT_E0).with_window(w))
+    });
+    x_slope.into_iter().chain(window).collect()
 }
 
 /// Both implementations equal brute force under each of `rules`, on
@@ -79,9 +82,9 @@ fn check_rules(
     let fine = SEEDS[..2]
         .iter()
         .map(|&seed| random_grid_quantised(seed ^ pitch.to_bits(), nx, nz, pitch, 0.001));
-    let pairs: Vec<(f64, f64, bool)> = rules
+    let pairs: Vec<BruteRule> = rules
         .iter()
-        .map(|r| (r.e0, r.sigma, r.rate == RateEstimate::Capped))
+        .map(|r| (r.e0, r.sigma, r.window_mm()))
         .collect();
     let mut collisions = vec![0; rules.len()];
     let mut contacts_not_struck = vec![0; rules.len()];
@@ -103,8 +106,10 @@ fn check_rules(
             for (k, &angle) in ANGLES.iter().enumerate() {
                 let (want, placed) = (&brute[k].0[r], brute[k].1);
                 let what = format!(
-                    "grid #{s}, {nx}x{nz} at p={pitch}, angle {angle}, e0 {}, sigma {}",
-                    rule.e0, rule.sigma
+                    "grid #{s}, {nx}x{nz} at p={pitch}, angle {angle}, e0 {}, sigma {}, window {:?}",
+                    rule.e0,
+                    rule.sigma,
+                    rule.window_mm()
                 );
                 assert!(
                     fast[k].mask == *want,
@@ -172,7 +177,7 @@ fn fast_and_paper_equal_brute_force_off_node_boundaries() {
         check_against_brute_force(60, 45, 5.3, &KneeForm::default()),
         check_against_brute_force(45, 40, 7.7, &KneeForm::default()),
     ];
-    assert_thresholds_exercised(&default_rules(), &counts);
+    assert_thresholds_exercised(&default_rules(5.3), &counts);
 }
 
 #[test]
@@ -184,7 +189,7 @@ fn fast_and_paper_equal_brute_force_with_footprint_rows_holding_no_node() {
     let pitch = 160.0 / 30.01;
     assert!(has_a_row_without_nodes(&KneeForm::default(), pitch));
     let counts = check_against_brute_force(50, 70, pitch, &KneeForm::default());
-    assert_thresholds_exercised(&default_rules(), &[counts]);
+    assert_thresholds_exercised(&default_rules(pitch), &[counts]);
 }
 
 #[test]
@@ -197,7 +202,9 @@ fn fast_and_paper_equal_brute_force_with_boundaries_on_nodes() {
         // a(0) = -12 mm for this one.
         check_against_brute_force(50, 30, 1.0, &SMALL),
     ];
-    assert_thresholds_exercised(&default_rules(), &counts);
+    // (The rules' order is the same at every pitch: only their windows
+    // scale with it.)
+    assert_thresholds_exercised(&default_rules(1.0), &counts);
 }
 
 #[test]
@@ -207,22 +214,19 @@ fn fast_and_paper_equal_brute_force_at_exact_thresholds() {
     // at a 4 mm pitch a rise of one 0.5 mm step is exactly the threshold
     // and must not strike, two steps must. (The fine grids of
     // `check_rules` are compared too.)
+    // Under the window rule at W = 4 mm, a drop of one 0.5 mm step is
+    // exactly sigma W and must not strike, two steps must.
+    let rule = |e0, sigma, rate| StrikeRule {
+        e0,
+        sigma,
+        rate,
+        window: 4.0,
+    };
     let rules = [
-        StrikeRule {
-            e0: 0.5,
-            sigma: 0.0,
-            rate: RateEstimate::XSlope,
-        },
-        StrikeRule {
-            e0: 1e-6,
-            sigma: 0.125,
-            rate: RateEstimate::XSlope,
-        },
-        StrikeRule {
-            e0: 1e-6,
-            sigma: 0.125,
-            rate: RateEstimate::Capped,
-        },
+        rule(0.5, 0.0, RateEstimate::XSlope),
+        rule(1e-6, 0.125, RateEstimate::XSlope),
+        rule(0.5, 0.0, RateEstimate::Window),
+        rule(1e-6, 0.125, RateEstimate::Window),
     ];
     let counts = check_rules(50, 40, 4.0, &KneeForm::default(), &rules);
     assert_thresholds_exercised(&rules, &[counts]);
@@ -236,7 +240,7 @@ fn fast_and_paper_equal_brute_force_for_a_small_knee_form() {
         check_against_brute_force(60, 40, 2.0, &SMALL),
         check_against_brute_force(50, 40, 3.3, &SMALL),
     ];
-    assert_thresholds_exercised(&default_rules(), &counts);
+    assert_thresholds_exercised(&default_rules(2.0), &counts);
 }
 
 #[test]

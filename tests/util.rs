@@ -196,30 +196,32 @@ pub fn row_start(v: &[[f64; 2]; 3], r: f64, dz: f64) -> Option<f64> {
     left.is_finite().then_some(left)
 }
 
+/// A strike rule as the brute force takes it: the rounding tolerance `e0`
+/// (mm), the deflection threshold `sigma` (a rate), and the deflection
+/// window `W` (mm) of SPEC's window rule, `None` for the x-slope rule.
+pub type BruteRule = (f64, f64, Option<f64>);
+
 /// SPEC's push and slide, transcribed per start: every node's membership
 /// from the distance to the footprint, every slide sorted in full, each
-/// contact judged by SPEC's strike rule with rounding tolerance `e0` (mm)
-/// and deflection threshold `sigma` (a rate). Returns the colliding mask
+/// contact judged by SPEC's strike rule `rule`. Returns the colliding mask
 /// and the number of placed starts.
 pub fn brute_force(
     grid: &HeightGrid,
     knee: &KneeForm,
     angle_deg: f64,
-    e0: f64,
-    sigma: f64,
+    rule: BruteRule,
 ) -> (Vec<u8>, usize) {
-    let (mut masks, placed) = brute_force_rules(grid, knee, angle_deg, &[(e0, sigma, false)]);
+    let (mut masks, placed) = brute_force_rules(grid, knee, angle_deg, &[rule]);
     (masks.remove(0), placed)
 }
 
-/// [`brute_force`] for several rules `(e0, sigma, capped)` at once (the
-/// geometry is the costly part): one mask per rule; `capped` takes the
-/// rate as `min(x-slope, (f - h) / p)`.
+/// [`brute_force`] for several rules at once (the geometry is the costly
+/// part): one mask per rule.
 pub fn brute_force_rules(
     grid: &HeightGrid,
     knee: &KneeForm,
     angle_deg: f64,
-    rules: &[(f64, f64, bool)],
+    rules: &[BruteRule],
 ) -> (Vec<Vec<u8>>, usize) {
     let GridSpec {
         nx, nz, pitch: p, ..
@@ -256,44 +258,59 @@ pub fn brute_force_rules(
             }
             placed += 1;
             front.sort_by(|x, y| x.0.total_cmp(&y.0));
-            for (&(e0, sigma, capped), mask) in rules.iter().zip(&mut masks) {
+            for (&(e0, sigma, window), mask) in rules.iter().zip(&mut masks) {
                 let mut f = yr;
+                // (travel, level after) of each group slid over so far.
+                let mut after: Vec<(f64, f64)> = Vec::new();
                 let mut k = 0;
                 while k < front.len() {
                     let mut end = k + 1;
                     while end < front.len() && front[end].0 - front[end - 1].0 <= TOL {
                         end += 1;
                     }
+                    // SPEC rule 2, window: the group's travel is its
+                    // smallest distance; the level W back is the level
+                    // after the last earlier group at most s - W + 1e-9
+                    // away, the pushed level where there is none.
+                    let s = front[k].0;
+                    let back = window.map(|w| {
+                        after
+                            .iter()
+                            .rev()
+                            .find(|&&(t, _)| t <= s - w + TOL)
+                            .map_or(yr, |&(_, level)| level)
+                    });
                     let mut gmin = f64::INFINITY;
                     for &(_, node) in &front[k..end] {
                         let h = grid.h[node];
-                        // SPEC rule 2: the rise of the surface from the node one
-                        // pitch behind (+x) in the same row; from the level where
-                        // that node is off the part.
-                        let i = node % nx;
-                        let behind = if i + 1 < nx {
-                            grid.h[node + 1]
-                        } else {
-                            f64::INFINITY
+                        let deflected = match (window, back) {
+                            (Some(w), Some(back)) => back - h > sigma * w,
+                            _ => {
+                                // SPEC rule 2, x-slope: the rise of the
+                                // surface from the node one pitch behind
+                                // (+x) in the same row; from the level
+                                // where that node is off the part.
+                                let i = node % nx;
+                                let behind = if i + 1 < nx {
+                                    grid.h[node + 1]
+                                } else {
+                                    f64::INFINITY
+                                };
+                                let x_slope = if behind.is_finite() {
+                                    (behind - h) / p
+                                } else {
+                                    (f - h) / p
+                                };
+                                x_slope > sigma
+                            }
                         };
-                        let x_slope = if behind.is_finite() {
-                            (behind - h) / p
-                        } else {
-                            (f - h) / p
-                        };
-                        // The capped estimate: no more than the node's drop
-                        // below the level over one pitch.
-                        let rate = if capped {
-                            x_slope.min((f - h) / p)
-                        } else {
-                            x_slope
-                        };
-                        if h < f - e0 && rate > sigma {
+                        if h < f - e0 && deflected {
                             mask[node] = 1;
                         }
                         gmin = gmin.min(h);
                     }
                     f = f.min(gmin);
+                    after.push((s, f));
                     k = end;
                 }
             }

@@ -142,8 +142,9 @@ pub struct SetupArgs {
     pub angles: AnglesArg,
     /// Deflection threshold delta (degrees, 0 <= delta < 45): a point the
     /// knee-form meets is a strike (a colliding point) only when the surface
-    /// there turns the knee-form aside by more than this angle (its rise
-    /// over one pitch from the point behind it). A surface it merely
+    /// turns the knee-form aside by more than this angle (measured as
+    /// --rate says: by default its drop over the last --window mm of
+    /// travel). A surface it merely
     /// brushes, nearly parallel to the slide, is not a strike. 0 is the
     /// paper's literal rule (any point sticking out); larger values report
     /// only steeper contacts.
@@ -155,15 +156,19 @@ pub struct SetupArgs {
     /// engineering tolerance.
     #[arg(long, default_value_t = StrikeRule::DEFAULT_E0, value_name = "MM")]
     pub e0: f64,
-    /// How a contact's deflection rate is estimated on the grid: `x-slope`
-    /// (default, SPEC's baseline): the surface's rise over one pitch from
-    /// the point behind it; `capped`: that rise capped by how far the point
-    /// sticks out past the knee-form's face over one pitch, so that a point
-    /// the knee-form crosses nearly level is no strike however steep the
-    /// surface behind it (fewer false alarms on near-level crests, later
-    /// strikes where footprint rows interleave: results/README.md).
-    #[arg(long, value_enum, default_value_t = RateEstimate::XSlope, value_name = "RATE")]
+    /// How the deflection of a contact is measured: `window` (default,
+    /// SPEC's rule): the knee-form's own level dropped by more than
+    /// tan(--deflection) x --window over the last --window mm of its travel
+    /// (on the grid and in the exact oracle alike); `x-slope` (SPEC's former
+    /// baseline, for node-for-node comparison with other implementations):
+    /// the surface's rise over one pitch from the point behind it.
+    #[arg(long, value_enum, default_value_t = RateEstimate::Window, value_name = "RATE")]
     pub rate: RateEstimate,
+    /// The deflection window W (mm, > 0, at most 100 and 1024 pitches) of
+    /// `--rate window`: how far back along its travel the knee-form's drop
+    /// is measured. A fixed length, independent of the pitch.
+    #[arg(long, default_value_t = StrikeRule::DEFAULT_WINDOW_MM, value_name = "MM")]
+    pub window: f64,
     /// Grid origin X,Z (mm), snapped to multiples of the pitch. Default: the
     /// part's xz bounding box grown by the knee-form's extent.
     #[arg(
@@ -512,7 +517,9 @@ impl SetupArgs {
                 thickness: self.thickness,
             },
             angles: parse_angles(&self.angles.angles)?,
-            rule: StrikeRule::new(self.deflection, self.e0).with_rate(self.rate),
+            rule: StrikeRule::new(self.deflection, self.e0)
+                .with_rate(self.rate)
+                .with_window(self.window),
             grid,
             algorithm: self.algorithm,
             max_memory_bytes: self.max_memory * f64::from(1u32 << 30),

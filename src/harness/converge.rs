@@ -129,8 +129,12 @@ pub struct ConvergeSummary {
     /// The strike rule of every pitch, as in `summary.json`: sigma =
     /// tan(deflection) and how the grid's rate is estimated.
     pub sigma: f64,
-    /// `capped` or `x-slope` (`summary.json`'s `rate`).
+    /// `window` or `x-slope` (`summary.json`'s `rate`).
     pub rate: String,
+    /// The deflection window (mm) of the `window` rule (`summary.json`'s
+    /// `window_mm`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub window_mm: Option<f64>,
     /// The pitches, coarsest first (mm).
     pub pitches_mm: Vec<f64>,
     /// Per metric, the fit of its max error, where it has one.
@@ -445,6 +449,7 @@ impl ConvergeSummary {
             ],
             sigma: setup.rule.sigma,
             rate: setup.rule.rate.name().into(),
+            window_mm: setup.rule.window_mm(),
             pitches_mm: options.pitches.clone(),
             fits: Default::default(),
             tolerance_mm: options.tolerance,

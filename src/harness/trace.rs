@@ -8,7 +8,7 @@
 
 use crate::grid::HeightGrid;
 use crate::kneeform::{GridFootprint, NODE_TOL};
-use crate::strike::StrikeRule;
+use crate::strike::{LevelHistory, Meeting, StrikeRule};
 
 /// A deliberate mistake in the grid side of a comparison, for the tests
 /// that show the harness catches a broken engine. Crate-private: no
@@ -103,6 +103,7 @@ pub(crate) fn grid_trace(
     }
     front.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
     let mut f = yr;
+    let mut history = LevelHistory::new(yr);
     let mut k = 0;
     while k < front.len() {
         let mut end = k + 1;
@@ -111,6 +112,9 @@ pub(crate) fn grid_trace(
                 end += 1;
             }
         }
+        // The group's travel is its smallest distance.
+        let s = front[k].0;
+        let earlier = history.earlier(s, rule.window);
         let mut gmin = f64::INFINITY;
         for &(d, i, j) in &front[k..end] {
             let hv = h(i, j);
@@ -119,7 +123,14 @@ pub(crate) fn grid_trace(
             } else {
                 f64::INFINITY
             };
-            if rule.strikes(hv, behind, f, p) {
+            let met = Meeting {
+                h: hv,
+                behind,
+                level: f,
+                earlier,
+                pitch: p,
+            };
+            if rule.strikes(met) {
                 trace.colliding.push(GridContact {
                     node: (i, j),
                     point: [spec.x(i), hv, spec.z(j)],
@@ -129,6 +140,7 @@ pub(crate) fn grid_trace(
             gmin = gmin.min(hv);
         }
         f = f.min(gmin);
+        history.push(s, f);
         k = end;
     }
     trace

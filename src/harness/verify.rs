@@ -284,6 +284,7 @@ impl VerifySummary {
             sigma: setup.rule.sigma,
             e0_mm: setup.rule.e0,
             rate: setup.rule.rate.name().into(),
+            window_mm: setup.rule.window_mm(),
             tie_band: comparison.band,
             tie_band_rule: tie_band_rule(options.tie_band_per_mm),
             area_distance_decided_mm: None,
@@ -396,8 +397,11 @@ pub struct VerifySummary {
     pub sigma: f64,
     /// Rounding tolerance e0 (mm).
     pub e0_mm: f64,
-    /// How the grid's deflection rate is estimated (`capped` or `x-slope`).
+    /// How the grid's deflection is measured (`window` or `x-slope`).
     pub rate: String,
+    /// The deflection window (mm) of the `window` rule.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub window_mm: Option<f64>,
     /// The tie band at this pitch: `sigma`, `m`, and its bounds as rates.
     pub tie_band: TieBand,
     /// The tie band's rule, in words.

@@ -95,7 +95,14 @@ impl Verification {
 /// `converge.json` alike: today's contact tolerance and the deflection
 /// rule's parameters. A key present in one file must be in the other, with
 /// the same value.
-pub const STRIKE_RULE_KEYS: [&str; 5] = ["eps_mm", "deflection_deg", "sigma", "e0_mm", "rate"];
+pub const STRIKE_RULE_KEYS: [&str; 6] = [
+    "eps_mm",
+    "deflection_deg",
+    "sigma",
+    "e0_mm",
+    "rate",
+    "window_mm",
+];
 
 /// Relative tolerance of the numbers compared between a run and a
 /// verification: both were written from the same flags, so they agree to
