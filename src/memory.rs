@@ -95,10 +95,7 @@ impl MemoryEstimate {
                 ("height grid", 8.0 * n + 8.0 * padded),
                 // The ranks, the strike thresholds (two under the window
                 // rule) and the distinct heights (at most one per node).
-                (
-                    "ranks",
-                    4.0 * padded + 4.0 * thresholds * padded + 8.0 * n,
-                ),
+                ("ranks", 4.0 * padded + 4.0 * thresholds * padded + 8.0 * n),
                 (
                     "push table",
                     WindowMin::bytes_for(spec.nz, padding.stride, WindowMin::max_width(footprints))

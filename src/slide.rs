@@ -261,6 +261,10 @@ pub struct WindowLayers {
     rows: Vec<(isize, usize, bool)>,
     /// Each row's `dj`.
     dj: Vec<i32>,
+    /// The entries of each row, ascending: row `r`'s are
+    /// `by_row[row_start[r]..row_start[r + 1]]`.
+    by_row: Vec<u32>,
+    row_start: Vec<u32>,
 }
 
 impl WindowLayers {
@@ -270,7 +274,12 @@ impl WindowLayers {
     /// [`NODE_TOL`](crate::kneeform::NODE_TOL) as there.
     pub fn new(grid: &PaddedGrid, fp: &GridFootprint, window: f64) -> WindowLayers {
         let p = fp.pitch;
-        let reach = window_reach(window, p);
+        // The start one column to -x dominates this one (its level is at
+        // least as high at the node and `W` back) once its own window looks
+        // back past its first group: from a travel of `W + p + d0` on,
+        // `d0` its first node's distance (a micrometre spare for rounding).
+        let d0 = fp.rows.iter().map(|r| r.d0).fold(f64::INFINITY, f64::min);
+        let reach = (window + p + d0 + 1e-6).min(window_reach(window, p));
         // (distance, dj, row, offset)
         let mut entries: Vec<(f64, i32, u32, isize)> = Vec::new();
         let mut rows = Vec::with_capacity(fp.rows.len());
@@ -284,7 +293,11 @@ impl WindowLayers {
                 entries.push((d, row.dj, r as u32, grid.offset(row.dj, row.kf - m)));
                 m += 1;
             }
-            rows.push((grid.offset(row.dj, row.kf - (m - 1)), (m - 1) as usize, true));
+            rows.push((
+                grid.offset(row.dj, row.kf - (m - 1)),
+                (m - 1) as usize,
+                true,
+            ));
         }
         entries.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let mut group = Vec::with_capacity(entries.len());
@@ -304,13 +317,17 @@ impl WindowLayers {
             }
             behind.push(n as u32);
         }
+        let row: Vec<u32> = entries.iter().map(|e| e.2).collect();
+        let (by_row, row_start) = by_row(&row, rows.len());
         WindowLayers {
             offsets: entries.iter().map(|e| e.3).collect(),
             group,
-            row: entries.iter().map(|e| e.2).collect(),
+            row,
             behind,
             rows,
             dj: fp.rows.iter().map(|r| r.dj).collect(),
+            by_row,
+            row_start,
         }
     }
 
@@ -324,10 +341,14 @@ impl WindowLayers {
         let keep: Vec<usize> = (0..self.offsets.len())
             .filter(|&e| real(self.dj[self.row[e] as usize]))
             .collect();
+        let row: Vec<u32> = keep.iter().map(|&e| self.row[e]).collect();
+        let (by_row, row_start) = by_row(&row, self.rows.len());
         std::borrow::Cow::Owned(WindowLayers {
             offsets: keep.iter().map(|&e| self.offsets[e]).collect(),
             group: keep.iter().map(|&e| self.group[e]).collect(),
-            row: keep.iter().map(|&e| self.row[e]).collect(),
+            row,
+            by_row,
+            row_start,
             behind: self.behind.clone(),
             rows: self
                 .rows
@@ -343,6 +364,73 @@ impl WindowLayers {
     pub fn depth(&self) -> usize {
         self.rows.iter().map(|r| r.1).max().unwrap_or(0)
     }
+
+    /// The real rows any of whose nodes over `lanes` lanes from `base` lies
+    /// below `top`, by the minima over `lanes` nodes (`still`; every real
+    /// row without it), into `rows`.
+    pub fn rows_below(
+        &self,
+        base: usize,
+        lanes: usize,
+        top: Rank,
+        still: Option<(WindowOf, usize)>,
+        rows: &mut Vec<u32>,
+    ) {
+        rows.clear();
+        for (r, &(offset, span, real)) in self.rows.iter().enumerate() {
+            if real && row_below(base, offset, span, lanes, top, still) {
+                rows.push(r as u32);
+            }
+        }
+    }
+}
+
+/// Entry indices grouped by row (`row[e]` is entry `e`'s), each group
+/// ascending, and where each row's group begins (one more for the end).
+fn by_row(row: &[u32], rows: usize) -> (Vec<u32>, Vec<u32>) {
+    let mut start = vec![0u32; rows + 1];
+    for &r in row {
+        start[r as usize + 1] += 1;
+    }
+    for r in 0..rows {
+        start[r + 1] += start[r];
+    }
+    let mut next = start.clone();
+    let mut by_row = vec![0u32; row.len()];
+    for (e, &r) in row.iter().enumerate() {
+        by_row[next[r as usize] as usize] = e as u32;
+        next[r as usize] += 1;
+    }
+    (by_row, start)
+}
+
+/// Whether a row whose deepest entry is `offset` from `base` and whose
+/// entries span `span` more columns holds a node below `top` over `lanes`
+/// lanes, by the minima over `lanes` nodes (`true` without them).
+#[inline(always)]
+fn row_below(
+    base: usize,
+    offset: isize,
+    span: usize,
+    lanes: usize,
+    top: Rank,
+    still: Option<(WindowOf, usize)>,
+) -> bool {
+    let Some((minima, shift)) = still else {
+        return true;
+    };
+    let first = base.wrapping_add_signed(offset) + shift;
+    let last = first + span;
+    let mut at = first;
+    loop {
+        if minima.at(at.min(last)) < top {
+            return true;
+        }
+        if at >= last {
+            return false;
+        }
+        at += lanes;
+    }
 }
 
 /// What [`slide_block_window`] reads and writes besides the heights.
@@ -356,66 +444,73 @@ pub struct WindowSlide<'a> {
     pub reach: &'a mut [Rank],
     /// Per node, 1 where a slide struck it.
     pub struck: &'a mut [u8],
+    /// Whether to record the reach: only the probes read it.
+    pub record_reach: bool,
+    /// Scratch: the entries slid over, as bits and in slide order.
+    pub slid_bits: &'a mut Vec<u64>,
     /// Scratch: the entries slid over.
     pub slid: &'a mut Vec<u32>,
+    /// Scratch: the rows a block may slide.
+    pub rows: &'a mut Vec<u32>,
+    /// Scratch: the entries that lowered a level.
+    pub lowered: &'a mut Vec<u32>,
 }
 
-/// Slides `B` consecutive starts over their [`WindowLayers`], each with
+/// Slides `S` consecutive starts over their [`WindowLayers`], each with
 /// its own level and its own level `W` back, and marks every node a start
 /// strikes by the window rule in `out.struck` (the strike is decided at
 /// each visit: it reads two levels, so no single reach per node decides
 /// it). `level[w]` is the level start `w` enters with (`yr`, or [`NEVER`]
 /// where not placed: it meets nothing).
 ///
-/// With `still` (as in [`slide_block`]), a footprint row whose nodes over
-/// the block's lanes and the row's span are none below every start's level
-/// is passed over: it lowers no level, so it moves no window level, and no
-/// node of it is a contact.
+/// Only the footprint rows among `rows` are slid, and of those, with
+/// `still` (the minima over `S` nodes, as in [`slide_block`]), only the
+/// rows with a node over these lanes below some start's level: a row with
+/// none lowers no level, so it moves no window level, and no node of it
+/// is a contact. (The caller passes the rows the whole block may slide,
+/// found with wider minima: fewer loads for the rows no lane slides.)
 #[inline(always)]
-pub fn slide_block_window<const B: usize>(
+pub fn slide_block_window<const S: usize>(
     h: &[Rank],
     out: &mut WindowSlide,
     layers: &WindowLayers,
     base: usize,
-    level: [Rank; B],
+    level: [Rank; S],
+    rows: &[u32],
     still: Option<(WindowOf, usize)>,
 ) {
     let top = level.iter().copied().max().unwrap_or(NEVER);
     if top == NEVER {
         return;
     }
-    let row_slid: Vec<bool> = layers
-        .rows
-        .iter()
-        .map(|&(offset, span, real)| {
-            real && match still {
-                Some((minima, shift)) => {
-                    let first = base.wrapping_add_signed(offset) + shift;
-                    let last = first + span;
-                    let mut at = first;
-                    loop {
-                        if minima.at(at.min(last)) < top {
-                            break true;
-                        }
-                        if at >= last {
-                            break false;
-                        }
-                        at += B;
-                    }
-                }
-                None => true,
+    out.slid_bits.clear();
+    out.slid_bits.resize(layers.offsets.len().div_ceil(64), 0);
+    for &r in rows {
+        let (offset, span, _) = layers.rows[r as usize];
+        if row_below(base, offset, span, S, top, still) {
+            let (from, to) = (
+                layers.row_start[r as usize],
+                layers.row_start[r as usize + 1],
+            );
+            for &e in &layers.by_row[from as usize..to as usize] {
+                out.slid_bits[e as usize / 64] |= 1 << (e % 64);
             }
-        })
-        .collect();
+        }
+    }
+    // In slide order.
     out.slid.clear();
-    out.slid.extend(
-        (0..layers.offsets.len() as u32).filter(|&e| row_slid[layers.row[e as usize] as usize]),
-    );
+    for (n, &word) in out.slid_bits.iter().enumerate() {
+        out.slid.extend(ones(word).map(|bit| (n * 64 + bit) as u32));
+    }
     let mut level = level;
     let mut before = level;
     let mut earlier = level;
     let mut group = None;
-    // The slid entries the window levels have taken in.
+    // The entries that lowered some start's level, and how many of them
+    // the window levels have taken in: an entry met at or above every
+    // start's level changes no level, so no window level either.
+    let mut lowered = std::mem::take(out.lowered);
+    lowered.clear();
     let mut trail = 0;
     for k in 0..out.slid.len() {
         let e = out.slid[k] as usize;
@@ -424,29 +519,42 @@ pub fn slide_block_window<const B: usize>(
             group = Some(g);
             before = level;
             let behind = layers.behind[g as usize];
-            while trail < k && layers.group[out.slid[trail] as usize] < behind {
-                let a = base.wrapping_add_signed(layers.offsets[out.slid[trail] as usize]);
-                let hv: &[Rank; B] = h[a..a + B].try_into().expect("B values");
-                for w in 0..B {
+            while trail < lowered.len() && layers.group[lowered[trail] as usize] < behind {
+                let a = base.wrapping_add_signed(layers.offsets[lowered[trail] as usize]);
+                let hv: &[Rank; S] = h[a..a + S].try_into().expect("S values");
+                for w in 0..S {
                     earlier[w] = earlier[w].min(hv[w]);
                 }
                 trail += 1;
             }
         }
         let a = base.wrapping_add_signed(layers.offsets[e]);
-        let hv: &[Rank; B] = h[a..a + B].try_into().expect("B values");
-        let contact: &[Rank; B] = out.contact[a..a + B].try_into().expect("B values");
-        let deflected: &[Rank; B] = out.deflected[a..a + B].try_into().expect("B values");
-        let r: &mut [Rank; B] = (&mut out.reach[a..a + B]).try_into().expect("B values");
-        for w in 0..B {
-            r[w] = r[w].max(before[w]);
+        let hv: &[Rank; S] = h[a..a + S].try_into().expect("S values");
+        if out.record_reach {
+            let r: &mut [Rank; S] = (&mut out.reach[a..a + S]).try_into().expect("S values");
+            for w in 0..S {
+                r[w] = r[w].max(before[w]);
+            }
         }
-        let s: &mut [u8; B] = (&mut out.struck[a..a + B]).try_into().expect("B values");
-        for w in 0..B {
+        // A node at or above the level it is met at is no contact and
+        // lowers nothing: most entries, so they are passed over here.
+        let mut below = 0u32;
+        for w in 0..S {
+            below |= u32::from(hv[w] < before[w]);
+        }
+        if below == 0 {
+            continue;
+        }
+        lowered.push(e as u32);
+        let contact: &[Rank; S] = out.contact[a..a + S].try_into().expect("S values");
+        let deflected: &[Rank; S] = out.deflected[a..a + S].try_into().expect("S values");
+        let s: &mut [u8; S] = (&mut out.struck[a..a + S]).try_into().expect("S values");
+        for w in 0..S {
             s[w] |= u8::from(before[w] >= contact[w]) & u8::from(earlier[w] >= deflected[w]);
             level[w] = level[w].min(hv[w]);
         }
     }
+    *out.lowered = lowered;
 }
 
 /// The scalar slide of one placed start past its [`WindowLayers`]: where
@@ -520,7 +628,8 @@ impl Extension {
             }
             let a = at(offset);
             out.reach[a] = out.reach[a].max(before);
-            out.struck[a] |= u8::from(before >= out.contact[a]) & u8::from(earlier >= out.deflected[a]);
+            out.struck[a] |=
+                u8::from(before >= out.contact[a]) & u8::from(earlier >= out.deflected[a]);
             self.level = self.level.min(h[a]);
         }
         if group.is_some() && self.level < before {

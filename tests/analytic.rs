@@ -210,8 +210,12 @@ fn scenario_grids_agree_with_brute_force() {
         let (grid, masks) = analyse(&tris, 3.0, &knee, &ANGLES);
         for m in &masks {
             let rule = kneeform::StrikeRule::default();
-            let (want, placed) =
-                brute_force(&grid, &knee, m.angle_deg, (rule.e0, rule.sigma, rule.window_mm()));
+            let (want, placed) = brute_force(
+                &grid,
+                &knee,
+                m.angle_deg,
+                (rule.e0, rule.sigma, rule.window_mm()),
+            );
             assert_eq!(
                 m.mask,
                 want,

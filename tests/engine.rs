@@ -55,13 +55,12 @@ fn check_against_brute_force(nx: usize, nz: usize, pitch: f64, knee: &KneeForm) 
 /// x-slope rule and the window rule, the window from below one pitch
 /// (0.6 p) through SPEC's default (5 mm) to many pitches (4.5 p).
 fn default_rules(pitch: f64) -> Vec<StrikeRule> {
-    let x_slope = DEFLECTIONS_DEG.map(|d| {
-        StrikeRule::new(d, StrikeRule::DEFAULT_E0).with_rate(RateEstimate::XSlope)
-    });
+    let x_slope = DEFLECTIONS_DEG
+        .map(|d| StrikeRule::new(d, StrikeRule::DEFAULT_E0).with_rate(RateEstimate::XSlope));
     let windows = [0.6 * pitch, StrikeRule::DEFAULT_WINDOW_MM, 4.5 * pitch];
-    let window = DEFLECTIONS_DEG.into_iter().flat_map(|d| {
-        windows.map(|w| StrikeRule::new(d, StrikeRule::DEFAULT_E0).with_window(w))
-    });
+    let window = DEFLECTIONS_DEG
+        .into_iter()
+        .flat_map(|d| windows.map(|w| StrikeRule::new(d, StrikeRule::DEFAULT_E0).with_window(w)));
     x_slope.into_iter().chain(window).collect()
 }
 

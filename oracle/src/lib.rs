@@ -72,6 +72,7 @@ mod rapier;
 mod rate;
 mod sweep;
 mod trace;
+mod window;
 
 pub use batch::evaluate;
 pub use direct::{
@@ -84,3 +85,4 @@ pub use rapier::{RapierComparison, RapierContact, RapierOptions, RapierSlide, ra
 pub use trace::{
     ContactPoint, FailureReason, OracleOptions, SlideEnd, StartStatus, StartTrace, trace_start,
 };
+pub use window::{Level, LevelCurve, WindowDrop};

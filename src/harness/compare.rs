@@ -11,7 +11,8 @@ use serde::{Deserialize, Serialize};
 
 use super::HarnessError;
 use super::metrics::{
-    DECIDED_METRICS, METRICS, StartComparison, StartPoints, Stats, TieBand, compare, metric_index,
+    DECIDED_METRICS, ExactRule, METRICS, StartComparison, StartPoints, Stats, TieBand, compare,
+    metric_index,
 };
 use super::nearest::PointSet;
 use super::trace::{Fault, grid_trace};
@@ -406,7 +407,7 @@ pub(crate) fn pair_results(
             let fp = &footprints[a];
             let trace = &traces[a * nodes.len() + s];
             let g = grid_trace(grid, fp, i, j, &options.rule, fault);
-            let cmp = compare(&g, trace, &band);
+            let cmp = compare(&g, trace, &band, ExactRule::of(&options.rule, spec.pitch));
             let grid_placed = g.yr.is_finite();
             let status = match (trace.status, grid_placed) {
                 (StartStatus::Failed { .. }, _) => "oracle_failed",

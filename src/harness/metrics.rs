@@ -1,7 +1,7 @@
 //! SPEC's harness metrics ("What the harness measures"): per start, the grid
 //! trace against the exact trace; over many starts, max, p95 and mean.
 
-use kneeform_oracle::{ContactPoint, StartStatus, StartTrace};
+use kneeform_oracle::{ContactPoint, LevelCurve, StartStatus, StartTrace};
 use serde::{Deserialize, Serialize};
 
 use super::trace::GridTrace;
@@ -149,31 +149,92 @@ impl TieBand {
     }
 }
 
-/// An exact contact's standing: a strike by SPEC's rule (`rate > sigma`),
-/// and its decision against the tie band.
+/// How the exact side judges its contacts: SPEC's window rule on the
+/// traced level curve, or (under `--rate x-slope`) the traced deflection
+/// rate against `sigma`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ExactRule {
+    /// `rate > sigma`, decided against [`TieBand`].
+    Rate,
+    /// SPEC's window rule: `f*(s - W) - f*(s) > sigma W`, the curve read
+    /// between its samples ([`LevelCurve`]).
+    ///
+    /// **Ties at the threshold.** A contact is decided when its drop lies
+    /// further from `sigma W` than the drop's stated error plus a bound of
+    /// the grid's drop error: twice the larger of the exact level's falls
+    /// over the pitch before each end of the window. The grid's level
+    /// follows the surface only at nodes, so it lags the exact level by up
+    /// to that fall at each end (SPEC, "Ties at the threshold": about twice
+    /// the grid's level error, the local slope times the pitch); the band
+    /// shrinks with the pitch.
+    Window {
+        /// `W` (mm).
+        window: f64,
+        /// The grid's pitch (mm).
+        pitch: f64,
+    },
+}
+
+impl ExactRule {
+    /// The exact side of `rule` on a grid of pitch `pitch` (mm).
+    pub fn of(rule: &crate::strike::StrikeRule, pitch: f64) -> ExactRule {
+        match rule.window_mm() {
+            Some(window) => ExactRule::Window { window, pitch },
+            None => ExactRule::Rate,
+        }
+    }
+}
+
+/// The casts' gap tolerance (mm) the harness's oracle runs with, which a
+/// drop's error includes ([`kneeform_oracle::OracleOptions`]).
+const JUMP_TOLERANCE: f64 = 1e-6;
+
+/// An exact contact's standing: a strike by SPEC's rule, and its decision
+/// against the tie band.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ExactStrike {
     /// The contact.
     pub contact: ContactPoint,
-    /// `rate > sigma`.
+    /// A strike by the rule (`rate > sigma`, or the window drop above
+    /// `sigma W`).
     pub strike: bool,
     /// Against the tie band.
     pub decision: Decision,
 }
 
-/// The exact contacts of a placed start with their standing; empty for a
-/// start that is not placed or failed.
-pub fn classify(exact: &StartTrace, band: &TieBand) -> Vec<ExactStrike> {
-    if exact.status != StartStatus::Placed {
+/// The exact contacts of a placed start with their standing by `rule`;
+/// empty for a start that is not placed or failed.
+pub fn classify(exact: &StartTrace, band: &TieBand, rule: ExactRule) -> Vec<ExactStrike> {
+    let Some(curve) = LevelCurve::of(exact) else {
         return Vec::new();
-    }
+    };
     exact
         .contacts
         .iter()
-        .map(|&c| ExactStrike {
-            contact: c,
-            strike: c.rate > band.sigma,
-            decision: band.decide(c.rate, c.rate_error),
+        .enumerate()
+        .map(|(k, &c)| match rule {
+            ExactRule::Rate => ExactStrike {
+                contact: c,
+                strike: c.rate > band.sigma,
+                decision: band.decide(c.rate, c.rate_error),
+            },
+            ExactRule::Window { window, pitch } => {
+                let drop = curve.drop_at(k, window, JUMP_TOLERANCE);
+                let fall = |s: f64| curve.at(s - pitch).value - curve.at(s).value;
+                let grid = 2.0 * fall(c.travel).max(fall(c.travel - window));
+                let (threshold, tie) = (band.sigma * window, grid + drop.error);
+                ExactStrike {
+                    contact: c,
+                    strike: drop.drop > threshold,
+                    decision: if drop.drop - tie > threshold {
+                        Decision::Strike
+                    } else if drop.drop + tie < threshold {
+                        Decision::NoStrike
+                    } else {
+                        Decision::Undecided
+                    },
+                }
+            }
         })
         .collect()
 }
@@ -293,9 +354,14 @@ fn nearest(p: [f64; 2], set: &[[f64; 2]]) -> f64 {
 /// miss the true highest point), the grid strikes, just after the push, the
 /// point the exact knee-form rests on. It does not count for misses: the
 /// grid's push contact is, by SPEC, not a colliding point.
-pub fn compare(grid: &GridTrace, exact: &StartTrace, band: &TieBand) -> StartComparison {
+pub fn compare(
+    grid: &GridTrace,
+    exact: &StartTrace,
+    band: &TieBand,
+    rule: ExactRule,
+) -> StartComparison {
     let placed = exact.status == StartStatus::Placed;
-    let classified = classify(exact, band);
+    let classified = classify(exact, band, rule);
     let push: Vec<[f64; 2]> = exact
         .push_witness
         .filter(|_| placed)
@@ -332,6 +398,7 @@ pub fn compare(grid: &GridTrace, exact: &StartTrace, band: &TieBand) -> StartCom
     };
     let first_strike = classified.iter().find(|c| c.strike);
     let first_possible = classified.iter().find(|c| c.decision != Decision::NoStrike);
+    let first_decided = classified.iter().find(|c| c.decision == Decision::Strike);
     let grid_first = grid.colliding.first().filter(|_| placed);
     StartComparison {
         push_error: match (grid.yr.is_finite(), exact.yr_star) {
@@ -342,9 +409,24 @@ pub fn compare(grid: &GridTrace, exact: &StartTrace, band: &TieBand) -> StartCom
             (Some(g), Some(e)) => Some(g.travel - e.contact.travel),
             _ => None,
         },
-        first_contact_error_decided: match (grid_first, first_possible) {
-            (Some(g), Some(e)) if e.decision == Decision::Strike => {
+        first_contact_error_decided: match (rule, grid_first, first_possible, first_decided) {
+            (ExactRule::Rate, Some(g), Some(e), _) if e.decision == Decision::Strike => {
                 Some(g.travel - e.contact.travel)
+            }
+            // Under the window the exact drop rises from 0 at every
+            // landing, so the first exact strike sits on the threshold:
+            // the grid's first strike is measured against the interval
+            // from the first possible exact strike to the first decided
+            // one (SPEC's metric table).
+            (ExactRule::Window { .. }, Some(g), Some(lo), Some(hi)) => {
+                let (lo, hi) = (lo.contact.travel, hi.contact.travel);
+                Some(if g.travel < lo {
+                    g.travel - lo
+                } else if g.travel > hi {
+                    g.travel - hi
+                } else {
+                    0.0
+                })
             }
             _ => None,
         },

@@ -93,11 +93,18 @@ pub fn oracle_options(knee: &KneeForm, pitch: f64, x_min: f64) -> OracleOptions 
     }
 }
 
-/// The tie band's rule in words, for the summaries.
-pub fn tie_band_rule(per_mm: f64) -> String {
-    format!(
-        "an exact contact is undecided when its deflection rate, widened by its rate_error, overlaps [sigma / (1 + m), sigma * (1 + m)] with m = {per_mm} x pitch (mm)"
-    )
+/// The tie band's rule in words, for the summaries: under the window rule
+/// (`window_mm`) the drop's band ([`super::metrics::ExactRule::Window`]),
+/// under x-slope the rate's ([`TieBand`]).
+pub fn tie_band_rule(per_mm: f64, window_mm: Option<f64>) -> String {
+    match window_mm {
+        Some(w) => format!(
+            "an exact contact is undecided when its drop over the last {w} mm, widened by its stated error and by twice the larger of the exact level's falls over the pitch before each end of the window (the grid's level error), overlaps sigma x {w} mm"
+        ),
+        None => format!(
+            "an exact contact is undecided when its deflection rate, widened by its rate_error, overlaps [sigma / (1 + m), sigma * (1 + m)] with m = {per_mm} x pitch (mm)"
+        ),
+    }
 }
 
 /// The starts of `selection` on `grid` (placed at one of `footprints` at
@@ -286,7 +293,7 @@ impl VerifySummary {
             rate: setup.rule.rate.name().into(),
             window_mm: setup.rule.window_mm(),
             tie_band: comparison.band,
-            tie_band_rule: tie_band_rule(options.tie_band_per_mm),
+            tie_band_rule: tie_band_rule(options.tie_band_per_mm, setup.rule.window_mm()),
             area_distance_decided_mm: None,
             area_distance_mm: None,
             area_distance: Vec::new(),
