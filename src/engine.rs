@@ -453,16 +453,13 @@ fn fast_band_impl<const W: usize>(
         .window
         .as_ref()
         .map(|(w, _)| WindowLayers::new(padded, fp, *w));
-    let window_layers: Vec<_> = band
-        .iter()
-        .filter_map(|&j0| Some(window_layers.as_ref()?.within(j0, nz)))
-        .collect();
     let slider = Slider {
         skip_still: fast.skip_still,
         still: fast.table.windows_of(W),
         h: &fast.ranked.ranks[window..],
         window,
         nx: padded.spec.nx as i64,
+        nz,
         visits,
         rule: fast.window.as_ref().map(|(w, deflected)| WindowRule {
             window: *w,
@@ -487,6 +484,7 @@ fn fast_band_impl<const W: usize>(
         .iter()
         .map(|&j0| RowState {
             first: padded.index(j0 as i64, 0),
+            j0,
             carry: NEVER,
             pending: None,
             extensions: Vec::new(),
@@ -514,7 +512,7 @@ fn fast_band_impl<const W: usize>(
                     .then(|| push_tile(&fast.table, &push_rows, tile[0], nz, padded.stride, base));
                 for t in 0..TILE {
                     let yr = yr.filter(|_| inside(k + t)).map(|yr| yr[t]);
-                    sink.window_layers = window_layers.get(k + t).map(|l| &**l);
+                    sink.window_layers = window_layers.as_ref();
                     placed +=
                         rows[k + t].advance(&slider, &mut sink, &layers[k + t], k + t, block, yr);
                 }
@@ -522,7 +520,7 @@ fn fast_band_impl<const W: usize>(
             } else {
                 let yr =
                     inside(k).then(|| push_block::<W>(&fast.table, &push_rows, band[k], nz, base));
-                sink.window_layers = window_layers.get(k).map(|l| &**l);
+                sink.window_layers = window_layers.as_ref();
                 placed += rows[k].advance(&slider, &mut sink, &layers[k], k, block, yr);
                 k += 1;
             }
@@ -532,7 +530,7 @@ fn fast_band_impl<const W: usize>(
     for (k, row) in rows.iter_mut().enumerate() {
         if let Some((right, yr_right)) = row.pending.take() {
             // Left of the last block lie no active starts.
-            sink.window_layers = window_layers.get(k).map(|l| &**l);
+            sink.window_layers = window_layers.as_ref();
             placed += slider.slide(&mut sink, &layers[k], k, row, right, yr_right, [OFF; W]);
         }
     }
@@ -566,6 +564,8 @@ struct WindowRule<'a> {
 
 /// One start row's state in [`fast_band_impl`].
 struct RowState<const W: usize> {
+    /// The start row.
+    j0: usize,
     /// The padded index of the row's column 0.
     first: usize,
     /// The level the slides carry into the next block, from +x.
@@ -612,6 +612,7 @@ struct Slider<'a> {
     /// The padded index of the reach window's first node.
     window: usize,
     nx: i64,
+    nz: usize,
     visits: &'a ProbeVisits,
     /// [`Fast::skip_still`].
     skip_still: bool,
@@ -736,16 +737,54 @@ impl Slider<'_> {
             // own: a block's starts span many levels, a run of them few.
             let top = level.iter().copied().max().unwrap_or(NEVER);
             let mut rows = std::mem::take(out.rows);
-            layers.rows_below(base, W, top, still(W), &mut rows);
+            let nz = self.nz;
+            layers.rows_below(row.j0, nz, base, W, top, still(W), &mut rows);
+            // Per run of lanes, the layers in which a push level to -x
+            // lies below some start's: only there can a node inside a
+            // footprint lie below a level.
+            let depth = layers.depth().min(63);
+            let moving = |lanes: std::ops::Range<usize>| {
+                let mut bits = 0u64;
+                for m in 0..=depth {
+                    let lower = lanes.clone().any(|w| {
+                        let at = w as i64 - m as i64 - 1;
+                        let beside = match at {
+                            0.. => yr[at as usize],
+                            _ if at >= -(W as i64) => left[(W as i64 + at) as usize],
+                            _ => NEVER,
+                        };
+                        beside < level[w]
+                    });
+                    bits |= u64::from(lower) << m;
+                }
+                // The probes read the reach of every node met, below its
+                // level or not.
+                if layers.depth() >= 64 || !pass_over {
+                    bits = !0;
+                }
+                bits
+            };
             if W > SUB_LANES {
-                for (c, level) in level.chunks_exact(SUB_LANES).enumerate() {
-                    let level: [Rank; SUB_LANES] = level.try_into().expect("SUB_LANES levels");
+                for (c, run) in level.chunks_exact(SUB_LANES).enumerate() {
+                    let run: [Rank; SUB_LANES] = run.try_into().expect("SUB_LANES levels");
+                    let lanes = c * SUB_LANES..(c + 1) * SUB_LANES;
+                    let moving = moving(lanes);
                     let base = base + c * SUB_LANES;
                     let still = still(SUB_LANES);
-                    slide_block_window(self.h, &mut out, layers, base, level, &rows, still);
+                    slide_block_window(self.h, &mut out, layers, base, run, &rows, moving, still);
                 }
             } else {
-                slide_block_window(self.h, &mut out, layers, base, level, &rows, still(W));
+                let moving = moving(0..W);
+                slide_block_window(
+                    self.h,
+                    &mut out,
+                    layers,
+                    base,
+                    level,
+                    &rows,
+                    moving,
+                    still(W),
+                );
             }
             *out.rows = rows;
         } else {

@@ -250,15 +250,19 @@ pub struct WindowLayers {
     offsets: Vec<isize>,
     /// Each entry's tie group, numbered in slide order.
     group: Vec<u32>,
-    /// Each entry's footprint row, an index into `rows`.
-    row: Vec<u32>,
+    /// Each entry's column past the first layer: the entry is the first
+    /// node in front of the start that many columns to -x.
+    layer: Vec<u16>,
+    /// Per footprint row, whether it has nodes inside the footprint: then
+    /// its node in layer `m` lies inside the footprint of the start
+    /// `m + 1` columns to -x, at or above that start's push level.
+    inside: Vec<bool>,
     /// Per group: the number of groups that lie `W` behind it (travel
     /// `<= s - W + 1e-9`); its window level is the level after them.
     behind: Vec<u32>,
-    /// Per footprint row: the offset of its deepest entry, the columns its
-    /// entries span past that one, and whether the row is a real one
-    /// (entries on padding rows are dropped by [`WindowLayers::within`]).
-    rows: Vec<(isize, usize, bool)>,
+    /// Per footprint row: the offset of its deepest entry and the columns
+    /// its entries span past that one.
+    rows: Vec<(isize, usize)>,
     /// Each row's `dj`.
     dj: Vec<i32>,
     /// The entries of each row, ascending: row `r`'s are
@@ -280,8 +284,8 @@ impl WindowLayers {
         // `d0` its first node's distance (a micrometre spare for rounding).
         let d0 = fp.rows.iter().map(|r| r.d0).fold(f64::INFINITY, f64::min);
         let reach = (window + p + d0 + 1e-6).min(window_reach(window, p));
-        // (distance, dj, row, offset)
-        let mut entries: Vec<(f64, i32, u32, isize)> = Vec::new();
+        // (distance, dj, row, offset, layer)
+        let mut entries: Vec<(f64, i32, u32, isize, u16)> = Vec::new();
         let mut rows = Vec::with_capacity(fp.rows.len());
         for (r, row) in fp.rows.iter().enumerate() {
             let mut m = 0;
@@ -290,14 +294,11 @@ impl WindowLayers {
                 if m > 0 && d > reach {
                     break;
                 }
-                entries.push((d, row.dj, r as u32, grid.offset(row.dj, row.kf - m)));
+                let layer = u16::try_from(m).expect("a window of at most 1024 pitches");
+                entries.push((d, row.dj, r as u32, grid.offset(row.dj, row.kf - m), layer));
                 m += 1;
             }
-            rows.push((
-                grid.offset(row.dj, row.kf - (m - 1)),
-                (m - 1) as usize,
-                true,
-            ));
+            rows.push((grid.offset(row.dj, row.kf - (m - 1)), (m - 1) as usize));
         }
         entries.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let mut group = Vec::with_capacity(entries.len());
@@ -322,7 +323,8 @@ impl WindowLayers {
         WindowLayers {
             offsets: entries.iter().map(|e| e.3).collect(),
             group,
-            row,
+            layer: entries.iter().map(|e| e.4).collect(),
+            inside: fp.rows.iter().map(|r| r.khi >= r.klo).collect(),
             behind,
             rows,
             dj: fp.rows.iter().map(|r| r.dj).collect(),
@@ -331,45 +333,21 @@ impl WindowLayers {
         }
     }
 
-    /// The list of a start in row `j0` of a grid of `nz` rows without the
-    /// entries on the `+inf` padding rows (as [`LayerRows::within`]).
-    pub fn within(&self, j0: usize, nz: usize) -> std::borrow::Cow<'_, WindowLayers> {
-        let real = |dj: i32| (0..nz as i64).contains(&(j0 as i64 + i64::from(dj)));
-        if self.dj.iter().all(|&dj| real(dj)) {
-            return std::borrow::Cow::Borrowed(self);
-        }
-        let keep: Vec<usize> = (0..self.offsets.len())
-            .filter(|&e| real(self.dj[self.row[e] as usize]))
-            .collect();
-        let row: Vec<u32> = keep.iter().map(|&e| self.row[e]).collect();
-        let (by_row, row_start) = by_row(&row, self.rows.len());
-        std::borrow::Cow::Owned(WindowLayers {
-            offsets: keep.iter().map(|&e| self.offsets[e]).collect(),
-            group: keep.iter().map(|&e| self.group[e]).collect(),
-            row,
-            by_row,
-            row_start,
-            behind: self.behind.clone(),
-            rows: self
-                .rows
-                .iter()
-                .zip(&self.dj)
-                .map(|(&(offset, span, _), &dj)| (offset, span, real(dj)))
-                .collect(),
-            dj: self.dj.clone(),
-        })
-    }
-
     /// The columns the deepest entry lies past the first layer.
     pub fn depth(&self) -> usize {
         self.rows.iter().map(|r| r.1).max().unwrap_or(0)
     }
 
-    /// The real rows any of whose nodes over `lanes` lanes from `base` lies
-    /// below `top`, by the minima over `lanes` nodes (`still`; every real
-    /// row without it), into `rows`.
+    /// The rows of a start in row `j0` of a grid of `nz` rows (rows on the
+    /// `+inf` padding change nothing, and the minima do not cover them)
+    /// any of whose nodes over `lanes` lanes from `base` lies below `top`,
+    /// by the minima over `lanes` nodes (`still`; every real row without
+    /// it), into `rows`.
+    #[allow(clippy::too_many_arguments)]
     pub fn rows_below(
         &self,
+        j0: usize,
+        nz: usize,
         base: usize,
         lanes: usize,
         top: Rank,
@@ -377,8 +355,9 @@ impl WindowLayers {
         rows: &mut Vec<u32>,
     ) {
         rows.clear();
-        for (r, &(offset, span, real)) in self.rows.iter().enumerate() {
-            if real && row_below(base, offset, span, lanes, top, still) {
+        let real = |dj: i32| (0..nz as i64).contains(&(j0 as i64 + i64::from(dj)));
+        for (r, (&(offset, span), &dj)) in self.rows.iter().zip(&self.dj).enumerate() {
+            if real(dj) && row_below(base, offset, span, lanes, top, still) {
                 rows.push(r as u32);
             }
         }
@@ -463,7 +442,12 @@ pub struct WindowSlide<'a> {
 /// it). `level[w]` is the level start `w` enters with (`yr`, or [`NEVER`]
 /// where not placed: it meets nothing).
 ///
-/// Only the footprint rows among `rows` are slid, and of those, with
+/// Only the footprint rows among `rows` are slid, and in rows with nodes
+/// inside the footprint only the layers `m` whose bit is set in `moving`
+/// (all from 64 on): the caller clears a layer's bit where no start's push
+/// level lies above that of the start `m + 1` columns to -x, whose
+/// footprint holds those nodes, so they are at or above every level. Of
+/// those, with
 /// `still` (the minima over `S` nodes, as in [`slide_block`]), only the
 /// rows with a node over these lanes below some start's level: a row with
 /// none lowers no level, so it moves no window level, and no node of it
@@ -477,6 +461,7 @@ pub fn slide_block_window<const S: usize>(
     base: usize,
     level: [Rank; S],
     rows: &[u32],
+    moving: u64,
     still: Option<(WindowOf, usize)>,
 ) {
     let top = level.iter().copied().max().unwrap_or(NEVER);
@@ -486,14 +471,18 @@ pub fn slide_block_window<const S: usize>(
     out.slid_bits.clear();
     out.slid_bits.resize(layers.offsets.len().div_ceil(64), 0);
     for &r in rows {
-        let (offset, span, _) = layers.rows[r as usize];
+        let (offset, span) = layers.rows[r as usize];
         if row_below(base, offset, span, S, top, still) {
             let (from, to) = (
                 layers.row_start[r as usize],
                 layers.row_start[r as usize + 1],
             );
+            let inside = layers.inside[r as usize];
             for &e in &layers.by_row[from as usize..to as usize] {
-                out.slid_bits[e as usize / 64] |= 1 << (e % 64);
+                let m = u32::from(layers.layer[e as usize]);
+                if !inside || m >= 64 || moving >> m & 1 != 0 {
+                    out.slid_bits[e as usize / 64] |= 1 << (e % 64);
+                }
             }
         }
     }

@@ -159,14 +159,21 @@ pub enum ExactRule {
     /// SPEC's window rule: `f*(s - W) - f*(s) > sigma W`, the curve read
     /// between its samples ([`LevelCurve`]).
     ///
-    /// **Ties at the threshold.** A contact is decided when its drop lies
-    /// further from `sigma W` than the drop's stated error plus a bound of
-    /// the grid's drop error: twice the larger of the exact level's falls
-    /// over the pitch before each end of the window. The grid's level
-    /// follows the surface only at nodes, so it lags the exact level by up
-    /// to that fall at each end (SPEC, "Ties at the threshold": about twice
-    /// the grid's level error, the local slope times the pitch); the band
-    /// shrinks with the pitch.
+    /// **Ties at the threshold.** The grid's drop `f(s - W) - h` reads a
+    /// node's height (a point of the surface: exact) and the grid's level
+    /// `W` back, which follows the surface only at the nodes met, so it
+    /// lies *above* the exact level (SPEC: "the grid's level is too deep"),
+    /// by up to the exact level's fall over the pitch before that travel
+    /// (before a pitch of travel, its push error, bounded the same way by
+    /// the fall over the first pitch). The grid's drop is therefore at
+    /// least the exact one, up to the travel between the contact and its
+    /// node: a grid can strike where the exact knee-form does not (a false
+    /// alarm, on the safe side), not the other way round. So the band is
+    /// one-sided, as SPEC's "level error" paragraph says: a contact is a
+    /// decided strike when its drop exceeds `sigma W` by more than the
+    /// drop's stated error, a decided non-strike when it falls short by
+    /// more than that error plus twice the grid's level error there (SPEC,
+    /// "Ties at the threshold"). The band shrinks with the pitch.
     Window {
         /// `W` (mm).
         window: f64,
@@ -220,15 +227,15 @@ pub fn classify(exact: &StartTrace, band: &TieBand, rule: ExactRule) -> Vec<Exac
             },
             ExactRule::Window { window, pitch } => {
                 let drop = curve.drop_at(k, window, JUMP_TOLERANCE);
-                let fall = |s: f64| curve.at(s - pitch).value - curve.at(s).value;
-                let grid = 2.0 * fall(c.travel).max(fall(c.travel - window));
-                let (threshold, tie) = (band.sigma * window, grid + drop.error);
+                let back = (c.travel - window).max(pitch);
+                let grid = 2.0 * (curve.at(back - pitch).value - curve.at(back).value);
+                let threshold = band.sigma * window;
                 ExactStrike {
                     contact: c,
                     strike: drop.drop > threshold,
-                    decision: if drop.drop - tie > threshold {
+                    decision: if drop.drop - drop.error > threshold {
                         Decision::Strike
-                    } else if drop.drop + tie < threshold {
+                    } else if drop.drop + drop.error + grid < threshold {
                         Decision::NoStrike
                     } else {
                         Decision::Undecided

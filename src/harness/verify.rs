@@ -99,7 +99,7 @@ pub fn oracle_options(knee: &KneeForm, pitch: f64, x_min: f64) -> OracleOptions 
 pub fn tie_band_rule(per_mm: f64, window_mm: Option<f64>) -> String {
     match window_mm {
         Some(w) => format!(
-            "an exact contact is undecided when its drop over the last {w} mm, widened by its stated error and by twice the larger of the exact level's falls over the pitch before each end of the window (the grid's level error), overlaps sigma x {w} mm"
+            "an exact contact is a decided strike when its drop over the last {w} mm exceeds sigma x {w} mm by more than its stated error, a decided non-strike when it falls short by more than its error plus twice the exact level's fall over the pitch before the travel {w} mm back (the grid's level error there, which only ever adds strikes), undecided otherwise"
         ),
         None => format!(
             "an exact contact is undecided when its deflection rate, widened by its rate_error, overlaps [sigma / (1 + m), sigma * (1 + m)] with m = {per_mm} x pitch (mm)"
