@@ -334,16 +334,11 @@ fn fast_window(
         Some(_) => vec![0u8; end - start],
         None => Vec::new(),
     };
-    let placed = fast_band(
-        padded,
-        fast,
-        fp,
-        band,
-        start,
-        &visits,
-        &mut reach,
-        &mut struck,
-    );
+    let out = BandOut {
+        reach: &mut reach,
+        struck: &mut struck,
+    };
+    let placed = fast_band(padded, fast, fp, band, start, &visits, out);
     let strikes = match fast.window {
         Some(_) => struck,
         None => strike_mask(&fast.thresholds[start..end], &reach),
@@ -401,7 +396,7 @@ dispatch! {
     /// about 5% faster than 32 and level with 128 (the noise is about
     /// 10%); 16 slower. [`LANE_SLACK`](crate::padded::LANE_SLACK) covers the
     /// widest block.
-    fn fast_band(padded: &PaddedGrid, fast: &Fast, fp: &GridFootprint, band: &[usize], window: usize, visits: &ProbeVisits, reach: &mut [Rank], struck: &mut [u8]) -> usize => fast_band_impl::<128, 64, 16>
+    fn fast_band(padded: &PaddedGrid, fast: &Fast, fp: &GridFootprint, band: &[usize], window: usize, visits: &ProbeVisits, out: BandOut) -> usize => fast_band_impl::<128, 64, 16>
 }
 
 /// The band's work in blocks of `W` starts.
@@ -429,9 +424,9 @@ fn fast_band_impl<const W: usize>(
     band: &[usize],
     window: usize,
     visits: &ProbeVisits,
-    reach: &mut [Rank],
-    struck: &mut [u8],
+    out: BandOut,
 ) -> usize {
+    let BandOut { reach, struck } = out;
     let push_rows = PushRows::new(padded, fp);
     let nz = padded.spec.nz;
     let layer = LayerRows::new(padded, fp);
@@ -535,6 +530,13 @@ fn fast_band_impl<const W: usize>(
         }
     }
     placed
+}
+
+/// What a band's slides record, per node of its reach window: the highest
+/// level that met it, and (under the window rule) whether it was struck.
+struct BandOut<'a> {
+    reach: &'a mut [Rank],
+    struck: &'a mut [u8],
 }
 
 /// What the slides of a band write, and the window rule's slide list of
@@ -837,15 +839,14 @@ impl Slider<'_> {
         let mut lower = 0u32;
         for c in 0..=depth {
             // The push level of the start c + 1 columns to -x of each lane.
-            let mut beside = [OFF; W];
-            for w in 0..W {
+            let beside: [Rank; W] = std::array::from_fn(|w| {
                 let at = w as i64 - c as i64 - 1;
-                beside[w] = if at >= 0 {
+                if at >= 0 {
                     yr[at as usize]
                 } else {
                     left[(W as i64 + at) as usize]
-                };
-            }
+                }
+            });
             for w in 0..W {
                 lower |= u32::from(beside[w] < level[w]);
             }
@@ -1154,16 +1155,8 @@ mod tests {
     use crate::kneeform::KneeForm;
 
     /// [`fast_band`]'s signature.
-    type BandFn = fn(
-        &PaddedGrid,
-        &Fast,
-        &GridFootprint,
-        &[usize],
-        usize,
-        &ProbeVisits,
-        &mut [Rank],
-        &mut [u8],
-    ) -> usize;
+    type BandFn =
+        fn(&PaddedGrid, &Fast, &GridFootprint, &[usize], usize, &ProbeVisits, BandOut) -> usize;
 
     /// Both rules: the window (the default) and the x-slope.
     fn rules() -> [StrikeRule; 2] {
@@ -1185,7 +1178,11 @@ mod tests {
     ) -> (Vec<u8>, Vec<Rank>, usize) {
         let mut reach = vec![NEVER; padded.h.len()];
         let mut struck = vec![0u8; padded.h.len()];
-        let placed = f(padded, fast, fp, rows, 0, visits, &mut reach, &mut struck);
+        let out = BandOut {
+            reach: &mut reach,
+            struck: &mut struck,
+        };
+        let placed = f(padded, fast, fp, rows, 0, visits, out);
         let mask = match fast.window {
             Some(_) => struck,
             None => strike_mask(&fast.thresholds, &reach),

@@ -33,7 +33,7 @@ use crate::strike::{LevelHistory, StrikeRule};
 /// The first layer of one footprint, ready for [`slide_block`]: the offset
 /// from a start's node to the first node in front in each footprint row, in
 /// slide order, and the tie groups (runs of that order whose distances
-/// agree within [`NODE_TOL`](crate::kneeform::NODE_TOL)).
+/// agree within [`NODE_TOL`]).
 #[derive(Debug, Clone)]
 pub struct LayerRows {
     offsets: Vec<isize>,
@@ -275,7 +275,7 @@ impl WindowLayers {
     /// Lays out `fp`'s slide list on `grid` for the window `window` (mm).
     /// Each entry's distance is `d0 + m p`, exactly as the per-start
     /// trace computes it, and groups are chained within
-    /// [`NODE_TOL`](crate::kneeform::NODE_TOL) as there.
+    /// [`NODE_TOL`] as there.
     pub fn new(grid: &PaddedGrid, fp: &GridFootprint, window: f64) -> WindowLayers {
         let p = fp.pitch;
         // The start one column to -x dominates this one (its level is at
@@ -453,6 +453,7 @@ pub struct WindowSlide<'a> {
 /// none lowers no level, so it moves no window level, and no node of it
 /// is a contact. (The caller passes the rows the whole block may slide,
 /// found with wider minima: fewer loads for the rows no lane slides.)
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub fn slide_block_window<const S: usize>(
     h: &[Rank],

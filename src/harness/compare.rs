@@ -525,6 +525,14 @@ pub fn assemble(
         values[metric_index("area_distance")].push(a.miss.max(a.false_alarm));
         values[metric_index("area_distance_decided")]
             .push(a.miss_decided.max(a.false_alarm_decided));
+        for (name, v) in [
+            ("area_miss_distance", a.miss),
+            ("area_miss_distance_decided", a.miss_decided),
+            ("area_false_alarm_distance", a.false_alarm),
+            ("area_false_alarm_distance_decided", a.false_alarm_decided),
+        ] {
+            values[metric_index(name)].push(v);
+        }
     }
     Comparison {
         rows: results.into_iter().map(|r| r.row).collect(),

@@ -8,8 +8,11 @@ use super::trace::GridTrace;
 
 /// The metric names, as the columns of `verify.csv` and the keys of
 /// `verify.json`: each over all strikes, then over the decided strikes
-/// (see [`TieBand`]), then the area distances.
-pub const METRICS: [&str; 11] = [
+/// (see [`TieBand`]), then the area distances: both directions at once,
+/// then each on its own (`area_miss_distance`, from the exact strikes to
+/// the grid's: what the grid misses; `area_false_alarm_distance`, from the
+/// grid's to the exact ones: what it strikes more).
+pub const METRICS: [&str; 15] = [
     "push_error",
     "first_contact_error",
     "miss_distance",
@@ -21,6 +24,10 @@ pub const METRICS: [&str; 11] = [
     "unmatched_deflection_decided",
     "area_distance",
     "area_distance_decided",
+    "area_miss_distance",
+    "area_miss_distance_decided",
+    "area_false_alarm_distance",
+    "area_false_alarm_distance_decided",
 ];
 
 /// The metrics a user's guarantee is made of (and `verify` passes or fails
