@@ -13,6 +13,7 @@ use std::time::Instant;
 use anyhow::{Context, ensure};
 use kneeform::grid::GridSpec;
 use kneeform::scenario::{self, PAPER_TRIANGLES};
+use kneeform::strike::RateEstimate;
 use kneeform::{
     Algorithm, EngineOptions, GridFootprint, HeightGrid, KneeForm, Setup, colliding_masks,
 };
@@ -59,6 +60,13 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     let mut blind_s = Vec::new();
     let mut blind_count = 0;
     let mut slide_s = Vec::new();
+    // SPEC's former x-slope rule on the same grid in the same runs: what
+    // the window rule costs, its load cancelling out.
+    let x_slope = EngineOptions {
+        rule: fast.rule.with_rate(RateEstimate::XSlope),
+        ..EngineOptions::default()
+    };
+    let mut x_slope_s = Vec::new();
     let mut grid = None;
     let mut composite_nodes = 0;
     for run in 0..args.runs {
@@ -72,17 +80,21 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         let t = Instant::now();
         let masks = colliding_masks(&g, &footprints, &fast, &|| {});
         slide_s.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        colliding_masks(&g, &footprints, &x_slope, &|| {});
+        x_slope_s.push(t.elapsed().as_secs_f64());
         composite_nodes = kneeform::composite(&masks)
             .iter()
             .filter(|&&c| c > 0)
             .count();
         eprintln!(
-            "run {}/{}: sample {:.3} s, blind spots {:.3} s, push+slide {:.3} s",
+            "run {}/{}: sample {:.3} s, blind spots {:.3} s, push+slide {:.3} s ({:.3} s under x-slope)",
             run + 1,
             args.runs,
             sample_s[run],
             blind_s[run],
-            slide_s[run]
+            slide_s[run],
+            x_slope_s[run]
         );
         grid = Some(g);
     }
@@ -91,6 +103,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     // back to back, so a load on this shared machine cancels out.
     let blind_ratio = median(blind_s.iter().zip(&sample_s).map(|(b, s)| b / s).collect());
     let blind = median(blind_s);
+    let window_ratio = median(slide_s.iter().zip(&x_slope_s).map(|(w, x)| w / x).collect());
+    let x_slope = median(x_slope_s);
     let (sample, slide) = (median(sample_s), median(slide_s));
     let total = sample + slide;
 
@@ -175,6 +189,10 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         md,
         "| push + slide, {} angles (median) | {slide:.3} s |",
         footprints.len()
+    )?;
+    writeln!(
+        md,
+        "| push + slide under `--rate x-slope` in the same runs (median) | {x_slope:.3} s; the window rule takes {window_ratio:.2}x that (median of the runs' ratios) |"
     )?;
     writeln!(
         md,
