@@ -477,9 +477,11 @@ fn fast_band_impl<const W: usize>(
     };
     let mut rows: Vec<RowState<W>> = band
         .iter()
-        .map(|&j0| RowState {
+        .zip(&active)
+        .map(|(&j0, active)| RowState {
             first: padded.index(j0 as i64, 0),
             j0,
+            first_active: active.start,
             carry: NEVER,
             pending: None,
             extensions: Vec::new(),
@@ -568,6 +570,9 @@ struct WindowRule<'a> {
 struct RowState<const W: usize> {
     /// The start row.
     j0: usize,
+    /// The first of its active starts ([`PaddedGrid::active_starts`]):
+    /// past it to -x no first layer holds a finite height.
+    first_active: i64,
     /// The padded index of the row's column 0.
     first: usize,
     /// The level the slides carry into the next block, from +x.
@@ -798,9 +803,22 @@ impl Slider<'_> {
             0.. => level[w as usize] != NEVER,
             _ => real(w) && left[(W as i64 + w) as usize] != OFF,
         };
+        // Most blocks have none: every start placed, or none.
+        let begins = |w: usize| placed_at(w as i64) && !placed_at(w as i64 - 1);
+        if row.extensions.is_empty() && !(0..W).any(begins) {
+            return placed;
+        }
         for w in (0..W).rev() {
             let column = block + w as i64;
             let here = placed_at(w as i64);
+            if row.extensions.is_empty() && !begins(w) {
+                continue;
+            }
+            // Past the row's active starts a slide meets nothing more.
+            if column < row.first_active {
+                row.extensions.clear();
+                break;
+            }
             row.extensions.retain_mut(|e| {
                 let shift = (e.column - column) as f64 * rule.pitch;
                 let on = e.goes_on(shift, here, rule.window, rule.pitch);

@@ -481,9 +481,26 @@ pub fn slide_block_window<const S: usize>(
             let inside = layers.inside[r as usize];
             for &e in &layers.by_row[from as usize..to as usize] {
                 let m = u32::from(layers.layer[e as usize]);
-                if !inside || m >= 64 || moving >> m & 1 != 0 {
-                    out.slid_bits[e as usize / 64] |= 1 << (e % 64);
+                if inside && m < 64 && moving >> m & 1 == 0 {
+                    continue;
                 }
+                // Where the rows may be passed over, an entry whose nodes
+                // are none below their start's level on entry is passed
+                // over too: levels only fall, so it lowers nothing and is
+                // no contact. Read here, a row's entries at once (adjacent
+                // columns), rather than one by one in slide order.
+                if still.is_some() {
+                    let a = base.wrapping_add_signed(layers.offsets[e as usize]);
+                    let hv: &[Rank; S] = h[a..a + S].try_into().expect("S values");
+                    let mut below = 0u32;
+                    for w in 0..S {
+                        below |= u32::from(hv[w] < level[w]);
+                    }
+                    if below == 0 {
+                        continue;
+                    }
+                }
+                out.slid_bits[e as usize / 64] |= 1 << (e % 64);
             }
         }
     }
