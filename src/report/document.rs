@@ -518,7 +518,11 @@ fn method_section(run: &Run) -> Markup {
                 } @else {
                     (row("Deflection threshold", html! {
                         (c("/deflection_deg")) " degrees (sigma = tan delta = " (c("/sigma"))
-                        "; rate estimated as " (c("/rate"))
+                        "; deflection measured as " (c("/rate"))
+                        @if s.window_mm.is_some() {
+                            ": the knee-form's drop over the last " (c("/window_mm"))
+                            " mm of its travel against sigma times that window"
+                        }
                         "): a point the knee-form meets is a strike only when the surface there turns it aside by more than this angle"
                     }))
                 }
