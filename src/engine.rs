@@ -612,6 +612,19 @@ impl<const W: usize> RowState<W> {
     }
 }
 
+/// A block of starts as the window rule's slides read it: its first
+/// start's column, the padded index of that start's node less the reach
+/// window's, the push levels of its starts and of the next block's (to
+/// -x), and the levels its placed starts enter with ([`NEVER`] elsewhere).
+#[derive(Clone, Copy)]
+struct Block<const W: usize> {
+    column: i64,
+    base: usize,
+    yr: [Rank; W],
+    left: [Rank; W],
+    level: [Rank; W],
+}
+
 /// What the slides of a band share.
 struct Slider<'a> {
     /// The height ranks from the reach window's first node on.
@@ -648,11 +661,6 @@ impl Slider<'_> {
         yr: [Rank; W],
         left: [Rank; W],
     ) -> usize {
-        if let (Some(rule), Some(layers)) = (&self.rule, sink.window_layers) {
-            return self.slide_window(rule, layers, sink, layer, k, row, block, yr, left);
-        }
-        let reach = &mut *sink.reach;
-        let left = left[W - 1];
         let base = row.first.wrapping_add_signed(block as isize) - self.window;
         // Only real starts are placed.
         let mut level = [NEVER; W];
@@ -664,6 +672,19 @@ impl Slider<'_> {
                 placed += 1;
             }
         }
+        if let (Some(rule), Some(layers)) = (&self.rule, sink.window_layers) {
+            let b = Block {
+                column: block,
+                base,
+                yr,
+                left,
+                level,
+            };
+            self.slide_window(rule, layers, sink, layer, k, row, &b);
+            return placed;
+        }
+        let reach = &mut *sink.reach;
+        let left = left[W - 1];
         let after = if self.moves(layer, base, left, &yr, &level) {
             // Rows of the layer that change nothing are passed over, where
             // no probe needs their reach.
@@ -706,21 +727,16 @@ impl Slider<'_> {
         layer: &LayerRows,
         k: usize,
         row: &mut RowState<W>,
-        block: i64,
-        yr: [Rank; W],
-        left: [Rank; W],
-    ) -> usize {
-        let base = row.first.wrapping_add_signed(block as isize) - self.window;
+        b: &Block<W>,
+    ) {
+        let Block {
+            column: block,
+            base,
+            yr,
+            left,
+            level,
+        } = *b;
         let real = |lane: i64| (0..self.nx).contains(&(block + lane));
-        // Only real starts are placed.
-        let mut level = [NEVER; W];
-        let mut placed = 0;
-        for w in 0..W {
-            if real(w as i64) && yr[w] != OFF {
-                level[w] = yr[w];
-                placed += 1;
-            }
-        }
         let mut out = WindowSlide {
             contact: rule.contact,
             deflected: rule.deflected,
@@ -806,7 +822,7 @@ impl Slider<'_> {
         // Most blocks have none: every start placed, or none.
         let begins = |w: usize| placed_at(w as i64) && !placed_at(w as i64 - 1);
         if row.extensions.is_empty() && !(0..W).any(begins) {
-            return placed;
+            return;
         }
         for w in (0..W).rev() {
             let column = block + w as i64;
@@ -833,7 +849,6 @@ impl Slider<'_> {
                 row.extensions.push(e);
             }
         }
-        placed
     }
 
     /// [`Slider::moves`] over a placed start's [`WindowLayers`]: its first
