@@ -684,8 +684,7 @@ impl Slider<'_> {
             return placed;
         }
         let reach = &mut *sink.reach;
-        let left = left[W - 1];
-        let after = if self.moves(layer, base, left, &yr, &level) {
+        let after = if self.moves(layer, 0, base, &left, &yr, &level) {
             // Rows of the layer that change nothing are passed over, where
             // no probe needs their reach.
             let still = (self.skip_still && !self.visits.any(k, base + self.window, W))
@@ -748,7 +747,7 @@ impl Slider<'_> {
             rows: sink.rows,
             lowered: sink.lowered,
         };
-        if self.moves_window(layer, layers.depth(), base, &left, &yr, &level) {
+        if self.moves(layer, layers.depth(), base, &left, &yr, &level) {
             let pass_over = self.skip_still && !self.visits.any(k, base + self.window, W);
             let still = |lanes| {
                 pass_over
@@ -851,13 +850,16 @@ impl Slider<'_> {
         }
     }
 
-    /// [`Slider::moves`] over a placed start's [`WindowLayers`]: its first
-    /// `depth + 1` columns' first layers. The first layer of the start `c`
-    /// columns to -x of a lane lies, in rows with nodes inside, inside the
-    /// footprint of the start one column further, so at or above that
-    /// start's push level; the other rows are read.
+    /// Whether the first `depth + 1` columns' first layers of some placed
+    /// start of the block (levels `level`, [`NEVER`] where not placed) hold
+    /// a node below its level: one layer under the x-slope rule, a start's
+    /// [`WindowLayers`] under the window rule. The first layer of the
+    /// start `c` columns to -x of a lane lies, in rows with nodes inside,
+    /// inside the footprint of the start one column further, so at or
+    /// above that start's push level (`yr`, the next block's `left` past
+    /// the first lane); the other rows are read.
     #[inline(always)]
-    fn moves_window<const W: usize>(
+    fn moves<const W: usize>(
         &self,
         layer: &LayerRows,
         depth: usize,
@@ -895,42 +897,6 @@ impl Slider<'_> {
             }
         }
         false
-    }
-
-    /// Whether the first layer of some placed start of the block (levels
-    /// `level`, [`NEVER`] where not placed) holds a node below its level:
-    /// its start one column to -x pushed lower (`left` for the first
-    /// lane's), or a node of a footprint row with none inside is lower.
-    #[inline(always)]
-    fn moves<const W: usize>(
-        &self,
-        layer: &LayerRows,
-        base: usize,
-        left: Rank,
-        yr: &[Rank; W],
-        level: &[Rank; W],
-    ) -> bool {
-        if !self.skip_still {
-            return true;
-        }
-        let mut beside = [OFF; W];
-        beside[0] = left;
-        beside[1..].copy_from_slice(&yr[..W - 1]);
-        let mut lower = 0u32;
-        for w in 0..W {
-            lower |= u32::from(beside[w] < level[w]);
-        }
-        if lower != 0 {
-            return true;
-        }
-        for offset in layer.outside() {
-            let a = base.wrapping_add_signed(offset);
-            let hv: &[Rank; W] = self.h[a..a + W].try_into().expect("W values");
-            for w in 0..W {
-                lower |= u32::from(hv[w] < level[w]);
-            }
-        }
-        lower != 0
     }
 }
 
