@@ -103,33 +103,8 @@ pub fn blind_spots(triangles: &[Triangle], grid: &HeightGrid, threshold: f64) ->
     if spec.nx < 2 || spec.nz < 2 {
         return Vec::new();
     }
-    let (cx, cz) = (spec.nx - 1, spec.nz - 1);
     let rows = bin_by_cell_row(triangles, grid);
-    // Per cell row: the lowest mesh point of each cell, in parallel.
-    let lowest: Vec<Vec<(f64, [f64; 2])>> = rows
-        .par_iter()
-        .enumerate()
-        .map(|(j, bin)| {
-            let mut row = vec![(f64::INFINITY, [0.0; 2]); cx];
-            for &k in bin {
-                let t = &triangles[k as usize];
-                // No point of the triangle lies lower than its lowest vertex.
-                let lowest = t[0][1].min(t[1][1]).min(t[2][1]);
-                for i in cell_columns(t, grid) {
-                    if lowest >= row[i].0 {
-                        continue;
-                    }
-                    let clipped = clip_to_cell(t, grid, i, j);
-                    for &[x, y, z] in clipped.points() {
-                        if y < row[i].0 {
-                            row[i] = (y, [x, z]);
-                        }
-                    }
-                }
-            }
-            row
-        })
-        .collect();
+    let lowest = lowest_points(triangles, grid, &rows);
     let mut spots = Vec::new();
     for (j, row) in lowest.iter().enumerate() {
         for (i, &(y_min, [x, z])) in row.iter().enumerate() {
@@ -154,8 +129,95 @@ pub fn blind_spots(triangles: &[Triangle], grid: &HeightGrid, threshold: f64) ->
             });
         }
     }
-    debug_assert!(spots.iter().all(|s| s.i < cx && s.j < cz));
+    debug_assert!(spots.iter().all(|s| s.i < spec.nx - 1 && s.j < spec.nz - 1));
     spots
+}
+
+/// Every cell's sampled reference height and the mesh's lowest point in it:
+/// what a blind spot is judged by, for all cells, flagged or not.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CellDepths {
+    /// Cells per row (`nx - 1`).
+    pub cx: usize,
+    /// Per cell, row-major: the reference height (the lowest sampled
+    /// corner, as [`blind_spots`] takes it) and the mesh's lowest y in the
+    /// cell's closed square (mm); `NaN` where either is missing.
+    pub cells: Vec<(f64, f64)>,
+}
+
+impl CellDepths {
+    /// The depth missed of cell `(i, j)`: how far the mesh sticks out past
+    /// the cell's reference height (mm; `NaN` where unknown).
+    pub fn depth(&self, i: usize, j: usize) -> f64 {
+        let (reference, lowest) = self.cells[j * self.cx + i];
+        reference - lowest
+    }
+
+    /// The reference height of cell `(i, j)` (mm; `NaN` where unknown).
+    pub fn reference(&self, i: usize, j: usize) -> f64 {
+        self.cells[j * self.cx + i].0
+    }
+}
+
+/// The reference height and lowest mesh point of every cell of `grid`
+/// (sampled from `triangles`): the blind-spot test before its threshold.
+pub fn cell_depths(triangles: &[Triangle], grid: &HeightGrid) -> CellDepths {
+    let spec = grid.spec;
+    if spec.nx < 2 || spec.nz < 2 {
+        return CellDepths {
+            cx: spec.nx.saturating_sub(1),
+            cells: Vec::new(),
+        };
+    }
+    let rows = bin_by_cell_row(triangles, grid);
+    let lowest = lowest_points(triangles, grid, &rows);
+    let cells = lowest
+        .iter()
+        .enumerate()
+        .flat_map(|(j, row)| {
+            row.iter().enumerate().map(move |(i, &(y, _))| {
+                let reference = reference_height(grid, i, j).unwrap_or(f64::NAN);
+                (reference, if y.is_finite() { y } else { f64::NAN })
+            })
+        })
+        .collect();
+    CellDepths {
+        cx: spec.nx - 1,
+        cells,
+    }
+}
+
+/// Per cell row, the lowest mesh point `(y, [x, z])` of each cell (`+inf`
+/// where no triangle meets the cell), in parallel over the rows.
+fn lowest_points(
+    triangles: &[Triangle],
+    grid: &HeightGrid,
+    rows: &[Vec<u32>],
+) -> Vec<Vec<(f64, [f64; 2])>> {
+    let cx = grid.spec.nx - 1;
+    rows.par_iter()
+        .enumerate()
+        .map(|(j, bin)| {
+            let mut row = vec![(f64::INFINITY, [0.0; 2]); cx];
+            for &k in bin {
+                let t = &triangles[k as usize];
+                // No point of the triangle lies lower than its lowest vertex.
+                let lowest = t[0][1].min(t[1][1]).min(t[2][1]);
+                for i in cell_columns(t, grid) {
+                    if lowest >= row[i].0 {
+                        continue;
+                    }
+                    let clipped = clip_to_cell(t, grid, i, j);
+                    for &[x, y, z] in clipped.points() {
+                        if y < row[i].0 {
+                            row[i] = (y, [x, z]);
+                        }
+                    }
+                }
+            }
+            row
+        })
+        .collect()
 }
 
 /// The largest `pitch / 2^k` (k >= 1) no larger than `width` mm.

@@ -10,9 +10,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::HarnessError;
+use super::causes::{Cells, Failure, Mechanism, Side};
 use super::metrics::{
-    DECIDED_METRICS, ExactRule, METRICS, StartComparison, StartPoints, Stats, TieBand, compare,
-    metric_index,
+    ExactRule, METRICS, StartComparison, StartPoints, Stats, TieBand, compare, metric_index,
 };
 use super::nearest::PointSet;
 use super::trace::{Fault, grid_trace};
@@ -53,6 +53,9 @@ pub struct CompareOptions {
     pub rule: StrikeRule,
     /// The tie band's growth with the pitch ([`TieBand`], per mm).
     pub tie_band_per_mm: f64,
+    /// The depth of a flagged blind spot (mm, the analysis's
+    /// `--blind-depth`): disagreements downstream of one are blind.
+    pub blind_depth: f64,
 }
 
 /// SplitMix64, for seeded start samples (same sample on every machine).
@@ -201,6 +204,28 @@ pub struct VerifyRow {
     pub worst_x: Option<f64>,
     /// Its z (mm).
     pub worst_z: Option<f64>,
+    /// Whether the exact knee-form touched a flagged blind spot in this
+    /// slide (its later disagreements are blind).
+    #[serde(default)]
+    pub blind: bool,
+    /// Whether the exact push contact lies on one.
+    #[serde(default)]
+    pub push_blind: bool,
+    /// `miss_distance` over decided exact strikes downstream of a blind
+    /// spot.
+    #[serde(default)]
+    pub miss_distance_blind: Option<f64>,
+    /// `false_alarm_distance_decided` over grid strikes downstream of one.
+    #[serde(default)]
+    pub false_alarm_distance_blind: Option<f64>,
+    /// `false_alarm_distance_decided` over the grid strikes the level
+    /// error does not explain.
+    #[serde(default)]
+    pub false_alarm_distance_unexplained: Option<f64>,
+    /// The largest distance of a struck node from touching the exact
+    /// knee-form (mm), away from blind spots.
+    #[serde(default)]
+    pub level_error_clearance: Option<f64>,
 }
 
 /// Counts of a comparison.
@@ -236,6 +261,17 @@ pub struct Counts {
     /// Exact contacts in the tie band: either answer is right at this
     /// pitch.
     pub exact_undecided: usize,
+    /// Pairs whose exact knee-form touched a flagged blind spot: their
+    /// later disagreements are blind.
+    #[serde(default)]
+    pub blind_pairs: usize,
+    /// Exact strikes at or after such a touch.
+    #[serde(default)]
+    pub blind_strikes: usize,
+    /// Grid strikes (away from blind spots) whose node lies within the
+    /// stated bound of the grid's level error of the exact knee-form.
+    #[serde(default)]
+    pub level_error_strikes: usize,
 }
 
 /// The area distance at one angle: the two directed Hausdorff distances in
@@ -254,9 +290,19 @@ pub struct AreaDistance {
     pub false_alarm: f64,
     /// `miss` from decided exact strikes only.
     pub miss_decided: f64,
-    /// `false_alarm` against every exact contact not gentler than the tie
-    /// band.
+    /// `false_alarm` from the grid strikes away from blind spots against
+    /// every exact contact not a decided non-strike.
     pub false_alarm_decided: f64,
+    /// `false_alarm_decided` from the grid strikes the level error does
+    /// not explain.
+    #[serde(default)]
+    pub false_alarm_unexplained: f64,
+    /// `miss` from decided exact strikes downstream of a blind spot.
+    #[serde(default)]
+    pub miss_blind: f64,
+    /// `false_alarm_decided` from grid strikes downstream of one.
+    #[serde(default)]
+    pub false_alarm_blind: f64,
 }
 
 /// The metrics of one grid against the exact traces.
@@ -276,8 +322,69 @@ pub struct Comparison {
     pub band: TieBand,
     /// Counts.
     pub counts: Counts,
+    /// The decided figures the level error can explain, over what it does
+    /// not explain.
+    pub unexplained: Unexplained,
     /// Seconds spent on the grid side.
     pub grid_s: f64,
+}
+
+/// The decided figures that the grid's level error can explain (the push
+/// error, an early first strike, false alarms), each taken over the values
+/// the level error does not explain (mm): where one is within the
+/// tolerance while its figure is not, the figure fails by the level error.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Unexplained {
+    /// `push_error_decided` where the push error exceeds the depth the
+    /// exact push contact's cell hides.
+    pub push_error: f64,
+    /// `first_contact_error_decided` but where the grid strikes first on a
+    /// node within the level error's bound.
+    pub first_contact_error: f64,
+    /// `false_alarm_distance_decided` over grid strikes beyond the bound
+    /// (`null` when infinite).
+    #[serde(with = "crate::harness::compare::infinite_as_null")]
+    pub false_alarm_distance: f64,
+    /// `area_false_alarm_distance_decided` from those strikes.
+    #[serde(with = "crate::harness::compare::infinite_as_null")]
+    pub area_false_alarm_distance: f64,
+    /// Grid strikes beyond the bound with no possible exact strike in
+    /// their start (a judged one: not an oracle failure).
+    pub unmatched_grid: usize,
+}
+
+impl Unexplained {
+    fn note_push(&mut self, push_error: Option<f64>) {
+        if let Some(e) = push_error {
+            self.push_error = self.push_error.max(e.abs());
+        }
+    }
+
+    fn note_false_alarm(&mut self, distance: f64, judged: bool) {
+        if distance.is_finite() {
+            self.false_alarm_distance = self.false_alarm_distance.max(distance);
+        } else if judged {
+            self.unmatched_grid += 1;
+        }
+    }
+}
+
+/// Serde for a distance that may be infinite: JSON has no infinity, so it
+/// is written `null` and read back infinite.
+pub(crate) mod infinite_as_null {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+        if v.is_finite() {
+            s.serialize_f64(*v)
+        } else {
+            s.serialize_none()
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
+    }
 }
 
 /// One start-angle pair compared: its row, its comparison, the grid's
@@ -335,24 +442,39 @@ pub fn row_of(
         grid_colliding: cmp.false_alarm.len(),
         worst_x: worst_at.map(|p| p[0]),
         worst_z: worst_at.map(|p| p[1]),
+        blind: cmp.blind,
+        push_blind: cmp.push_blind,
+        miss_distance_blind: worst(&cmp.miss_blind),
+        false_alarm_distance_blind: worst(&cmp.false_alarm_blind),
+        false_alarm_distance_unexplained: worst(
+            &cmp.false_alarm_decided
+                .iter()
+                .zip(&cmp.false_alarm_explained)
+                .filter(|(_, explained)| !**explained)
+                .map(|(d, _)| *d)
+                .collect::<Vec<f64>>(),
+        ),
+        level_error_clearance: worst(&cmp.level_clearance),
     }
 }
 
-/// Compares `grid` with `traces` (angle-major over `starts`, positions in
-/// mm that must be nodes of `grid`).
+/// Compares `grid` (sampled from `triangles`) with `traces` (angle-major
+/// over `starts`, positions in mm that must be nodes of `grid`).
 pub fn compare_grid(
+    triangles: &[Triangle],
     grid: &HeightGrid,
     footprints: &[GridFootprint],
     starts: &[[f64; 2]],
     traces: &[StartTrace],
     options: &CompareOptions,
 ) -> Result<Comparison, HarnessError> {
-    compare_grid_with(grid, footprints, starts, traces, options, None)
+    compare_grid_with(triangles, grid, footprints, starts, traces, options, None)
 }
 
 /// [`compare_grid`] with an optional deliberate mistake on the grid side:
 /// the harness's own tests show it catches a broken engine.
 pub(crate) fn compare_grid_with(
+    triangles: &[Triangle],
     grid: &HeightGrid,
     footprints: &[GridFootprint],
     starts: &[[f64; 2]],
@@ -361,17 +483,18 @@ pub(crate) fn compare_grid_with(
     fault: Option<Fault>,
 ) -> Result<Comparison, HarnessError> {
     let t = Instant::now();
-    let results = pair_results(grid, footprints, starts, traces, options, fault)?;
+    let results = pair_results(triangles, grid, footprints, starts, traces, options, fault)?;
     let grid_s = t.elapsed().as_secs_f64();
     let band = TieBand::new(options.rule.sigma, grid.spec.pitch, options.tie_band_per_mm);
     let angles: Vec<f64> = footprints.iter().map(|fp| fp.angle_deg).collect();
     Ok(assemble(results, &angles, band, grid_s))
 }
 
-/// Every start-angle pair of `starts` (positions in mm, nodes of `grid`)
-/// at `footprints` compared with `traces` (angle-major), in angle-major
-/// order: the per-pair work of a comparison.
+/// Every start-angle pair of `starts` (positions in mm, nodes of `grid`,
+/// sampled from `triangles`) at `footprints` compared with `traces`
+/// (angle-major), in angle-major order: the per-pair work of a comparison.
 pub(crate) fn pair_results(
+    triangles: &[Triangle],
     grid: &HeightGrid,
     footprints: &[GridFootprint],
     starts: &[[f64; 2]],
@@ -397,6 +520,7 @@ pub(crate) fn pair_results(
             expected: footprints.len() * nodes.len(),
         });
     }
+    let cells = Cells::of(triangles, grid, options.blind_depth);
     let pairs: Vec<(usize, usize)> = (0..footprints.len())
         .flat_map(|a| (0..nodes.len()).map(move |s| (a, s)))
         .collect();
@@ -407,7 +531,13 @@ pub(crate) fn pair_results(
             let fp = &footprints[a];
             let trace = &traces[a * nodes.len() + s];
             let g = grid_trace(grid, fp, i, j, &options.rule, fault);
-            let cmp = compare(&g, trace, &band, ExactRule::of(&options.rule, spec.pitch));
+            let cmp = compare(
+                &g,
+                trace,
+                &band,
+                ExactRule::of(&options.rule, spec.pitch),
+                &cells,
+            );
             let grid_placed = g.yr.is_finite();
             let status = match (trace.status, grid_placed) {
                 (StartStatus::Failed { .. }, _) => "oracle_failed",
@@ -449,6 +579,7 @@ pub fn assemble(
         ..Counts::default()
     };
     let mut values: Vec<Vec<f64>> = vec![Vec::new(); METRICS.len()];
+    let mut unexplained = Unexplained::default();
     let (mut grid_set, mut exact_set) = (HashSet::new(), HashSet::new());
     let mut area_points: Vec<StartPoints> = vec![StartPoints::default(); angles_deg.len()];
     for (k, pair) in results.iter().enumerate() {
@@ -473,22 +604,54 @@ pub fn assemble(
             values[metric_index(name)].extend(finite);
             infinite.len()
         };
-        push("push_error", &Vec::from_iter(cmp.push_error));
+        let opt = |v: Option<f64>| Vec::from_iter(v);
+        push("push_error", &opt(cmp.push_error));
+        let push_error = cmp.push_error.filter(|_| !cmp.push_blind);
+        push("push_error_decided", &opt(push_error));
         push(
-            "first_contact_error",
-            &Vec::from_iter(cmp.first_contact_error),
+            "push_error_blind",
+            &opt(cmp.push_error.filter(|_| cmp.push_blind)),
         );
+        if !cmp.push_explained {
+            unexplained.note_push(push_error);
+        }
+        push("first_contact_error", &opt(cmp.first_contact_error));
         push(
             "first_contact_error_decided",
-            &Vec::from_iter(cmp.first_contact_error_decided),
+            &opt(cmp.first_contact_error_decided),
         );
+        push(
+            "first_contact_error_blind",
+            &opt(cmp.first_contact_error_blind),
+        );
+        // A grid first strike earlier than the exact one is a false alarm
+        // at the first contact: the level error's when its node is within
+        // the bound.
+        if let Some(e) = cmp.first_contact_error_decided
+            && !(e < 0.0 && cmp.first_contact_explained)
+        {
+            unexplained.first_contact_error = unexplained.first_contact_error.max(e.abs());
+        }
         // A start the oracle failed on has no exact answer: it is counted
         // as a failure, not as grid strikes without an exact one.
         let judged = row.status != "oracle_failed";
         let unmatched_exact = push("miss_distance", &cmp.miss);
         let unmatched_exact_decided = push("miss_distance_decided", &cmp.miss_decided);
+        push("miss_distance_blind", &cmp.miss_blind);
         let unmatched_grid = push("false_alarm_distance", &cmp.false_alarm);
         let unmatched_grid_decided = push("false_alarm_distance_decided", &cmp.false_alarm_decided);
+        push("false_alarm_distance_blind", &cmp.false_alarm_blind);
+        for (&d, &explained) in cmp
+            .false_alarm_decided
+            .iter()
+            .zip(&cmp.false_alarm_explained)
+        {
+            if explained {
+                counts.level_error_strikes += 1;
+            } else {
+                unexplained.note_false_alarm(d, judged);
+            }
+        }
         if judged {
             counts.unmatched_exact += unmatched_exact;
             counts.unmatched_exact_decided += unmatched_exact_decided;
@@ -500,6 +663,14 @@ pub fn assemble(
             "unmatched_deflection_decided",
             &cmp.unmatched_deflection_decided,
         );
+        push(
+            "unmatched_deflection_blind",
+            &cmp.unmatched_deflection_blind,
+        );
+        push("level_error_clearance", &cmp.level_clearance);
+        push("level_error_bound", &cmp.level_bound);
+        counts.blind_pairs += usize::from(cmp.blind);
+        counts.blind_strikes += cmp.blind_strikes;
         if row.status == "compared" || row.status == "grid_not_placed" {
             grid_set.extend(grid_nodes.iter().map(|&n| (a, n)));
             exact_set.extend(snapped.iter().map(|&n| (a, n)));
@@ -525,7 +696,13 @@ pub fn assemble(
         values[metric_index("area_distance")].push(a.miss.max(a.false_alarm));
         values[metric_index("area_distance_decided")]
             .push(a.miss_decided.max(a.false_alarm_decided));
+        values[metric_index("area_distance_blind")].push(a.miss_blind.max(a.false_alarm_blind));
+        unexplained.area_false_alarm_distance = unexplained
+            .area_false_alarm_distance
+            .max(a.false_alarm_unexplained);
         for (name, v) in [
+            ("area_miss_distance_blind", a.miss_blind),
+            ("area_false_alarm_distance_blind", a.false_alarm_blind),
             ("area_miss_distance", a.miss),
             ("area_miss_distance_decided", a.miss_decided),
             ("area_false_alarm_distance", a.false_alarm),
@@ -545,6 +722,7 @@ pub fn assemble(
         area,
         band,
         counts,
+        unexplained,
         grid_s,
     }
 }
@@ -556,60 +734,202 @@ fn area_distance(angle_deg: f64, pts: StartPoints) -> AreaDistance {
     // is any distance from anything: PointSet's Hausdorff says both.
     let grid = PointSet::new(pts.grid.clone());
     let from_grid = |to: Vec<[f64; 2]>| PointSet::new(to).hausdorff_from(&pts.grid);
+    let possible = PointSet::new(pts.with_push(&pts.possible));
     AreaDistance {
         angle_deg,
         miss: grid.hausdorff_from(&pts.strikes),
         false_alarm: from_grid(pts.with_push(&pts.strikes)),
         miss_decided: grid.hausdorff_from(&pts.decided),
-        false_alarm_decided: from_grid(pts.with_push(&pts.possible)),
+        false_alarm_decided: possible.hausdorff_from(&pts.grid_decided),
+        false_alarm_unexplained: possible.hausdorff_from(&pts.grid_unexplained),
+        miss_blind: grid.hausdorff_from(&pts.blind),
+        false_alarm_blind: possible.hausdorff_from(&pts.grid_blind),
     }
 }
 
 impl Comparison {
-    /// Whether every decided metric ([`DECIDED_METRICS`]) is within
-    /// `tolerance` (mm) and nothing is contradictory or failed. Undecided
-    /// strikes (in the tie band) never fail a comparison; they are counted
-    /// and their metrics shown beside the decided ones.
+    /// Whether the comparison holds at `tolerance` (mm): no failing figure
+    /// ([`Comparison::failures`]) fails the verdict. Undecided contacts,
+    /// blind disagreements and the level error's false alarms are reported
+    /// beside the decided figures, with their mechanism; they do not fail
+    /// it (SPEC, "What the harness measures").
     pub fn passes(&self, tolerance: f64) -> bool {
-        self.failures(tolerance).is_empty()
+        !self.failures(tolerance).iter().any(|f| f.fails_verdict)
     }
 
-    /// Why a comparison fails `tolerance`, one phrase per reason (empty
-    /// when it passes).
-    pub fn failures(&self, tolerance: f64) -> Vec<String> {
-        let c = &self.counts;
-        let mut why: Vec<String> = self
-            .stats
-            .iter()
-            .filter(|(m, s)| DECIDED_METRICS.contains(&m.as_str()) && s.max > tolerance)
-            .map(|(m, s)| format!("{m} {:.3} mm", s.max))
+    /// Every figure beyond `tolerance` (mm), each with its mechanism: the
+    /// decided figures (misses first: safety, then false alarms: cost),
+    /// the figures over all strikes that fail only through blind or
+    /// undecided contacts, and the counts of pairs without an answer.
+    pub fn failures(&self, tolerance: f64) -> Vec<Failure> {
+        use Mechanism::*;
+        let u = &self.unexplained;
+        let max = |m: &str| self.stat(m).max;
+        // An infinite area distance is no statistic: read it per angle.
+        let area = |f: &dyn Fn(&AreaDistance) -> f64| self.area.iter().map(f).fold(0.0, f64::max);
+        let level = |unexplained: f64| {
+            if unexplained <= tolerance {
+                LevelError
+            } else {
+                Unexplained
+            }
+        };
+        let decided: [(&str, f64, Mechanism, Side); 7] = [
+            (
+                "miss_distance_decided",
+                max("miss_distance_decided"),
+                Unexplained,
+                Side::Miss,
+            ),
+            (
+                "unmatched_deflection_decided",
+                max("unmatched_deflection_decided"),
+                Unexplained,
+                Side::Miss,
+            ),
+            (
+                "area_miss_distance_decided",
+                area(&|a| a.miss_decided),
+                Unexplained,
+                Side::Miss,
+            ),
+            (
+                "false_alarm_distance_decided",
+                max("false_alarm_distance_decided"),
+                level(u.false_alarm_distance),
+                Side::FalseAlarm,
+            ),
+            (
+                "area_false_alarm_distance_decided",
+                area(&|a| a.false_alarm_decided),
+                level(u.area_false_alarm_distance),
+                Side::FalseAlarm,
+            ),
+            (
+                "push_error_decided",
+                max("push_error_decided"),
+                level(u.push_error),
+                Side::Level,
+            ),
+            (
+                "first_contact_error_decided",
+                max("first_contact_error_decided"),
+                level(u.first_contact_error),
+                Side::Level,
+            ),
+        ];
+        let mut failures: Vec<Failure> = decided
+            .into_iter()
+            .filter(|&(_, v, _, _)| v > tolerance)
+            .map(|(m, v, mech, side)| Failure::new(m, v, mech, side))
             .collect();
-        if self
-            .area
-            .iter()
-            .any(|a| !(a.miss_decided.is_finite() && a.false_alarm_decided.is_finite()))
-        {
-            why.push("area distance infinite (one side strikes nothing)".into());
+        // Over all strikes: beyond the tolerance while the decided figure
+        // is within it, through blind or undecided contacts.
+        let all: [(&str, f64, f64, f64, Side); 6] = [
+            (
+                "miss_distance",
+                max("miss_distance"),
+                max("miss_distance_decided"),
+                max("miss_distance_blind"),
+                Side::Miss,
+            ),
+            (
+                "area_miss_distance",
+                area(&|a| a.miss),
+                area(&|a| a.miss_decided),
+                area(&|a| a.miss_blind),
+                Side::Miss,
+            ),
+            (
+                "false_alarm_distance",
+                max("false_alarm_distance"),
+                max("false_alarm_distance_decided"),
+                max("false_alarm_distance_blind"),
+                Side::FalseAlarm,
+            ),
+            (
+                "area_false_alarm_distance",
+                area(&|a| a.false_alarm),
+                area(&|a| a.false_alarm_decided),
+                area(&|a| a.false_alarm_blind),
+                Side::FalseAlarm,
+            ),
+            (
+                "push_error",
+                max("push_error"),
+                max("push_error_decided"),
+                max("push_error_blind"),
+                Side::Level,
+            ),
+            (
+                "first_contact_error",
+                max("first_contact_error"),
+                max("first_contact_error_decided"),
+                max("first_contact_error_blind"),
+                Side::Level,
+            ),
+        ];
+        for (m, v, decided, blind, side) in all {
+            if v > tolerance && decided <= tolerance {
+                let mech = if blind > tolerance { Blind } else { Undecided };
+                failures.push(Failure::new(m, v, mech, side));
+            }
         }
-        for (n, what) in [
+        let c = &self.counts;
+        for (m, n, mech, side) in [
             (
+                "oracle_failed",
                 c.oracle_failed,
-                "oracle failures (no exact answer for those starts)",
+                OracleFailure,
+                Side::Coverage,
             ),
             (
+                "oracle_not_placed",
                 c.oracle_not_placed,
-                "starts placed by the grid but not by the oracle",
+                Unexplained,
+                Side::Coverage,
             ),
             (
+                "unmatched_grid_decided",
                 c.unmatched_grid_decided,
-                "grid strikes with no possible exact one in their start",
+                if u.unmatched_grid == 0 {
+                    LevelError
+                } else {
+                    Unexplained
+                },
+                Side::FalseAlarm,
             ),
         ] {
             if n > 0 {
-                why.push(format!("{n} {what}"));
+                failures.push(Failure::new(m, n as f64, mech, side));
             }
         }
-        why
+        failures
+    }
+
+    /// The verdict in one line: misses (safety) and false alarms (cost)
+    /// apart, each failing figure with its mechanism.
+    pub fn verdict(&self, tolerance: f64) -> String {
+        let failures = self.failures(tolerance);
+        let side = |sides: &[Side]| -> String {
+            let of: Vec<String> = failures
+                .iter()
+                .filter(|f| sides.contains(&f.side))
+                .map(Failure::phrase)
+                .collect();
+            if of.is_empty() {
+                format!("within {tolerance} mm")
+            } else {
+                of.join(", ")
+            }
+        };
+        format!(
+            "misses: {}; false alarms: {}; push and first contact: {}; coverage: {}",
+            side(&[Side::Miss]),
+            side(&[Side::FalseAlarm]),
+            side(&[Side::Level]),
+            side(&[Side::Coverage]),
+        )
     }
 
     /// The statistics of metric `name`.
@@ -619,13 +939,16 @@ impl Comparison {
 
     /// The worst start-angle pairs by their largest decided metric, at most
     /// `n`.
-    pub fn worst(&self, n: usize) -> Vec<(VerifyRow, String, f64)> {
+    ///
+    /// Pairs whose worst metric is one of `failing` (the figures that fail
+    /// the verdict) come first: they are where a reader looks.
+    pub fn worst(&self, n: usize, failing: &[&str]) -> Vec<(VerifyRow, String, f64)> {
         let mut scored: Vec<(VerifyRow, String, f64)> = self
             .rows
             .iter()
             .filter_map(|r| {
                 let candidates = [
-                    ("push_error", r.push_error),
+                    ("push_error_decided", r.push_error.filter(|_| !r.push_blind)),
                     ("first_contact_error_decided", r.first_contact_error_decided),
                     ("miss_distance_decided", r.miss_distance_decided),
                     (
@@ -640,11 +963,17 @@ impl Comparison {
                 let (name, v) = candidates
                     .into_iter()
                     .filter_map(|(m, v)| v.map(|v| (m, v.abs())))
-                    .max_by(|a, b| a.1.total_cmp(&b.1))?;
+                    .max_by(|a, b| {
+                        failing
+                            .contains(&a.0)
+                            .cmp(&failing.contains(&b.0))
+                            .then(a.1.total_cmp(&b.1))
+                    })?;
                 Some((r.clone(), name.to_string(), v))
             })
             .collect();
-        scored.sort_by(|a, b| b.2.total_cmp(&a.2));
+        let fails = |m: &str| failing.contains(&m);
+        scored.sort_by(|a, b| fails(&b.1).cmp(&fails(&a.1)).then(b.2.total_cmp(&a.2)));
         scored.truncate(n);
         scored
     }

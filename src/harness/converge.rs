@@ -214,6 +214,7 @@ impl<'a> Ladder<'a> {
                 knee: setup.knee,
                 rule: setup.rule,
                 tie_band_per_mm,
+                blind_depth: setup.blind_depth,
             },
         })
     }
@@ -290,6 +291,7 @@ impl<'a> Ladder<'a> {
         let seconds = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let pairs = pair_results(
+            self.triangles,
             &grid,
             &footprints,
             &self.starts,

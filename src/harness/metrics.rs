@@ -4,20 +4,27 @@
 use kneeform_oracle::{ContactPoint, LevelCurve, StartStatus, StartTrace};
 use serde::{Deserialize, Serialize};
 
+use super::causes::Cells;
 use super::trace::GridTrace;
 
-/// The metric names, as the columns of `verify.csv` and the keys of
-/// `verify.json`: each over all strikes, then over the decided strikes
-/// (see [`TieBand`]), then the area distances: both directions at once,
-/// then each on its own (`area_miss_distance`, from the exact strikes to
-/// the grid's: what the grid misses; `area_false_alarm_distance`, from the
-/// grid's to the exact ones: what it strikes more).
-pub const METRICS: [&str; 15] = [
+/// The metric names, as the rows of `converge.csv` and the keys of
+/// `verify.json`: each over all strikes; over the *decided* strikes (see
+/// [`TieBand`]) not downstream of a flagged blind spot (`_decided`); over
+/// the disagreements downstream of one (`_blind`, SPEC's "Blind spots");
+/// the area distances, both directions at once, then each on its own
+/// (`area_miss_distance`, from the exact strikes to the grid's: what the
+/// grid misses; `area_false_alarm_distance`, from the grid's to the exact
+/// ones: what it strikes more); and the grid's level error at its strikes
+/// (`level_error_clearance`: how far a struck node lies from touching the
+/// exact knee-form; `level_error_bound`: the stated bound of the grid's
+/// level error there, see [`compare`]).
+pub const METRICS: [&str; 26] = [
     "push_error",
     "first_contact_error",
     "miss_distance",
     "false_alarm_distance",
     "unmatched_deflection",
+    "push_error_decided",
     "first_contact_error_decided",
     "miss_distance_decided",
     "false_alarm_distance_decided",
@@ -28,13 +35,24 @@ pub const METRICS: [&str; 15] = [
     "area_miss_distance_decided",
     "area_false_alarm_distance",
     "area_false_alarm_distance_decided",
+    "push_error_blind",
+    "first_contact_error_blind",
+    "miss_distance_blind",
+    "false_alarm_distance_blind",
+    "unmatched_deflection_blind",
+    "area_distance_blind",
+    "area_miss_distance_blind",
+    "area_false_alarm_distance_blind",
+    "level_error_clearance",
+    "level_error_bound",
 ];
 
 /// The metrics a user's guarantee is made of (and `verify` passes or fails
-/// on): the push error, the decided strike metrics and the decided area
-/// distance. The others are shown beside them, never hidden.
+/// on): the push error and the decided strike metrics, away from blind
+/// spots, and the decided area distance. The others are shown beside them,
+/// never hidden.
 pub const DECIDED_METRICS: [&str; 6] = [
-    "push_error",
+    "push_error_decided",
     "first_contact_error_decided",
     "miss_distance_decided",
     "false_alarm_distance_decided",
@@ -170,17 +188,20 @@ pub enum ExactRule {
     /// node's height (a point of the surface: exact) and the grid's level
     /// `W` back, which follows the surface only at the nodes met, so it
     /// lies *above* the exact level (SPEC: "the grid's level is too deep"),
-    /// by up to the exact level's fall over the pitch before that travel
-    /// (before a pitch of travel, its push error, bounded the same way by
-    /// the fall over the first pitch). The grid's drop is therefore at
+    /// by up to the stated bound of the grid's level error there
+    /// ([`LevelErrorBound`]: the exact level's fall over the pitch before
+    /// that travel plus the rise of the surface within `sqrt 2` pitches of
+    /// the exact contacts; before any travel, the push error, bounded by
+    /// the rise at the push contact). The grid's drop is therefore at
     /// least the exact one, up to the travel between the contact and its
     /// node: a grid can strike where the exact knee-form does not (a false
     /// alarm, on the safe side), not the other way round. So the band is
     /// one-sided, as SPEC's "level error" paragraph says: a contact is a
     /// decided strike when its drop exceeds `sigma W` by more than the
     /// drop's stated error, a decided non-strike when it falls short by
-    /// more than that error plus twice the grid's level error there (SPEC,
-    /// "Ties at the threshold"). The band shrinks with the pitch.
+    /// more than that error plus the bound of the grid's level error `W`
+    /// back (SPEC, "Ties at the threshold"). The band shrinks with the
+    /// pitch.
     Window {
         /// `W` (mm).
         window: f64,
@@ -216,12 +237,27 @@ pub struct ExactStrike {
     pub decision: Decision,
 }
 
-/// The exact contacts of a placed start with their standing by `rule`;
-/// empty for a start that is not placed or failed.
-pub fn classify(exact: &StartTrace, band: &TieBand, rule: ExactRule) -> Vec<ExactStrike> {
-    let Some(curve) = LevelCurve::of(exact) else {
-        return Vec::new();
-    };
+/// The exact contacts of a placed start with their standing by `rule` on
+/// the grid of `cells`; empty for a start that is not placed or failed.
+pub fn classify(
+    exact: &StartTrace,
+    band: &TieBand,
+    rule: ExactRule,
+    cells: &Cells,
+) -> Vec<ExactStrike> {
+    match LevelErrorBound::of(exact, cells) {
+        Some(bound) => classify_with(exact, band, rule, &bound),
+        None => Vec::new(),
+    }
+}
+
+fn classify_with(
+    exact: &StartTrace,
+    band: &TieBand,
+    rule: ExactRule,
+    bound: &LevelErrorBound,
+) -> Vec<ExactStrike> {
+    let curve = &bound.curve;
     exact
         .contacts
         .iter()
@@ -232,10 +268,9 @@ pub fn classify(exact: &StartTrace, band: &TieBand, rule: ExactRule) -> Vec<Exac
                 strike: c.rate > band.sigma,
                 decision: band.decide(c.rate, c.rate_error),
             },
-            ExactRule::Window { window, pitch } => {
+            ExactRule::Window { window, .. } => {
                 let drop = curve.drop_at(k, window, JUMP_TOLERANCE);
-                let back = (c.travel - window).max(pitch);
-                let grid = 2.0 * (curve.at(back - pitch).value - curve.at(back).value);
+                let grid = bound.at(c.travel - window);
                 let threshold = band.sigma * window;
                 ExactStrike {
                     contact: c,
@@ -255,38 +290,78 @@ pub fn classify(exact: &StartTrace, band: &TieBand, rule: ExactRule) -> Vec<Exac
 
 /// One start at one angle, grid against exact. Distances are in xz, the
 /// grid's domain (SPEC, "What the harness measures").
+///
+/// A disagreement is *blind* when the exact knee-form touched a flagged
+/// blind spot ([`Cells::touches_blind_spot`]) at or before its travel in
+/// this slide; the `_decided` figures leave blind ones out and the
+/// `_blind` figures hold them.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct StartComparison {
     /// `yr - yr*` (mm), when both are placed.
     pub push_error: Option<f64>,
+    /// Whether the exact push contact lies on a flagged blind spot (the
+    /// push error is then blind).
+    pub push_blind: bool,
+    /// Whether the push error lies within the grid's level error at the
+    /// push: at most the depth the exact push contact's cell hides between
+    /// its sampled corners.
+    pub push_explained: bool,
     /// Grid travel to the first strike minus the exact travel to the first
     /// strike (mm), when both have one.
     pub first_contact_error: Option<f64>,
-    /// The same where the exact first possible strike (not gentler than the
-    /// band) is a decided one.
+    /// The same against the interval from the first possible exact strike
+    /// to the first decided one (under x-slope: where the first possible
+    /// one is decided), when the disagreement is not blind.
     pub first_contact_error_decided: Option<f64>,
+    /// The same, when the disagreement is blind.
+    pub first_contact_error_blind: Option<f64>,
+    /// Whether a grid first strike earlier than the exact interval is
+    /// explained by the level error.
+    pub first_contact_explained: bool,
     /// For each exact strike, the xz distance to the nearest grid strike of
     /// the same start (mm); `+inf` where the grid has none.
     pub miss: Vec<f64>,
-    /// The same for each decided exact strike.
+    /// The same for each decided exact strike not downstream of a blind
+    /// spot.
     pub miss_decided: Vec<f64>,
+    /// The same for each decided exact strike downstream of one.
+    pub miss_blind: Vec<f64>,
     /// For each grid strike, the xz distance to the nearest exact strike or
     /// to the exact push contact (mm); `+inf` where there is neither.
     pub false_alarm: Vec<f64>,
-    /// For each grid strike, the xz distance to the nearest exact contact
-    /// that is not a decided non-strike, or to the exact push contact.
+    /// For each grid strike not downstream of a blind spot, the xz
+    /// distance to the nearest exact contact that is not a decided
+    /// non-strike, or to the exact push contact.
     pub false_alarm_decided: Vec<f64>,
+    /// Whether each of those is explained by the grid's level error.
+    pub false_alarm_explained: Vec<bool>,
+    /// The same distance for each grid strike downstream of a blind spot.
+    pub false_alarm_blind: Vec<f64>,
     /// For each exact strike met when the grid strikes nothing in this
     /// start: how far the exact knee-form had been deflected below the
     /// grid's level by then, `yr - f` (mm). The grid slid on at `yr`, so
     /// this is the part of the true path it missed.
     pub unmatched_deflection: Vec<f64>,
-    /// The same for decided exact strikes.
+    /// The same for decided exact strikes not downstream of a blind spot.
     pub unmatched_deflection_decided: Vec<f64>,
+    /// The same for decided exact strikes downstream of one.
+    pub unmatched_deflection_blind: Vec<f64>,
+    /// For each grid strike not downstream of a blind spot: how far its
+    /// node lies from touching the exact knee-form at its travel,
+    /// `h - f*(s)` (mm).
+    pub level_clearance: Vec<f64>,
+    /// For each of those, the stated bound of the grid's level error at
+    /// that travel (mm; see [`compare`]).
+    pub level_bound: Vec<f64>,
     /// Exact strikes (`rate > sigma`).
     pub exact_strikes: usize,
     /// Exact contacts in the tie band.
     pub undecided: usize,
+    /// Whether the exact knee-form touched a flagged blind spot in this
+    /// slide.
+    pub blind: bool,
+    /// Exact strikes at or after that touch.
+    pub blind_strikes: usize,
     /// The points compared, xz (mm).
     pub points: StartPoints,
 }
@@ -298,10 +373,20 @@ pub struct StartComparison {
 pub struct StartPoints {
     /// The grid strikes, in the order of `false_alarm`.
     pub grid: Vec<[f64; 2]>,
-    /// The exact strikes (`rate > sigma`), in the order of `miss`.
+    /// The grid strikes not downstream of a blind spot, in the order of
+    /// `false_alarm_decided`.
+    pub grid_decided: Vec<[f64; 2]>,
+    /// Those of them the level error does not explain.
+    pub grid_unexplained: Vec<[f64; 2]>,
+    /// The grid strikes downstream of a blind spot.
+    pub grid_blind: Vec<[f64; 2]>,
+    /// The exact strikes (by SPEC's rule), in the order of `miss`.
     pub strikes: Vec<[f64; 2]>,
-    /// The decided exact strikes, in the order of `miss_decided`.
+    /// The decided exact strikes not downstream of a blind spot, in the
+    /// order of `miss_decided`.
     pub decided: Vec<[f64; 2]>,
+    /// The decided exact strikes downstream of one.
+    pub blind: Vec<[f64; 2]>,
     /// The exact contacts that are not decided non-strikes.
     pub possible: Vec<[f64; 2]>,
     /// The exact push contact, when placed: a point of the exact curve for
@@ -312,11 +397,39 @@ pub struct StartPoints {
 impl StartPoints {
     /// Appends `other`'s points to these.
     pub fn extend(&mut self, other: &StartPoints) {
-        self.grid.extend(&other.grid);
-        self.strikes.extend(&other.strikes);
-        self.decided.extend(&other.decided);
-        self.possible.extend(&other.possible);
-        self.push.extend(&other.push);
+        for (to, from) in self.sets_mut().into_iter().zip(other.sets()) {
+            to.extend(from);
+        }
+    }
+
+    /// Every set, in a fixed order (what a shard's file holds).
+    pub fn sets(&self) -> [&Vec<[f64; 2]>; 9] {
+        [
+            &self.grid,
+            &self.grid_decided,
+            &self.grid_unexplained,
+            &self.grid_blind,
+            &self.strikes,
+            &self.decided,
+            &self.blind,
+            &self.possible,
+            &self.push,
+        ]
+    }
+
+    /// Every set, mutable, in the order of [`StartPoints::sets`].
+    pub fn sets_mut(&mut self) -> [&mut Vec<[f64; 2]>; 9] {
+        [
+            &mut self.grid,
+            &mut self.grid_decided,
+            &mut self.grid_unexplained,
+            &mut self.grid_blind,
+            &mut self.strikes,
+            &mut self.decided,
+            &mut self.blind,
+            &mut self.possible,
+            &mut self.push,
+        ]
     }
 
     /// `exact`'s points with the push contacts: what a grid strike's false
@@ -330,13 +443,19 @@ impl StartComparison {
     /// Where the worst decided disagreement of this start lies (xz, mm)
     /// and how large it is: the decided exact strike furthest from the
     /// grid's strikes or the grid strike furthest from every possible exact
-    /// one, whichever is further (infinite distances first).
+    /// one, whichever is further (infinite distances first), away from
+    /// blind spots.
     pub fn worst_decided_point(&self) -> Option<([f64; 2], f64)> {
         self.points
             .decided
             .iter()
             .zip(&self.miss_decided)
-            .chain(self.points.grid.iter().zip(&self.false_alarm_decided))
+            .chain(
+                self.points
+                    .grid_decided
+                    .iter()
+                    .zip(&self.false_alarm_decided),
+            )
             .map(|(&p, &d)| (p, d))
             .max_by(|a, b| a.1.total_cmp(&b.1))
     }
@@ -352,16 +471,121 @@ fn nearest(p: [f64; 2], set: &[[f64; 2]]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The stated bound of the grid's level error along one exact trace: how
+/// much deeper than the exact knee-form's level `f*(s)` the grid's level
+/// may lie at travel `s` (mm).
+///
+/// **The bound.** The grid's level follows the exact one at the nodes it
+/// meets. Where the exact knee-form touches the mesh at `w`, the grid has
+/// a node under the knee-form within `sqrt 2` pitches of `w`, at most
+/// [`Cells::rise_near`] above it, met within about a pitch more of
+/// travel; so at travel `s` the grid's level lies at most
+/// `f*(s - p) - f*(s) + rise` deeper than the exact one: the exact level's
+/// fall over the pitch before `s` (`yr*` for travel below 0) plus the
+/// largest rise of the exact contacts in force over that pitch (the push
+/// contact's before the first contact: the push error is bounded the same
+/// way). Both terms shrink with the pitch.
+///
+/// It serves twice: a node poking through the grid's level by no more than
+/// the bound is a contact the exact knee-form need not make (a false alarm
+/// on the safe side, SPEC's "What the window does not fix"), and the grid's
+/// window drop may exceed the exact one by up to the bound at `s - W` (the
+/// tie band's grid term, [`ExactRule::Window`]).
+pub struct LevelErrorBound<'a> {
+    curve: LevelCurve<'a>,
+    travels: Vec<f64>,
+    rises: Vec<f64>,
+    push_rise: f64,
+    pitch: f64,
+}
+
+impl<'a> LevelErrorBound<'a> {
+    /// The bound along `exact` on the grid of `cells`; `None` for a start
+    /// that is not placed or failed.
+    pub fn of(exact: &'a StartTrace, cells: &Cells) -> Option<LevelErrorBound<'a>> {
+        let curve = LevelCurve::of(exact)?;
+        Some(LevelErrorBound {
+            curve,
+            travels: exact.contacts.iter().map(|c| c.travel).collect(),
+            rises: exact
+                .contacts
+                .iter()
+                .map(|c| cells.rise_near(c.witness))
+                .collect(),
+            push_rise: exact.push_witness.map_or(0.0, |w| cells.rise_near(w)),
+            pitch: cells.pitch(),
+        })
+    }
+
+    /// The rise of the exact push contact (mm).
+    pub fn push_rise(&self) -> f64 {
+        self.push_rise
+    }
+
+    /// The largest rise of the exact contacts in force over the pitch of
+    /// travel before `s` (mm).
+    fn rise_in_force(&self, s: f64) -> f64 {
+        // The contact in force at travel t: the last one at or before t.
+        let in_force = |t: f64| self.travels.partition_point(|&c| c <= t + LEVEL_TOL);
+        let (from, to) = (in_force(s - self.pitch), in_force(s));
+        let before = if from == 0 {
+            self.push_rise
+        } else {
+            self.rises[from - 1]
+        };
+        self.rises[from..to].iter().fold(before, |m, &r| m.max(r))
+    }
+
+    /// The bound at travel `s` (mm).
+    pub fn at(&self, s: f64) -> f64 {
+        let fall = self.curve.at(s - self.pitch).value - self.curve.at(s).value;
+        fall.max(0.0) + self.rise_in_force(s)
+    }
+
+    /// Whether a grid strike of a node of height `h` met at travel `s` may
+    /// owe its deflection test to the level error: under the window rule,
+    /// whether the drop from the exact level `W` back, raised by the bound
+    /// there, exceeds `sigma W` (the grid's level `W` back is at most that
+    /// much deeper). Under x-slope the grid's rate is no level's
+    /// difference: the level error explains no strike there.
+    fn explains_drop(&self, h: f64, s: f64, sigma: f64, rule: ExactRule) -> bool {
+        match rule {
+            ExactRule::Rate => false,
+            ExactRule::Window { window, .. } => {
+                let back = s - window;
+                self.curve.at(back).value - h + self.at(back) > sigma * window - LEVEL_TOL
+            }
+        }
+    }
+
+    /// How far a mesh point of height `h` met at travel `s` lies from
+    /// touching the exact knee-form, `h - f*(s)` (mm).
+    pub fn clearance(&self, h: f64, s: f64) -> f64 {
+        h - self.curve.at(s).value
+    }
+}
+
+/// A clearance within its bound, up to rounding (mm).
+const LEVEL_TOL: f64 = 1e-6;
+
 /// Compares a grid trace with the exact trace of the same start and angle.
 ///
 /// **Strikes on both sides.** The grid's strikes are SPEC's (rule 2 of the
-/// slide); the exact strikes are the contacts whose traced deflection rate
-/// exceeds `sigma` ([`classify`]). Over *all* strikes, a miss is an exact
-/// strike far from every grid strike, a false alarm a grid strike far from
-/// every exact strike. Over *decided* strikes, misses are counted only from
-/// exact contacts steeper than the tie band, and a grid strike is a false
-/// alarm only when it is far from every exact contact that is not gentler
-/// than the band: near the threshold either answer is right.
+/// slide); the exact strikes are the contacts [`classify`] finds striking.
+/// Over *all* strikes, a miss is an exact strike far from every grid
+/// strike, a false alarm a grid strike far from every exact strike. Over
+/// *decided* strikes, misses are counted only from exact contacts beyond
+/// the tie band, and a grid strike is a false alarm only when it is far
+/// from every exact contact that is not a decided non-strike: near the
+/// threshold either answer is right.
+///
+/// **Blind.** From the first exact contact (the push contact included) on
+/// a flagged blind spot of `cells` on, the exact strikes and the grid
+/// strikes of this slide are blind: reported apart from the decided ones.
+///
+/// **Level error.** Each grid strike not blind is checked against the
+/// exact level curve: its node's clearance `h - f*(s)` against
+/// [`level_bound`]'s bound. A false alarm within it is the level error's.
 ///
 /// The exact push contact counts as a point of the exact curve for false
 /// alarms: where the grid's push level is above the exact one (its nodes
@@ -373,15 +597,59 @@ pub fn compare(
     exact: &StartTrace,
     band: &TieBand,
     rule: ExactRule,
+    cells: &Cells,
 ) -> StartComparison {
     let placed = exact.status == StartStatus::Placed;
-    let classified = classify(exact, band, rule);
-    let push: Vec<[f64; 2]> = exact
-        .push_witness
-        .filter(|_| placed)
-        .map(xz)
-        .into_iter()
-        .collect();
+    let bound = LevelErrorBound::of(exact, cells);
+    let classified = match &bound {
+        Some(bound) => classify_with(exact, band, rule, bound),
+        None => Vec::new(),
+    };
+    let push_witness = exact.push_witness.filter(|_| placed);
+    let push: Vec<[f64; 2]> = push_witness.map(xz).into_iter().collect();
+    // Where the exact knee-form first touches a flagged blind spot.
+    let push_blind = push_witness.is_some_and(|w| cells.touches_blind_spot(w));
+    let blind_from: Option<f64> = if !placed {
+        None
+    } else if push_blind {
+        Some(0.0)
+    } else {
+        exact
+            .contacts
+            .iter()
+            .find(|c| cells.touches_blind_spot(c.witness))
+            .map(|c| c.travel)
+    };
+    let is_blind = |s: f64| blind_from.is_some_and(|b| s >= b - LEVEL_TOL);
+    // Each grid strike: blind, or its clearance against the bound.
+    let mut grid_blind = Vec::new();
+    let mut grid_decided = Vec::new();
+    let mut grid_unexplained = Vec::new();
+    let mut explained_flags = Vec::new();
+    let mut level_clearance = Vec::new();
+    let mut level_bound = Vec::new();
+    let mut first_grid_explained = false;
+    for (k, g) in grid.colliding.iter().enumerate() {
+        let p = xz(g.point);
+        if is_blind(g.travel) {
+            grid_blind.push(p);
+            continue;
+        }
+        let explained = bound.as_ref().is_some_and(|b| {
+            let (clearance, at) = (b.clearance(g.point[1], g.travel), b.at(g.travel));
+            level_clearance.push(clearance);
+            level_bound.push(at);
+            clearance <= at + LEVEL_TOL && b.explains_drop(g.point[1], g.travel, band.sigma, rule)
+        });
+        if k == 0 {
+            first_grid_explained = explained;
+        }
+        grid_decided.push(p);
+        explained_flags.push(explained);
+        if !explained {
+            grid_unexplained.push(p);
+        }
+    }
     let points = |keep: &dyn Fn(&ExactStrike) -> bool| -> Vec<[f64; 2]> {
         classified
             .iter()
@@ -389,10 +657,15 @@ pub fn compare(
             .map(|c| xz(c.contact.witness))
             .collect()
     };
+    let decided_strike = |c: &ExactStrike| c.decision == Decision::Strike;
     let pts = StartPoints {
         grid: grid.colliding.iter().map(|c| xz(c.point)).collect(),
+        grid_decided,
+        grid_unexplained,
+        grid_blind,
         strikes: points(&|c| c.strike),
-        decided: points(&|c| c.decision == Decision::Strike),
+        decided: points(&|c| decided_strike(c) && !is_blind(c.contact.travel)),
+        blind: points(&|c| decided_strike(c) && is_blind(c.contact.travel)),
         possible: points(&|c| c.decision != Decision::NoStrike),
         push,
     };
@@ -414,18 +687,13 @@ pub fn compare(
     let first_possible = classified.iter().find(|c| c.decision != Decision::NoStrike);
     let first_decided = classified.iter().find(|c| c.decision == Decision::Strike);
     let grid_first = grid.colliding.first().filter(|_| placed);
-    StartComparison {
-        push_error: match (grid.yr.is_finite(), exact.yr_star) {
-            (true, Some(star)) if placed => Some(grid.yr - star),
-            _ => None,
-        },
-        first_contact_error: match (grid_first, first_strike) {
-            (Some(g), Some(e)) => Some(g.travel - e.contact.travel),
-            _ => None,
-        },
-        first_contact_error_decided: match (rule, grid_first, first_possible, first_decided) {
+    // The decided first-contact error, and the travel where that
+    // disagreement begins (blind when the exact knee-form touched a blind
+    // spot by then).
+    let first_decided_error: Option<(f64, f64)> =
+        match (rule, grid_first, first_possible, first_decided) {
             (ExactRule::Rate, Some(g), Some(e), _) if e.decision == Decision::Strike => {
-                Some(g.travel - e.contact.travel)
+                Some((g.travel - e.contact.travel, g.travel.min(e.contact.travel)))
             }
             // Under the window the exact drop rises from 0 at every
             // landing, so the first exact strike sits on the threshold:
@@ -435,39 +703,70 @@ pub fn compare(
             (ExactRule::Window { .. }, Some(g), Some(lo), Some(hi)) => {
                 let (lo, hi) = (lo.contact.travel, hi.contact.travel);
                 Some(if g.travel < lo {
-                    g.travel - lo
+                    (g.travel - lo, g.travel)
                 } else if g.travel > hi {
-                    g.travel - hi
+                    (g.travel - hi, hi)
                 } else {
-                    0.0
+                    (0.0, f64::NEG_INFINITY)
                 })
             }
             _ => None,
+        };
+    let first_blind = first_decided_error.is_some_and(|(_, at)| is_blind(at));
+    let first_of = |blind: bool| {
+        first_decided_error
+            .filter(|_| first_blind == blind)
+            .map(|(e, _)| e)
+    };
+    let miss_of =
+        |set: &[[f64; 2]]| -> Vec<f64> { set.iter().map(|&e| nearest(e, grid_points)).collect() };
+    let false_alarm_of = |set: &[[f64; 2]], to: &[[f64; 2]]| -> Vec<f64> {
+        set.iter().map(|&g| nearest(g, to)).collect()
+    };
+    StartComparison {
+        push_error: match (grid.yr.is_finite(), exact.yr_star) {
+            (true, Some(star)) if placed => Some(grid.yr - star),
+            _ => None,
         },
-        miss: pts
-            .strikes
-            .iter()
-            .map(|&e| nearest(e, grid_points))
-            .collect(),
-        miss_decided: pts
-            .decided
-            .iter()
-            .map(|&e| nearest(e, grid_points))
-            .collect(),
-        false_alarm: grid_points
-            .iter()
-            .map(|&g| nearest(g, &strikes_or_push))
-            .collect(),
-        false_alarm_decided: grid_points
-            .iter()
-            .map(|&g| nearest(g, &possible_or_push))
-            .collect(),
+        push_blind,
+        push_explained: match (grid.yr.is_finite(), exact.yr_star) {
+            (true, Some(star)) if placed => bound.as_ref().is_some_and(|b| {
+                (-LEVEL_TOL..=b.push_rise() + LEVEL_TOL).contains(&(grid.yr - star))
+            }),
+            _ => false,
+        },
+        first_contact_error: match (grid_first, first_strike) {
+            (Some(g), Some(e)) => Some(g.travel - e.contact.travel),
+            _ => None,
+        },
+        first_contact_error_decided: first_of(false),
+        first_contact_error_blind: first_of(true),
+        first_contact_explained: first_grid_explained,
+        miss: miss_of(&pts.strikes),
+        miss_decided: miss_of(&pts.decided),
+        miss_blind: miss_of(&pts.blind),
+        false_alarm: false_alarm_of(grid_points, &strikes_or_push),
+        false_alarm_decided: false_alarm_of(&pts.grid_decided, &possible_or_push),
+        false_alarm_explained: explained_flags,
+        false_alarm_blind: false_alarm_of(&pts.grid_blind, &possible_or_push),
         unmatched_deflection: deflection(&|c| c.strike),
-        unmatched_deflection_decided: deflection(&|c| c.decision == Decision::Strike),
+        unmatched_deflection_decided: deflection(&|c| {
+            decided_strike(c) && !is_blind(c.contact.travel)
+        }),
+        unmatched_deflection_blind: deflection(&|c| {
+            decided_strike(c) && is_blind(c.contact.travel)
+        }),
+        level_clearance,
+        level_bound,
         exact_strikes: pts.strikes.len(),
         undecided: classified
             .iter()
             .filter(|c| c.decision == Decision::Undecided)
+            .count(),
+        blind: blind_from.is_some(),
+        blind_strikes: classified
+            .iter()
+            .filter(|c| c.strike && is_blind(c.contact.travel))
             .count(),
         points: pts,
     }

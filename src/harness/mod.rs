@@ -11,6 +11,8 @@
 //!   comparison;
 //! * [`trace`]: the grid's push and slide of one start, with the travel of
 //!   each colliding node;
+//! * [`causes`]: why a figure fails (blind spots touched, the grid's
+//!   level error, undecided contacts, oracle failures);
 //! * [`metrics`]: push, first-contact, miss and false-alarm errors, the
 //!   tie band, the area distance;
 //! * [`nearest`]: a 2-d tree for the area distance's nearest points;
@@ -25,6 +27,7 @@
 //! SPEC, tested equal to the engine's masks on every start.
 
 pub mod auto;
+pub mod causes;
 pub mod compare;
 pub mod converge;
 pub mod direct;

@@ -94,7 +94,7 @@ pub struct PitchPart {
 #[serde(tag = "kind", content = "summary", rename_all = "lowercase")]
 pub enum StudySummary {
     /// A verification's.
-    Verify(VerifySummary),
+    Verify(Box<VerifySummary>),
     /// A convergence study's.
     Converge(ConvergeSummary),
     /// A direct verification's (`verify --approach direct`).
@@ -203,7 +203,15 @@ pub fn verify_shard(
         oracle_s,
     } = Traced::new(input, setup, options, Some(shard), progress)?;
     let t = Instant::now();
-    let pairs = pair_results(&grid, &footprints, &starts, &traces, &compare, None)?;
+    let pairs = pair_results(
+        &input.part.triangles,
+        &grid,
+        &footprints,
+        &starts,
+        &traces,
+        &compare,
+        None,
+    )?;
     let grid_s = t.elapsed().as_secs_f64();
     let band = TieBand::new(setup.rule.sigma, spec.pitch, options.tie_band_per_mm);
     // The study's identity and settings; its statistics are the merge's
@@ -230,7 +238,7 @@ pub fn verify_shard(
             Some(options.tolerance),
             vec![setup.pitch],
         ),
-        summary: StudySummary::Verify(summary),
+        summary: StudySummary::Verify(Box::new(summary)),
         sample_s,
         oracle_s,
     })
@@ -384,7 +392,7 @@ pub fn merge_verify(parts: &[StudyPart]) -> Option<Verification> {
         return None;
     };
     let result = merged_pitch(parts, 0)?;
-    let mut summary = summary.clone();
+    let mut summary = VerifySummary::clone(summary);
     summary.set_comparison(&result.comparison, &first.spec);
     let t = &mut summary.timings;
     t.sample_s = parts.iter().map(|p| p.sample_s).fold(0.0, f64::max);

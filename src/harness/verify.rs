@@ -99,7 +99,7 @@ pub fn oracle_options(knee: &KneeForm, pitch: f64, x_min: f64) -> OracleOptions 
 pub fn tie_band_rule(per_mm: f64, window_mm: Option<f64>) -> String {
     match window_mm {
         Some(w) => format!(
-            "an exact contact is a decided strike when its drop over the last {w} mm exceeds sigma x {w} mm by more than its stated error, a decided non-strike when it falls short by more than its error plus twice the exact level's fall over the pitch before the travel {w} mm back (the grid's level error there, which only ever adds strikes), undecided otherwise"
+            "an exact contact is a decided strike when its drop over the last {w} mm exceeds sigma x {w} mm by more than its stated error, a decided non-strike when it falls short by more than its error plus the bound of the grid's level error {w} mm back (the exact level's fall over the pitch before that travel plus the rise of the surface within sqrt 2 pitches of the exact contacts in force: the grid's level is deeper by at most that, which only ever adds strikes), undecided otherwise; a grid strike whose node lies within that bound of touching the exact knee-form, and whose drop the bound can explain, is the level error's (a false alarm on the safe side); disagreements from the exact knee-form's first touch of a flagged blind spot on are blind"
         ),
         None => format!(
             "an exact contact is undecided when its deflection rate, widened by its rate_error, overlaps [sigma / (1 + m), sigma * (1 + m)] with m = {per_mm} x pitch (mm)"
@@ -182,7 +182,15 @@ pub(crate) fn verify_with(
         oracle_s,
         ..
     } = &traced;
-    let comparison = compare_grid_with(grid, footprints, starts, traces, compare, fault)?;
+    let comparison = compare_grid_with(
+        &input.part.triangles,
+        grid,
+        footprints,
+        starts,
+        traces,
+        compare,
+        fault,
+    )?;
     let summary = VerifySummary::new(
         input,
         setup,
@@ -253,6 +261,7 @@ impl Traced {
                 knee: setup.knee,
                 rule: setup.rule,
                 tie_band_per_mm: options.tie_band_per_mm,
+                blind_depth: setup.blind_depth,
             },
             sample_s,
             oracle_s,
@@ -281,6 +290,9 @@ impl VerifySummary {
             pitch_mm: setup.pitch,
             tolerance_mm: options.tolerance,
             pass: false,
+            verdict: String::new(),
+            failures: Vec::new(),
+            unexplained: Default::default(),
             angles_deg: setup.angles.clone(),
             knee_form_mm: [
                 setup.knee.triangle_side,
@@ -319,6 +331,9 @@ impl VerifySummary {
     /// A merge of shards sets them from the merged comparison this way.
     pub fn set_comparison(&mut self, comparison: &Comparison, spec: &GridSpec) {
         self.pass = comparison.passes(self.tolerance_mm);
+        self.verdict = comparison.verdict(self.tolerance_mm);
+        self.failures = comparison.failures(self.tolerance_mm);
+        self.unexplained = comparison.unexplained;
         self.tie_band = comparison.band;
         self.area_distance_decided_mm =
             Some(comparison.stat("area_distance_decided").max).filter(|_| {
@@ -338,7 +353,15 @@ impl VerifySummary {
         self.area_iou = comparison.area_iou;
         self.counts = comparison.counts;
         self.worst_starts = comparison
-            .worst(10)
+            .worst(
+                10,
+                &self
+                    .failures
+                    .iter()
+                    .filter(|f| f.fails_verdict)
+                    .map(|f| f.metric.as_str())
+                    .collect::<Vec<&str>>(),
+            )
             .into_iter()
             .map(|(row, metric, value)| WorstStart {
                 i: row.i,
@@ -391,9 +414,23 @@ pub struct VerifySummary {
     pub pitch_mm: f64,
     /// The tolerance every metric's max is held to (mm).
     pub tolerance_mm: f64,
-    /// Whether every decided metric is within tolerance, with nothing
-    /// contradictory or failed (undecided strikes never fail).
+    /// Whether no failing figure fails the verdict: every decided figure
+    /// away from blind spots within tolerance or explained by the grid's
+    /// level error, no oracle failure, nothing contradictory (undecided
+    /// and blind disagreements are reported in `failures`, never failing).
     pub pass: bool,
+    /// The verdict in words: misses (safety) and false alarms (cost)
+    /// apart, each failing figure with its mechanism.
+    #[serde(default)]
+    pub verdict: String,
+    /// Every figure beyond the tolerance: `metric`, `value`, `mechanism`
+    /// (`blind`, `level-error`, `undecided`, `oracle-failure` or
+    /// `unexplained`), `side` and whether it fails the verdict.
+    #[serde(default)]
+    pub failures: Vec<crate::harness::causes::Failure>,
+    /// The figures the level error can explain, over what it does not.
+    #[serde(default)]
+    pub unexplained: crate::harness::compare::Unexplained,
     /// Angles (degrees).
     pub angles_deg: Vec<f64>,
     /// Knee-form L, R, W (mm).

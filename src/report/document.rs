@@ -778,6 +778,13 @@ fn verify_block(k: usize, json: &Value, verdict: Verdict) -> Markup {
             (c("/pass")) ")"
         }
         "\n"
+        @if json.get("verdict").is_some_and(|v| v.as_str().is_some_and(|v| !v.is_empty())) {
+            p class="headline" {
+                "Misses (safety) and false alarms (cost) apart, each figure beyond the tolerance with its mechanism (blind: downstream of a flagged blind spot; level-error: the grid's level error, on the safe side; undecided; oracle-failure; unexplained): "
+                (c("/verdict"))
+            }
+            "\n"
+        }
         @if decided {
             p class="headline" {
                 "Area distance (decided strikes: the grid's colliding area against the exact one, both ways, in xz): "

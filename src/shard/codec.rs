@@ -66,27 +66,46 @@ pub(super) fn put_pair(out: &mut Vec<u8>, pair: &PairResult) {
         c.push_error,
         c.first_contact_error,
         c.first_contact_error_decided,
+        c.first_contact_error_blind,
     ] {
         put_opt(out, v);
     }
+    out.push(flags(c));
     for v in [
         &c.miss,
         &c.miss_decided,
+        &c.miss_blind,
         &c.false_alarm,
         &c.false_alarm_decided,
+        &c.false_alarm_blind,
         &c.unmatched_deflection,
         &c.unmatched_deflection_decided,
+        &c.unmatched_deflection_blind,
+        &c.level_clearance,
+        &c.level_bound,
     ] {
         put_f64s(out, v);
     }
+    put_u64(out, c.false_alarm_explained.len() as u64);
+    out.extend(c.false_alarm_explained.iter().map(|&b| u8::from(b)));
     put_u64(out, c.exact_strikes as u64);
     put_u64(out, c.undecided as u64);
-    let p = &c.points;
-    for v in [&p.grid, &p.strikes, &p.decided, &p.possible, &p.push] {
+    put_u64(out, c.blind_strikes as u64);
+    for v in c.points.sets() {
         put_points(out, v);
     }
     put_nodes(out, &pair.grid_nodes);
     put_nodes(out, &pair.snapped);
+}
+
+/// A pair's yes-no facts, one bit each: whether its exact knee-form
+/// touched a blind spot, its push contact lies on one, its push error and
+/// its first grid strike are explained by the level error.
+fn flags(c: &StartComparison) -> u8 {
+    u8::from(c.blind)
+        | u8::from(c.push_blind) << 1
+        | u8::from(c.push_explained) << 2
+        | u8::from(c.first_contact_explained) << 3
 }
 
 /// One direct pair: its row's status, levels, contact and counts, and
@@ -181,6 +200,17 @@ impl<'a> Reader<'a> {
         Ok(some.then_some(v))
     }
 
+    pub(super) fn bools(&mut self) -> Result<Vec<bool>, String> {
+        let n = self.count(1)?;
+        (0..n)
+            .map(|_| match self.u8()? {
+                0 => Ok(false),
+                1 => Ok(true),
+                b => Err(format!("a flag {b}")),
+            })
+            .collect()
+    }
+
     pub(super) fn points(&mut self) -> Result<Vec<[f64; 2]>, String> {
         let n = self.count(16)?;
         (0..n).map(|_| Ok([self.f64()?, self.f64()?])).collect()
@@ -236,26 +266,40 @@ impl<'a> Reader<'a> {
         let (i, j) = (self.len()?, self.len()?);
         let (push_error, first_contact_error, first_contact_error_decided) =
             (self.opt()?, self.opt()?, self.opt()?);
-        let cmp = StartComparison {
+        let first_contact_error_blind = self.opt()?;
+        let flags = self.u8()?;
+        if flags >> 4 != 0 {
+            return Err(format!("pair flags {flags}"));
+        }
+        let mut cmp = StartComparison {
             push_error,
+            push_blind: flags & 2 != 0,
+            push_explained: flags & 4 != 0,
             first_contact_error,
             first_contact_error_decided,
+            first_contact_error_blind,
+            first_contact_explained: flags & 8 != 0,
             miss: self.f64s()?,
             miss_decided: self.f64s()?,
+            miss_blind: self.f64s()?,
             false_alarm: self.f64s()?,
             false_alarm_decided: self.f64s()?,
+            false_alarm_blind: self.f64s()?,
             unmatched_deflection: self.f64s()?,
             unmatched_deflection_decided: self.f64s()?,
+            unmatched_deflection_blind: self.f64s()?,
+            level_clearance: self.f64s()?,
+            level_bound: self.f64s()?,
+            false_alarm_explained: self.bools()?,
             exact_strikes: self.len()?,
             undecided: self.len()?,
-            points: StartPoints {
-                grid: self.points()?,
-                strikes: self.points()?,
-                decided: self.points()?,
-                possible: self.points()?,
-                push: self.points()?,
-            },
+            blind: flags & 1 != 0,
+            blind_strikes: self.len()?,
+            points: StartPoints::default(),
         };
+        for set in cmp.points.sets_mut() {
+            *set = self.points()?;
+        }
         Ok(PairResult {
             row: row_of(i, j, angle_deg, status, &cmp),
             cmp,
@@ -272,20 +316,36 @@ mod tests {
     pub(super) fn pair() -> PairResult {
         let cmp = StartComparison {
             push_error: Some(-0.25),
+            push_blind: true,
+            push_explained: false,
             first_contact_error: None,
             first_contact_error_decided: Some(f64::MIN_POSITIVE),
+            first_contact_error_blind: Some(-2.0),
+            first_contact_explained: true,
             miss: vec![1.5, f64::INFINITY],
             miss_decided: vec![f64::INFINITY],
-            false_alarm: vec![0.1 + 0.2],
-            false_alarm_decided: Vec::new(),
+            miss_blind: vec![0.5],
+            false_alarm: vec![0.1 + 0.2, 7.0],
+            false_alarm_decided: vec![0.3],
+            false_alarm_explained: vec![true],
+            false_alarm_blind: vec![7.0],
             unmatched_deflection: vec![3.0],
             unmatched_deflection_decided: vec![-0.0],
+            unmatched_deflection_blind: Vec::new(),
+            level_clearance: vec![0.01],
+            level_bound: vec![0.25],
             exact_strikes: 2,
             undecided: 1,
+            blind: true,
+            blind_strikes: 1,
             points: StartPoints {
-                grid: vec![[1.0, 2.0]],
+                grid: vec![[1.0, 2.0], [9.0, 9.5]],
+                grid_decided: vec![[1.0, 2.0]],
+                grid_unexplained: Vec::new(),
+                grid_blind: vec![[9.0, 9.5]],
                 strikes: vec![[3.0, 4.0], [5.0, 6.0]],
                 decided: vec![[5.0, 6.0]],
+                blind: vec![[3.0, 4.0]],
                 possible: Vec::new(),
                 push: vec![[-7.5, 8.25]],
             },

@@ -47,7 +47,8 @@ use crate::output::{OutputDir, WriteError};
 /// `shard.json` of a study's shard.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StudyRecord {
-    /// The format of the shard's files (1).
+    /// The format of the shard's files (2: pairs carry the blind and
+    /// level-error facts).
     pub format: u32,
     /// Which shard of how many.
     pub shard: Shard,
@@ -70,9 +71,9 @@ pub struct StudyRecord {
 }
 
 /// The format [`write_study_shard`] writes and [`merge_study`] reads.
-pub const FORMAT: u32 = 1;
+pub const FORMAT: u32 = 2;
 
-const MAGIC: &[u8; 16] = b"kneeform study 1";
+const MAGIC: &[u8; 16] = b"kneeform study 2";
 
 /// The largest `shard.bin` read (bytes): far beyond a study's (a few
 /// hundred bytes per start and angle), short of exhausting memory.

@@ -1,0 +1,319 @@
+//! Why the grid and the exact knee-form disagree, as SPEC names the causes
+//! ("Blind spots", "What the window does not fix: the level error"), and
+//! the failing figures of a comparison with their mechanism.
+//!
+//! * **Blind.** The exact knee-form touched a flagged blind spot (a cell
+//!   whose mesh sticks out past its sampled corners by more than the
+//!   blind-spot depth, [`crate::blind`]) at or before the disagreement, in
+//!   the same slide: the grid cannot see what deflected it.
+//! * **Level error.** The grid's level is too deep (it follows the surface
+//!   only at the nodes it met), so a node poking through it by a little is
+//!   a grid strike the exact knee-form never touches: a false alarm, on the
+//!   safe side. A grid strike is explained by it when its node lies within
+//!   the stated bound of the grid's level error of the exact knee-form at
+//!   that travel ([`super::metrics::compare`]).
+//! * **Undecided.** The disagreement is on a contact in the tie band:
+//!   either answer is right at this pitch.
+//! * **Oracle failure.** No exact answer for the pair: never counted
+//!   clear.
+//! * **Unexplained.** None of the above: a real disagreement.
+
+use serde::{Deserialize, Serialize};
+
+use crate::blind::{CellDepths, cell_depths};
+use crate::grid::{GridSpec, HeightGrid};
+use crate::mesh::Triangle;
+
+/// How far outside a cell's closed square a point may lie and still be in
+/// it (mm): witnesses on a cell's edge belong to both cells.
+const CELL_TOL: f64 = 1e-6;
+
+/// How far from a touched mesh point (in pitches, xz) the grid's nearest
+/// node under the knee-form may lie ([`Cells::rise_near`]).
+pub const RISE_REACH: f64 = std::f64::consts::SQRT_2;
+
+/// What the harness knows of a grid's cells: the depth each hides between
+/// its sampled corners, and which are flagged blind spots.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cells {
+    spec: GridSpec,
+    depths: CellDepths,
+    threshold: f64,
+    /// The grid's heights (mm), row-major.
+    heights: Vec<f64>,
+}
+
+impl Cells {
+    /// The cells of `grid` (sampled from `triangles`), blind spots being
+    /// those deeper than `threshold` mm (the analysis's `--blind-depth`).
+    pub fn of(triangles: &[Triangle], grid: &HeightGrid, threshold: f64) -> Cells {
+        Cells {
+            spec: grid.spec,
+            depths: cell_depths(triangles, grid),
+            threshold,
+            heights: grid.h.clone(),
+        }
+    }
+
+    /// The grid's pitch (mm).
+    pub fn pitch(&self) -> f64 {
+        self.spec.pitch
+    }
+
+    /// The cells whose closed square holds `(x, z)` (mm), within
+    /// [`CELL_TOL`].
+    fn around(&self, x: f64, z: f64) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let spec = self.spec;
+        let span = |v: f64, origin: f64, cells: usize| {
+            let lo = ((v - origin - CELL_TOL) / spec.pitch).floor().max(0.0);
+            let hi = ((v - origin + CELL_TOL) / spec.pitch).floor();
+            let hi = hi.min(cells as f64 - 1.0);
+            if hi < lo || !lo.is_finite() || !hi.is_finite() {
+                0..0
+            } else {
+                lo as usize..hi as usize + 1
+            }
+        };
+        let has_cells = !self.depths.cells.is_empty();
+        let (cx, cz) = if has_cells {
+            (spec.nx - 1, spec.nz - 1)
+        } else {
+            (0, 0)
+        };
+        let columns = span(x, spec.x(0), cx);
+        span(z, spec.z(0), cz).flat_map(move |j| columns.clone().map(move |i| (i, j)))
+    }
+
+    /// Whether the mesh point `p` (`[x, y, z]`, mm, analysis frame) lies in
+    /// a flagged blind spot, proud of every sampled corner of its cell: the
+    /// exact knee-form touching it touches what the grid cannot see (the
+    /// feature itself or its foot, anywhere the mesh stands out past the
+    /// grid's samples).
+    pub fn touches_blind_spot(&self, p: [f64; 3]) -> bool {
+        self.around(p[0], p[2]).any(|(i, j)| {
+            self.depths.depth(i, j) > self.threshold
+                && p[1] < self.depths.reference(i, j) - CELL_TOL
+        })
+    }
+
+    /// How much higher than the mesh point `p` (`[x, y, z]`, mm) the grid
+    /// may be wherever the knee-form touches `p`: the largest `h - y` over
+    /// the nodes within [`RISE_REACH`] pitches of `p` in xz (mm, `>= 0`).
+    ///
+    /// A knee-form touching `p` on the rim of its outline covers no corner
+    /// of `p`'s cell, perhaps, but covers a node within `sqrt 2` pitches of it
+    /// (the outline is far wider than a pitch), and that node lies at most
+    /// this much above `p`: the grid's level there is at most this much
+    /// deeper than the exact one. About the local slope times `sqrt 2` times the
+    /// pitch: it shrinks with the pitch.
+    pub fn rise_near(&self, p: [f64; 3]) -> f64 {
+        let spec = self.spec;
+        let reach = RISE_REACH * spec.pitch;
+        let index = |v: f64, origin: f64, n: usize| {
+            let lo = ((v - reach - origin) / spec.pitch).ceil().max(0.0);
+            let hi = ((v + reach - origin) / spec.pitch)
+                .floor()
+                .min(n as f64 - 1.0);
+            if hi < lo || !lo.is_finite() || !hi.is_finite() {
+                0..0
+            } else {
+                lo as usize..hi as usize + 1
+            }
+        };
+        let mut rise: f64 = 0.0;
+        for j in index(p[2], spec.z(0), spec.nz) {
+            for i in index(p[0], spec.x(0), spec.nx) {
+                let (dx, dz) = (spec.x(i) - p[0], spec.z(j) - p[2]);
+                let h = self.heights[j * spec.nx + i];
+                if dx.hypot(dz) <= reach + CELL_TOL && h.is_finite() {
+                    rise = rise.max(h - p[1]);
+                }
+            }
+        }
+        rise
+    }
+}
+
+/// Why a figure fails its tolerance.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Mechanism {
+    /// Downstream of a flagged blind spot the exact knee-form touched.
+    Blind,
+    /// The grid's level error: false alarms on the safe side, within the
+    /// stated bound.
+    LevelError,
+    /// Contacts in the tie band.
+    Undecided,
+    /// Pairs the oracle failed on.
+    OracleFailure,
+    /// A real disagreement.
+    Unexplained,
+}
+
+impl Mechanism {
+    /// The name `verify.json` writes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mechanism::Blind => "blind",
+            Mechanism::LevelError => "level-error",
+            Mechanism::Undecided => "undecided",
+            Mechanism::OracleFailure => "oracle-failure",
+            Mechanism::Unexplained => "unexplained",
+        }
+    }
+
+    /// Whether a figure failing by this mechanism fails the verdict: blind
+    /// disagreements are reported apart, the level error's false alarms
+    /// against their bound and undecided contacts beside the decided ones
+    /// (SPEC); an oracle failure or an unexplained figure fails.
+    pub fn fails_verdict(self) -> bool {
+        matches!(self, Mechanism::OracleFailure | Mechanism::Unexplained)
+    }
+}
+
+/// Which side of the guarantee a figure speaks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Side {
+    /// Exact strikes the grid misses: safety.
+    Miss,
+    /// Grid strikes with no exact one near: cost (design freedom).
+    FalseAlarm,
+    /// The push level or the travel to the first strike.
+    Level,
+    /// Pairs without an answer to compare.
+    Coverage,
+}
+
+/// One failing figure of a comparison.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Failure {
+    /// The metric (a row of `verify.csv`'s statistics) or count.
+    pub metric: String,
+    /// Its value: mm for a metric (`null` when infinite), a count for a
+    /// count.
+    pub value: Option<f64>,
+    /// Why it fails.
+    pub mechanism: Mechanism,
+    /// Which side of the guarantee it speaks for.
+    pub side: Side,
+    /// Whether it fails the verdict ([`Mechanism::fails_verdict`]).
+    pub fails_verdict: bool,
+}
+
+impl Failure {
+    /// A failing figure `metric` of `value` by `mechanism`.
+    pub fn new(metric: &str, value: f64, mechanism: Mechanism, side: Side) -> Failure {
+        Failure {
+            metric: metric.into(),
+            value: Some(value).filter(|v| v.is_finite()),
+            mechanism,
+            side,
+            fails_verdict: mechanism.fails_verdict(),
+        }
+    }
+
+    /// The figure in words, for a console line.
+    pub fn phrase(&self) -> String {
+        let value = match self.value {
+            Some(v) if self.side == Side::Coverage => format!("{v}"),
+            Some(v) => format!("{v:.3} mm"),
+            None => "infinite".into(),
+        };
+        format!("{} {value} ({})", self.metric, self.mechanism.name())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::tessellate;
+
+    /// A plane `y = slope * x` at pitch 2 mm over [0, 40] x [0, 20], with a
+    /// rib 0.4 mm wide and 3 mm proud (towards the knee, -y) along z at
+    /// x = 21 (between node columns 20 and 22).
+    fn ribbed(slope: f64) -> (Vec<Triangle>, HeightGrid) {
+        let xs = [0.0, 10.0, 20.0, 20.8, 21.0, 21.2, 22.0, 30.0, 40.0];
+        let zs = [0.0, 10.0, 20.0];
+        let y = |x: f64| {
+            let rib = if (20.8..=21.2).contains(&x) { 3.0 } else { 0.0 };
+            slope * x - rib
+        };
+        let triangles = tessellate(&xs, &zs, |i, _| y(xs[i]));
+        let spec = GridSpec {
+            pitch: 2.0,
+            i_origin: 0,
+            j_origin: 0,
+            nx: 21,
+            nz: 11,
+        };
+        let grid = HeightGrid::sample(&triangles, spec);
+        (triangles, grid)
+    }
+
+    #[test]
+    fn a_point_on_a_flagged_rib_or_its_foot_touches_a_blind_spot_and_the_plane_does_not() {
+        let (triangles, grid) = ribbed(0.0);
+        let cells = Cells::of(&triangles, &grid, 0.5);
+        assert!(cells.touches_blind_spot([21.0, -3.0, 7.0]), "the rib's top");
+        assert!(cells.touches_blind_spot([20.9, -1.0, 7.0]), "its flank");
+        assert!(
+            !cells.touches_blind_spot([21.0, -3.0, 30.0]),
+            "off the grid"
+        );
+        assert!(!cells.touches_blind_spot([15.0, 0.0, 7.0]), "the plane");
+        // In the rib's cell but on the plane at the sampled corners' height.
+        assert!(!cells.touches_blind_spot([20.2, 0.0, 7.0]));
+        // A deeper threshold flags nothing.
+        let deep = Cells::of(&triangles, &grid, 3.5);
+        assert!(!deep.touches_blind_spot([21.0, -3.0, 7.0]));
+    }
+
+    #[test]
+    fn the_rise_near_a_point_is_the_slope_times_sqrt_2_pitches_up_to_the_nodes() {
+        let (triangles, grid) = ribbed(0.25);
+        let cells = Cells::of(&triangles, &grid, 10.0);
+        // On the plane at x = 9: the highest node within 2.83 mm lies at
+        // x = 10 (x = 12 is 3 mm away), 1 mm uphill.
+        let p = [9.0, 0.25 * 9.0, 7.0];
+        let rise = cells.rise_near(p);
+        let reach = RISE_REACH * 2.0;
+        let highest_x = (0..=20)
+            .map(|i| 2.0 * f64::from(i))
+            .filter(|&x| {
+                (0..=10).any(|j| (x - 9.0).hypot(2.0 * f64::from(j) - 7.0) <= reach + 1e-9)
+            })
+            .fold(f64::NEG_INFINITY, f64::max);
+        assert_eq!(highest_x, 10.0);
+        assert!((rise - 0.25 * (highest_x - 9.0)).abs() < 1e-12, "{rise}");
+        // A point above every node near it rises by nothing.
+        assert_eq!(cells.rise_near([9.0, 100.0, 7.0]), 0.0);
+    }
+
+    #[test]
+    fn only_unexplained_figures_and_oracle_failures_fail_the_verdict() {
+        for (m, fails) in [
+            (Mechanism::Blind, false),
+            (Mechanism::LevelError, false),
+            (Mechanism::Undecided, false),
+            (Mechanism::OracleFailure, true),
+            (Mechanism::Unexplained, true),
+        ] {
+            assert_eq!(m.fails_verdict(), fails, "{m:?}");
+            let f = Failure::new("miss_distance_decided", 2.5, m, Side::Miss);
+            assert_eq!(f.fails_verdict, fails);
+            assert!(f.phrase().contains(m.name()));
+        }
+        let json = serde_json::to_string(&Failure::new(
+            "area_miss_distance_decided",
+            f64::INFINITY,
+            Mechanism::LevelError,
+            Side::FalseAlarm,
+        ))
+        .unwrap();
+        assert!(json.contains(r#""mechanism":"level-error""#), "{json}");
+        assert!(json.contains(r#""value":null"#), "{json}");
+        assert!(json.contains(r#""side":"false-alarm""#), "{json}");
+    }
+}
