@@ -109,3 +109,29 @@ fn grid_push_level_is_never_below_the_exact_one() {
     }
     assert!(compared > 50, "only {compared} placed starts compared");
 }
+
+/// A start of the bundled wave whose slide GJK's cast could not confirm
+/// (it reported no hit while the contact query on the swept knee-form
+/// reported an overlap: `verify` at 1 mm counted 2 oracle failures there):
+/// the cast is now decided by distances, and the start is traced.
+#[test]
+fn the_wave_s_unconfirmed_misses_are_decided_by_distance() {
+    let input = kneeform::mesh::read_part(
+        std::path::Path::new("scenarios/wave.toml"),
+        1.0,
+        kneeform::Side::Left,
+    )
+    .unwrap();
+    let setup = kneeform::Setup {
+        pitch: 1.0,
+        ..kneeform::Setup::default()
+    };
+    let spec = setup.grid_spec(&input.part).unwrap();
+    let options = kneeform::harness::oracle_options(&setup.knee, 1.0, spec.x(0));
+    let part = kneeform_oracle::Part::from_triangles(&input.part.triangles).unwrap();
+    let traces = evaluate(&part, &[[359.0, -30.0]], &[10.0, 20.0], &options).unwrap();
+    for t in &traces {
+        assert_eq!(t.status, StartStatus::Placed, "{t:?}");
+        assert!(t.contacts.len() > 100, "{}", t.contacts.len());
+    }
+}

@@ -70,14 +70,15 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         for row in &chosen.study {
             let mm = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
             eprintln!(
-                "kneeform: pitch study: {:>6} mm: exact area distance {} mm, change from the coarser grid {} mm, analysis about {:.1} s, {:.2} GiB{}",
+                "kneeform: pitch study: {:>6} mm: judged area distance to the exact knee-form {} mm (the level error's false alarms, safe side, shown: {} mm; change from the coarser grid, shown: {} mm), analysis about {:.1} s, {:.2} GiB{}",
                 row.pitch_mm,
                 mm(row.exact_area_distance_mm),
+                mm(row.level_error_area_mm),
                 mm(row.grid_change_mm),
                 row.predicted_s,
                 row.memory_gib,
                 if row.meets {
-                    ": meets the tolerance"
+                    ": the judged distance meets the tolerance"
                 } else {
                     ""
                 }

@@ -6,9 +6,12 @@
 //! each pitch it measures, on the study's angles (the setup's first, middle
 //! and last):
 //!
-//! * the **exact error**: the decided area distance against the exact
-//!   oracle, on a seeded sample of starts taken on the coarsest grid (so
-//!   every grid holds them), traced once;
+//! * the **exact error**: the area distance against the exact oracle, on
+//!   a seeded sample of starts taken on the coarsest grid (so every grid
+//!   holds them), traced once, as `verify` judges it: from the decided
+//!   exact strikes away from flagged blind spots to the grid's, and from
+//!   the grid strikes the grid's level error does not explain to the
+//!   exact ones (the level error's false alarms are shown beside it);
 //! * the **grid change**: the area distance between this pitch's colliding
 //!   area and the previous, coarser pitch's, over the whole part (the
 //!   sample cannot see a feature its starts do not cross; this does). It is
@@ -61,9 +64,17 @@ impl AutoPitch {
 pub struct PitchStudyRow {
     /// The pitch (mm).
     pub pitch_mm: f64,
-    /// Decided area distance against the exact oracle on the sample (mm;
-    /// `null` where one side strikes nothing).
+    /// The area distance judged against the exact oracle on the sample
+    /// (mm; `null` where one side strikes nothing): from the decided exact
+    /// strikes not downstream of a flagged blind spot to the grid's, and
+    /// from the grid's strikes the level error does not explain to the
+    /// exact ones (what `verify` fails on).
     pub exact_area_distance_mm: Option<f64>,
+    /// The false-alarm side over every decided grid strike, the level
+    /// error's included (mm; shown, not judged: the grid's level error
+    /// strikes more, on the safe side, at half order).
+    #[serde(default)]
+    pub level_error_area_mm: Option<f64>,
     /// Area distance to the previous, coarser pitch's colliding area over
     /// the whole part (mm; `null` for the first pitch or where one side
     /// strikes nothing).
@@ -169,15 +180,24 @@ pub fn choose_pitch(
         }
         let (result, masks, grid) = ladder.measure(p, progress)?;
         let (comparison, seconds) = (&result.comparison, result.seconds);
-        let decided = comparison.stat("area_distance_decided").max;
-        let finite = comparison
+        // Judged: misses from decided strikes away from blind spots, and
+        // false alarms the level error does not explain.
+        let decided = comparison
             .area
             .iter()
-            .all(|a| a.miss_decided.is_finite() && a.false_alarm_decided.is_finite());
+            .map(|a| a.miss_decided.max(a.false_alarm_unexplained))
+            .fold(0.0, f64::max);
+        let level_error = comparison
+            .area
+            .iter()
+            .map(|a| a.false_alarm_decided)
+            .fold(0.0, f64::max);
+        let finite = decided.is_finite();
         let struck = struck_points(&grid, &masks);
         let row = PitchStudyRow {
             pitch_mm: p,
             exact_area_distance_mm: finite.then_some(decided),
+            level_error_area_mm: Some(level_error).filter(|v| v.is_finite()),
             grid_change_mm: previous
                 .as_ref()
                 .and_then(|prev| area_change(prev, &struck)),
@@ -194,11 +214,12 @@ pub fn choose_pitch(
                 predicted_s: row.predicted_s,
                 study_s: started.elapsed().as_secs_f64(),
                 reason: format!(
-                    "the coarsest pitch whose decided area distance to the exact knee-form is within {} mm ({:.3} mm on {} sampled starts at angles {:?})",
+                    "the coarsest pitch whose area distance to the exact knee-form is within {} mm ({:.3} mm on {} sampled starts at angles {:?}: decided misses away from flagged blind spots, and false alarms the grid's level error does not explain; with the level error's false alarms, which strike more on the safe side, {:.3} mm; the whole-part change from the coarser pitch is shown, not judged)",
                     auto.tolerance,
                     decided,
                     ladder.starts.len(),
-                    angles
+                    angles,
+                    level_error
                 ),
             });
         }
