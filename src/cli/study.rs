@@ -54,9 +54,22 @@ pub fn print_verification(result: &Verification, out: &Path) -> ExitCode {
         );
     }
     let c = &s.counts;
+    let reasons: Vec<String> = s
+        .oracle_failures
+        .iter()
+        .map(|(why, n)| format!("{n}: {why}"))
+        .collect();
     eprintln!(
-        "{:>29}: {:.3}; {} start-angle pairs compared, {} oracle failures",
-        "area IoU", s.area_iou, c.compared, c.oracle_failed
+        "{:>29}: {:.3}; {} start-angle pairs compared, {} oracle failures{}",
+        "area IoU",
+        s.area_iou,
+        c.compared,
+        c.oracle_failed,
+        if reasons.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", reasons.join("; "))
+        }
     );
     let band = match s.window_mm {
         Some(w) => format!("drop over {w} mm within its bound of sigma x {w} mm"),
@@ -178,7 +191,19 @@ pub fn print_convergence(study: &Convergence, out: &Path) {
             r.pitch,
             study.summary.predicted_full_time_s.unwrap_or(f64::NAN)
         ),
-        (Some(t), None) => eprintln!("kneeform: no pitch tried is within {t} mm"),
+        (Some(t), None) => {
+            // Why not: the finest pitch's figures that fail the verdict.
+            let why = study.summary.verdicts.last().map_or(String::new(), |v| {
+                let failing: Vec<String> = v
+                    .failures
+                    .iter()
+                    .filter(|f| f.fails_verdict)
+                    .map(|f| f.phrase())
+                    .collect();
+                format!(": at {} mm, {}", v.pitch_mm, failing.join("; "))
+            });
+            eprintln!("kneeform: no pitch tried is within {t} mm{why}")
+        }
         _ => {}
     }
     eprintln!("kneeform: results in {}", out.display());

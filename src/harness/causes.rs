@@ -16,6 +16,11 @@
 //!   either answer is right at this pitch.
 //! * **Oracle failure.** No exact answer for the pair: never counted
 //!   clear.
+//! * **Rim.** A missed exact strike lies outside the grid's footprint at
+//!   its travel: the knee-form's outline reaches up to a pitch past the
+//!   footprint's outermost nodes, and the exact knee-form's edge touched
+//!   the part in that rim (a surface sloping up towards the knee-form's
+//!   side). It shrinks with the pitch but is a miss: it fails the verdict.
 //! * **Unexplained.** None of the above: a real disagreement.
 
 use serde::{Deserialize, Serialize};
@@ -96,6 +101,53 @@ impl Cells {
         })
     }
 
+    /// Whether a node on the part among `rows` (`(j, i_lo, i_hi)`, the
+    /// knee-form's footprint) lies within [`RISE_REACH`] pitches of `p` in
+    /// xz: whether the grid samples the part under the knee-form near the
+    /// point the exact knee-form touches.
+    pub fn samples_near(&self, p: [f64; 3], rows: &[(usize, i64, i64)]) -> bool {
+        let spec = self.spec;
+        let reach = RISE_REACH * spec.pitch + CELL_TOL;
+        rows.iter().any(|&(j, lo, hi)| {
+            let (lo, hi) = (lo.max(0), hi.min(spec.nx as i64 - 1));
+            let dz = spec.z(j) - p[2];
+            if dz.abs() > reach {
+                return false;
+            }
+            let dx = (reach * reach - dz * dz).sqrt();
+            let first = ((p[0] - dx - spec.x(0)) / spec.pitch).ceil().max(lo as f64);
+            let last = ((p[0] + dx - spec.x(0)) / spec.pitch)
+                .floor()
+                .min(hi as f64);
+            first <= last
+                && (first as usize..=last as usize)
+                    .any(|i| self.heights[j * spec.nx + i].is_finite())
+        })
+    }
+
+    /// Whether the mesh point `p` lies outside the grid's footprint after
+    /// `travel` mm of slide, the footprint's rows at the push being `rows`
+    /// (`(j, i_lo, i_hi)`): beyond its first or last row, or beyond both
+    /// rows around it in x. The knee-form's outline reaches up to a pitch
+    /// past the footprint's outermost nodes; a point touched there lies in
+    /// that rim, where the grid has no node at this pitch.
+    pub fn outside_footprint(&self, p: [f64; 3], rows: &[(usize, i64, i64)], travel: f64) -> bool {
+        let spec = self.spec;
+        let t = CELL_TOL;
+        let span = |&(_, lo, hi): &(usize, i64, i64)| {
+            let x = |i: i64| spec.x(0) + i as f64 * spec.pitch - travel;
+            (x(lo) - t..=x(hi) + t).contains(&p[0])
+        };
+        let below = rows.iter().filter(|r| spec.z(r.0) <= p[2] + t);
+        let above = rows.iter().filter(|r| spec.z(r.0) >= p[2] - t);
+        let nearest_below = below.max_by(|a, b| spec.z(a.0).total_cmp(&spec.z(b.0)));
+        let nearest_above = above.min_by(|a, b| spec.z(a.0).total_cmp(&spec.z(b.0)));
+        match (nearest_below, nearest_above) {
+            (Some(b), Some(a)) => !(span(b) || span(a)),
+            _ => true,
+        }
+    }
+
     /// How much higher than the mesh point `p` (`[x, y, z]`, mm) the grid
     /// may be wherever the knee-form touches `p`: the largest `h - y` over
     /// the nodes within [`RISE_REACH`] pitches of `p` in xz (mm, `>= 0`).
@@ -147,6 +199,11 @@ pub enum Mechanism {
     Undecided,
     /// Pairs the oracle failed on.
     OracleFailure,
+    /// Exact strikes in the knee-form's rim: between its outline and the
+    /// grid's footprint, which reaches up to a pitch less far; the grid
+    /// has no node there at this pitch (misses, on the unsafe side: they
+    /// fail the verdict).
+    Rim,
     /// A real disagreement.
     Unexplained,
 }
@@ -159,6 +216,7 @@ impl Mechanism {
             Mechanism::LevelError => "level-error",
             Mechanism::Undecided => "undecided",
             Mechanism::OracleFailure => "oracle-failure",
+            Mechanism::Rim => "rim",
             Mechanism::Unexplained => "unexplained",
         }
     }
@@ -168,7 +226,10 @@ impl Mechanism {
     /// against their bound and undecided contacts beside the decided ones
     /// (SPEC); an oracle failure or an unexplained figure fails.
     pub fn fails_verdict(self) -> bool {
-        matches!(self, Mechanism::OracleFailure | Mechanism::Unexplained)
+        matches!(
+            self,
+            Mechanism::OracleFailure | Mechanism::Rim | Mechanism::Unexplained
+        )
     }
 }
 
@@ -292,12 +353,32 @@ mod tests {
     }
 
     #[test]
-    fn only_unexplained_figures_and_oracle_failures_fail_the_verdict() {
+    fn a_point_between_the_footprint_s_outer_row_and_the_outline_is_in_the_rim() {
+        let (triangles, grid) = ribbed(0.0);
+        let cells = Cells::of(&triangles, &grid, 0.5);
+        // Rows j = 2..=4 (z = 4, 6, 8), columns 3..=6 (x = 6..12) at the
+        // push.
+        let rows = [(2, 3, 6), (3, 3, 6), (4, 3, 6)];
+        let inside =
+            |x: f64, z: f64, travel: f64| !cells.outside_footprint([x, 0.0, z], &rows, travel);
+        assert!(inside(9.0, 5.0, 0.0));
+        assert!(inside(6.0, 8.0, 0.0), "on the outer nodes");
+        assert!(!inside(9.0, 8.5, 0.0), "beyond the last row");
+        assert!(!inside(9.0, 3.5, 0.0), "before the first row");
+        assert!(!inside(12.5, 5.0, 0.0), "beyond the rows' span in x");
+        // After 3 mm of slide the footprint spans x = 3..9.
+        assert!(inside(3.5, 5.0, 3.0));
+        assert!(!inside(11.0, 5.0, 3.0));
+    }
+
+    #[test]
+    fn only_unexplained_figures_rim_misses_and_oracle_failures_fail_the_verdict() {
         for (m, fails) in [
             (Mechanism::Blind, false),
             (Mechanism::LevelError, false),
             (Mechanism::Undecided, false),
             (Mechanism::OracleFailure, true),
+            (Mechanism::Rim, true),
             (Mechanism::Unexplained, true),
         ] {
             assert_eq!(m.fails_verdict(), fails, "{m:?}");

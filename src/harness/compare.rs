@@ -226,6 +226,9 @@ pub struct VerifyRow {
     /// knee-form (mm), away from blind spots.
     #[serde(default)]
     pub level_error_clearance: Option<f64>,
+    /// Why the oracle failed on this pair (`oracle_failed` rows).
+    #[serde(default)]
+    pub oracle_failure: Option<String>,
 }
 
 /// Counts of a comparison.
@@ -297,6 +300,10 @@ pub struct AreaDistance {
     /// not explain.
     #[serde(default)]
     pub false_alarm_unexplained: f64,
+    /// `miss_decided` from the decided exact strikes inside the grid's
+    /// footprint (not in the knee-form's rim).
+    #[serde(default)]
+    pub miss_inside: f64,
     /// `miss` from decided exact strikes downstream of a blind spot.
     #[serde(default)]
     pub miss_blind: f64,
@@ -351,6 +358,13 @@ pub struct Unexplained {
     /// Grid strikes beyond the bound with no possible exact strike in
     /// their start (a judged one: not an oracle failure).
     pub unmatched_grid: usize,
+    /// `miss_distance_decided` over the exact strikes inside the grid's
+    /// footprint (not in the knee-form's rim; `null` when infinite).
+    #[serde(default, with = "crate::harness::compare::infinite_as_null")]
+    pub miss_distance: f64,
+    /// `area_miss_distance_decided` from those strikes.
+    #[serde(default, with = "crate::harness::compare::infinite_as_null")]
+    pub area_miss_distance: f64,
 }
 
 impl Unexplained {
@@ -455,6 +469,7 @@ pub fn row_of(
                 .collect::<Vec<f64>>(),
         ),
         level_error_clearance: worst(&cmp.level_clearance),
+        oracle_failure: cmp.oracle_failure.map(|r| r.to_string()),
     }
 }
 
@@ -638,6 +653,13 @@ pub fn assemble(
         let unmatched_exact = push("miss_distance", &cmp.miss);
         let unmatched_exact_decided = push("miss_distance_decided", &cmp.miss_decided);
         push("miss_distance_blind", &cmp.miss_blind);
+        for (&d, &rim) in cmp.miss_decided.iter().zip(&cmp.miss_rim) {
+            // (Infinite ones, no grid strike in the start, are the
+            // unmatched counts and the unmatched deflection's.)
+            if !rim && d.is_finite() {
+                unexplained.miss_distance = unexplained.miss_distance.max(d);
+            }
+        }
         let unmatched_grid = push("false_alarm_distance", &cmp.false_alarm);
         let unmatched_grid_decided = push("false_alarm_distance_decided", &cmp.false_alarm_decided);
         push("false_alarm_distance_blind", &cmp.false_alarm_blind);
@@ -700,6 +722,7 @@ pub fn assemble(
         unexplained.area_false_alarm_distance = unexplained
             .area_false_alarm_distance
             .max(a.false_alarm_unexplained);
+        unexplained.area_miss_distance = unexplained.area_miss_distance.max(a.miss_inside);
         for (name, v) in [
             ("area_miss_distance_blind", a.miss_blind),
             ("area_false_alarm_distance_blind", a.false_alarm_blind),
@@ -742,6 +765,7 @@ fn area_distance(angle_deg: f64, pts: StartPoints) -> AreaDistance {
         miss_decided: grid.hausdorff_from(&pts.decided),
         false_alarm_decided: possible.hausdorff_from(&pts.grid_decided),
         false_alarm_unexplained: possible.hausdorff_from(&pts.grid_unexplained),
+        miss_inside: grid.hausdorff_from(&pts.decided_inside),
         miss_blind: grid.hausdorff_from(&pts.blind),
         false_alarm_blind: possible.hausdorff_from(&pts.grid_blind),
     }
@@ -767,62 +791,69 @@ impl Comparison {
         let max = |m: &str| self.stat(m).max;
         // An infinite area distance is no statistic: read it per angle.
         let area = |f: &dyn Fn(&AreaDistance) -> f64| self.area.iter().map(f).fold(0.0, f64::max);
-        let level = |unexplained: f64| {
-            if unexplained <= tolerance {
-                LevelError
-            } else {
-                Unexplained
-            }
-        };
-        let decided: [(&str, f64, Mechanism, Side); 7] = [
+        // Each decided figure, the mechanism that may explain it, and what
+        // is left of it where that mechanism does not (mm).
+        let none = (Unexplained, f64::INFINITY);
+        let decided: [(&str, f64, (Mechanism, f64), Side); 7] = [
             (
                 "miss_distance_decided",
                 max("miss_distance_decided"),
-                Unexplained,
+                (Rim, u.miss_distance),
                 Side::Miss,
             ),
             (
                 "unmatched_deflection_decided",
                 max("unmatched_deflection_decided"),
-                Unexplained,
+                none,
                 Side::Miss,
             ),
             (
                 "area_miss_distance_decided",
                 area(&|a| a.miss_decided),
-                Unexplained,
+                (Rim, u.area_miss_distance),
                 Side::Miss,
             ),
             (
                 "false_alarm_distance_decided",
                 max("false_alarm_distance_decided"),
-                level(u.false_alarm_distance),
+                (LevelError, u.false_alarm_distance),
                 Side::FalseAlarm,
             ),
             (
                 "area_false_alarm_distance_decided",
                 area(&|a| a.false_alarm_decided),
-                level(u.area_false_alarm_distance),
+                (LevelError, u.area_false_alarm_distance),
                 Side::FalseAlarm,
             ),
             (
                 "push_error_decided",
                 max("push_error_decided"),
-                level(u.push_error),
+                (LevelError, u.push_error),
                 Side::Level,
             ),
             (
                 "first_contact_error_decided",
                 max("first_contact_error_decided"),
-                level(u.first_contact_error),
+                (LevelError, u.first_contact_error),
                 Side::Level,
             ),
         ];
-        let mut failures: Vec<Failure> = decided
-            .into_iter()
-            .filter(|&(_, v, _, _)| v > tolerance)
-            .map(|(m, v, mech, side)| Failure::new(m, v, mech, side))
-            .collect();
+        // A figure its mechanism explains only in part is named twice:
+        // whole, by the mechanism, and what is left, unexplained.
+        let mut failures: Vec<Failure> = Vec::new();
+        for (m, v, (mech, left), side) in decided {
+            if v <= tolerance {
+                continue;
+            }
+            if mech == Unexplained || left >= v - 1e-9 {
+                failures.push(Failure::new(m, v, Unexplained, side));
+                continue;
+            }
+            failures.push(Failure::new(m, v, mech, side));
+            if left > tolerance {
+                failures.push(Failure::new(m, left, Unexplained, side));
+            }
+        }
         // Over all strikes: beyond the tolerance while the decided figure
         // is within it, through blind or undecided contacts.
         let all: [(&str, f64, f64, f64, Side); 6] = [
@@ -905,6 +936,17 @@ impl Comparison {
             }
         }
         failures
+    }
+
+    /// The oracle's failures by reason: how many pairs each.
+    pub fn oracle_failures(&self) -> std::collections::BTreeMap<String, usize> {
+        let mut by = std::collections::BTreeMap::new();
+        for r in &self.rows {
+            if let Some(reason) = &r.oracle_failure {
+                *by.entry(reason.clone()).or_insert(0) += 1;
+            }
+        }
+        by
     }
 
     /// The verdict in one line: misses (safety) and false alarms (cost)

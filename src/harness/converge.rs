@@ -158,6 +158,24 @@ pub struct ConvergeSummary {
     pub starts: usize,
     /// Per pitch: engine seconds for the study's angles.
     pub seconds: Vec<f64>,
+    /// Per pitch, at the tolerance asked for: the verdict and every figure
+    /// beyond it with its mechanism (as `verify.json`'s); empty without a
+    /// tolerance.
+    #[serde(default)]
+    pub verdicts: Vec<PitchVerdict>,
+}
+
+/// One pitch's verdict in a convergence study.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PitchVerdict {
+    /// The pitch (mm).
+    pub pitch_mm: f64,
+    /// Whether it passes the tolerance.
+    pub pass: bool,
+    /// Misses and false alarms apart, in words.
+    pub verdict: String,
+    /// The figures beyond the tolerance, with their mechanism.
+    pub failures: Vec<super::causes::Failure>,
 }
 
 /// Nested grids over the coarsest grid's extent (pitches dividing its
@@ -463,6 +481,7 @@ impl ConvergeSummary {
             tie_band_rule: tie_band_rule(options.tie_band_per_mm, setup.rule.window_mm()),
             starts,
             seconds: Vec::new(),
+            verdicts: Vec::new(),
         };
         summary.set_results(results);
         summary
@@ -484,6 +503,18 @@ impl ConvergeSummary {
         self.recommended_pitch_mm = recommended.map(|r| r.pitch);
         self.predicted_full_time_s = recommended.map(|r| r.seconds * full_angles);
         self.seconds = results.iter().map(|r| r.seconds).collect();
+        self.verdicts = match self.tolerance_mm {
+            Some(t) => results
+                .iter()
+                .map(|r| PitchVerdict {
+                    pitch_mm: r.pitch,
+                    pass: r.comparison.passes(t),
+                    verdict: r.comparison.verdict(t),
+                    failures: r.comparison.failures(t),
+                })
+                .collect(),
+            None => Vec::new(),
+        };
     }
 }
 

@@ -1,7 +1,7 @@
 //! SPEC's harness metrics ("What the harness measures"): per start, the grid
 //! trace against the exact trace; over many starts, max, p95 and mean.
 
-use kneeform_oracle::{ContactPoint, LevelCurve, StartStatus, StartTrace};
+use kneeform_oracle::{ContactPoint, FailureReason, LevelCurve, StartStatus, StartTrace};
 use serde::{Deserialize, Serialize};
 
 use super::causes::Cells;
@@ -237,21 +237,9 @@ pub struct ExactStrike {
     pub decision: Decision,
 }
 
-/// The exact contacts of a placed start with their standing by `rule` on
-/// the grid of `cells`; empty for a start that is not placed or failed.
-pub fn classify(
-    exact: &StartTrace,
-    band: &TieBand,
-    rule: ExactRule,
-    cells: &Cells,
-) -> Vec<ExactStrike> {
-    match LevelErrorBound::of(exact, cells) {
-        Some(bound) => classify_with(exact, band, rule, &bound),
-        None => Vec::new(),
-    }
-}
-
-fn classify_with(
+/// The exact contacts of a placed start with their standing by `rule`,
+/// against the grid's level error `bound` along it.
+fn classify(
     exact: &StartTrace,
     band: &TieBand,
     rule: ExactRule,
@@ -324,6 +312,9 @@ pub struct StartComparison {
     /// The same for each decided exact strike not downstream of a blind
     /// spot.
     pub miss_decided: Vec<f64>,
+    /// Whether each of those lies in the knee-form's rim, outside the
+    /// grid's footprint at its travel ([`Cells::outside_footprint`]).
+    pub miss_rim: Vec<bool>,
     /// The same for each decided exact strike downstream of one.
     pub miss_blind: Vec<f64>,
     /// For each grid strike, the xz distance to the nearest exact strike or
@@ -353,6 +344,8 @@ pub struct StartComparison {
     /// For each of those, the stated bound of the grid's level error at
     /// that travel (mm; see [`compare`]).
     pub level_bound: Vec<f64>,
+    /// Why the oracle failed on this pair, when it did.
+    pub oracle_failure: Option<FailureReason>,
     /// Exact strikes (`rate > sigma`).
     pub exact_strikes: usize,
     /// Exact contacts in the tie band.
@@ -387,6 +380,9 @@ pub struct StartPoints {
     pub decided: Vec<[f64; 2]>,
     /// The decided exact strikes downstream of one.
     pub blind: Vec<[f64; 2]>,
+    /// The decided exact strikes away from blind spots that lie inside the
+    /// grid's footprint at their travel (not in the knee-form's rim).
+    pub decided_inside: Vec<[f64; 2]>,
     /// The exact contacts that are not decided non-strikes.
     pub possible: Vec<[f64; 2]>,
     /// The exact push contact, when placed: a point of the exact curve for
@@ -403,7 +399,7 @@ impl StartPoints {
     }
 
     /// Every set, in a fixed order (what a shard's file holds).
-    pub fn sets(&self) -> [&Vec<[f64; 2]>; 9] {
+    pub fn sets(&self) -> [&Vec<[f64; 2]>; 10] {
         [
             &self.grid,
             &self.grid_decided,
@@ -412,13 +408,14 @@ impl StartPoints {
             &self.strikes,
             &self.decided,
             &self.blind,
+            &self.decided_inside,
             &self.possible,
             &self.push,
         ]
     }
 
     /// Every set, mutable, in the order of [`StartPoints::sets`].
-    pub fn sets_mut(&mut self) -> [&mut Vec<[f64; 2]>; 9] {
+    pub fn sets_mut(&mut self) -> [&mut Vec<[f64; 2]>; 10] {
         [
             &mut self.grid,
             &mut self.grid_decided,
@@ -427,6 +424,7 @@ impl StartPoints {
             &mut self.strikes,
             &mut self.decided,
             &mut self.blind,
+            &mut self.decided_inside,
             &mut self.possible,
             &mut self.push,
         ]
@@ -500,9 +498,20 @@ pub struct LevelErrorBound<'a> {
 }
 
 impl<'a> LevelErrorBound<'a> {
-    /// The bound along `exact` on the grid of `cells`; `None` for a start
-    /// that is not placed or failed.
-    pub fn of(exact: &'a StartTrace, cells: &Cells) -> Option<LevelErrorBound<'a>> {
+    /// The bound along `exact` on the grid of `cells`, whose push covered
+    /// the footprint rows `push_rows` ([`GridTrace::push_rows`]); `None`
+    /// for a start that is not placed or failed.
+    ///
+    /// Where no node of the part under the knee-form at the push lies
+    /// within `sqrt 2` pitches of the exact push contact (the knee-form's
+    /// rim cuts a sliver of the part, or an edge, narrower than the pitch),
+    /// the grid cannot sample what the exact knee-form rests on: the push
+    /// contact's rise is unbounded at this pitch (a finer grid samples it).
+    pub fn of(
+        exact: &'a StartTrace,
+        cells: &Cells,
+        push_rows: &[(usize, i64, i64)],
+    ) -> Option<LevelErrorBound<'a>> {
         let curve = LevelCurve::of(exact)?;
         Some(LevelErrorBound {
             curve,
@@ -512,7 +521,13 @@ impl<'a> LevelErrorBound<'a> {
                 .iter()
                 .map(|c| cells.rise_near(c.witness))
                 .collect(),
-            push_rise: exact.push_witness.map_or(0.0, |w| cells.rise_near(w)),
+            push_rise: exact.push_witness.map_or(0.0, |w| {
+                if cells.samples_near(w, push_rows) {
+                    cells.rise_near(w)
+                } else {
+                    f64::INFINITY
+                }
+            }),
             pitch: cells.pitch(),
         })
     }
@@ -600,9 +615,9 @@ pub fn compare(
     cells: &Cells,
 ) -> StartComparison {
     let placed = exact.status == StartStatus::Placed;
-    let bound = LevelErrorBound::of(exact, cells);
+    let bound = LevelErrorBound::of(exact, cells, &grid.push_rows);
     let classified = match &bound {
-        Some(bound) => classify_with(exact, band, rule, bound),
+        Some(bound) => classify(exact, band, rule, bound),
         None => Vec::new(),
     };
     let push_witness = exact.push_witness.filter(|_| placed);
@@ -658,6 +673,14 @@ pub fn compare(
             .collect()
     };
     let decided_strike = |c: &ExactStrike| c.decision == Decision::Strike;
+    let in_rim = |c: &ExactStrike| {
+        cells.outside_footprint(c.contact.witness, &grid.push_rows, c.contact.travel)
+    };
+    let decided_away: Vec<&ExactStrike> = classified
+        .iter()
+        .filter(|c| decided_strike(c) && !is_blind(c.contact.travel))
+        .collect();
+    let miss_rim: Vec<bool> = decided_away.iter().map(|c| in_rim(c)).collect();
     let pts = StartPoints {
         grid: grid.colliding.iter().map(|c| xz(c.point)).collect(),
         grid_decided,
@@ -666,6 +689,12 @@ pub fn compare(
         strikes: points(&|c| c.strike),
         decided: points(&|c| decided_strike(c) && !is_blind(c.contact.travel)),
         blind: points(&|c| decided_strike(c) && is_blind(c.contact.travel)),
+        decided_inside: decided_away
+            .iter()
+            .zip(&miss_rim)
+            .filter(|(_, rim)| !**rim)
+            .map(|(c, _)| xz(c.contact.witness))
+            .collect(),
         possible: points(&|c| c.decision != Decision::NoStrike),
         push,
     };
@@ -744,6 +773,7 @@ pub fn compare(
         first_contact_explained: first_grid_explained,
         miss: miss_of(&pts.strikes),
         miss_decided: miss_of(&pts.decided),
+        miss_rim,
         miss_blind: miss_of(&pts.blind),
         false_alarm: false_alarm_of(grid_points, &strikes_or_push),
         false_alarm_decided: false_alarm_of(&pts.grid_decided, &possible_or_push),
@@ -758,6 +788,10 @@ pub fn compare(
         }),
         level_clearance,
         level_bound,
+        oracle_failure: match exact.status {
+            StartStatus::Failed { reason } => Some(reason),
+            _ => None,
+        },
         exact_strikes: pts.strikes.len(),
         undecided: classified
             .iter()

@@ -43,6 +43,9 @@ pub struct GridTrace {
     pub yr: f64,
     /// The colliding nodes in the order they are met.
     pub colliding: Vec<GridContact>,
+    /// The footprint's nodes at the push, per row of the grid: `(j, i_lo,
+    /// i_hi)` (columns inclusive, not clipped to the grid).
+    pub push_rows: Vec<(usize, i64, i64)>,
 }
 
 /// Pushes and slides the start at node `(i0, j0)`, with an optional fault.
@@ -74,7 +77,13 @@ pub(crate) fn grid_trace(
         });
     let mut yr = f64::INFINITY;
     let mut front: Vec<(f64, usize, usize)> = Vec::new();
+    let mut push_rows = Vec::new();
     for (row, j) in rows {
+        push_rows.push((
+            j,
+            i0 as i64 + i64::from(row.klo),
+            i0 as i64 + i64::from(row.khi),
+        ));
         for k in row.klo..=row.khi {
             let i = i0 as i64 + i64::from(k);
             if (0..spec.nx as i64).contains(&i) {
@@ -97,6 +106,7 @@ pub(crate) fn grid_trace(
     let mut trace = GridTrace {
         yr,
         colliding: Vec::new(),
+        push_rows,
     };
     if yr == f64::INFINITY {
         return trace;

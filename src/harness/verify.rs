@@ -293,6 +293,7 @@ impl VerifySummary {
             verdict: String::new(),
             failures: Vec::new(),
             unexplained: Default::default(),
+            oracle_failures: Default::default(),
             angles_deg: setup.angles.clone(),
             knee_form_mm: [
                 setup.knee.triangle_side,
@@ -334,6 +335,7 @@ impl VerifySummary {
         self.verdict = comparison.verdict(self.tolerance_mm);
         self.failures = comparison.failures(self.tolerance_mm);
         self.unexplained = comparison.unexplained;
+        self.oracle_failures = comparison.oracle_failures();
         self.tie_band = comparison.band;
         self.area_distance_decided_mm =
             Some(comparison.stat("area_distance_decided").max).filter(|_| {
@@ -424,13 +426,16 @@ pub struct VerifySummary {
     #[serde(default)]
     pub verdict: String,
     /// Every figure beyond the tolerance: `metric`, `value`, `mechanism`
-    /// (`blind`, `level-error`, `undecided`, `oracle-failure` or
+    /// (`blind`, `level-error`, `undecided`, `oracle-failure`, `rim` or
     /// `unexplained`), `side` and whether it fails the verdict.
     #[serde(default)]
     pub failures: Vec<crate::harness::causes::Failure>,
     /// The figures the level error can explain, over what it does not.
     #[serde(default)]
     pub unexplained: crate::harness::compare::Unexplained,
+    /// The oracle's failures by reason (pairs each; never counted clear).
+    #[serde(default)]
+    pub oracle_failures: std::collections::BTreeMap<String, usize>,
     /// Angles (degrees).
     pub angles_deg: Vec<f64>,
     /// Knee-form L, R, W (mm).

@@ -13,6 +13,7 @@
 use crate::harness::compare::{PairResult, STATUSES, row_of};
 use crate::harness::direct::{DIRECT_STATUSES, DirectPair, DirectRow};
 use crate::harness::metrics::{StartComparison, StartPoints};
+use kneeform_oracle::FailureReason;
 
 pub(super) fn put_u64(out: &mut Vec<u8>, v: u64) {
     out.extend_from_slice(&v.to_le_bytes());
@@ -71,6 +72,7 @@ pub(super) fn put_pair(out: &mut Vec<u8>, pair: &PairResult) {
         put_opt(out, v);
     }
     out.push(flags(c));
+    out.push(c.oracle_failure.map_or(0, |r| 1 + failure_index(r)));
     for v in [
         &c.miss,
         &c.miss_decided,
@@ -86,8 +88,10 @@ pub(super) fn put_pair(out: &mut Vec<u8>, pair: &PairResult) {
     ] {
         put_f64s(out, v);
     }
-    put_u64(out, c.false_alarm_explained.len() as u64);
-    out.extend(c.false_alarm_explained.iter().map(|&b| u8::from(b)));
+    for flags in [&c.false_alarm_explained, &c.miss_rim] {
+        put_u64(out, flags.len() as u64);
+        out.extend(flags.iter().map(|&b| u8::from(b)));
+    }
     put_u64(out, c.exact_strikes as u64);
     put_u64(out, c.undecided as u64);
     put_u64(out, c.blind_strikes as u64);
@@ -96,6 +100,23 @@ pub(super) fn put_pair(out: &mut Vec<u8>, pair: &PairResult) {
     }
     put_nodes(out, &pair.grid_nodes);
     put_nodes(out, &pair.snapped);
+}
+
+/// The oracle's failure reasons, in the order a shard's file numbers them
+/// (from 1; 0 is no failure).
+const FAILURE_REASONS: [FailureReason; 5] = [
+    FailureReason::CastNotConverged,
+    FailureReason::UnconfirmedMiss,
+    FailureReason::PenetratingStart,
+    FailureReason::CastBudgetExhausted,
+    FailureReason::Unsupported,
+];
+
+fn failure_index(reason: FailureReason) -> u8 {
+    FAILURE_REASONS
+        .iter()
+        .position(|&r| r == reason)
+        .map_or(u8::MAX, |k| k as u8)
 }
 
 /// A pair's yes-no facts, one bit each: whether its exact knee-form
@@ -271,6 +292,14 @@ impl<'a> Reader<'a> {
         if flags >> 4 != 0 {
             return Err(format!("pair flags {flags}"));
         }
+        let oracle_failure = match self.u8()? {
+            0 => None,
+            k => Some(
+                *FAILURE_REASONS
+                    .get(usize::from(k) - 1)
+                    .ok_or_else(|| format!("an oracle failure reason {k}"))?,
+            ),
+        };
         let mut cmp = StartComparison {
             push_error,
             push_blind: flags & 2 != 0,
@@ -291,6 +320,8 @@ impl<'a> Reader<'a> {
             level_clearance: self.f64s()?,
             level_bound: self.f64s()?,
             false_alarm_explained: self.bools()?,
+            miss_rim: self.bools()?,
+            oracle_failure,
             exact_strikes: self.len()?,
             undecided: self.len()?,
             blind: flags & 1 != 0,
@@ -324,6 +355,7 @@ mod tests {
             first_contact_explained: true,
             miss: vec![1.5, f64::INFINITY],
             miss_decided: vec![f64::INFINITY],
+            miss_rim: vec![true],
             miss_blind: vec![0.5],
             false_alarm: vec![0.1 + 0.2, 7.0],
             false_alarm_decided: vec![0.3],
@@ -334,6 +366,7 @@ mod tests {
             unmatched_deflection_blind: Vec::new(),
             level_clearance: vec![0.01],
             level_bound: vec![0.25],
+            oracle_failure: Some(FailureReason::UnconfirmedMiss),
             exact_strikes: 2,
             undecided: 1,
             blind: true,
@@ -346,6 +379,7 @@ mod tests {
                 strikes: vec![[3.0, 4.0], [5.0, 6.0]],
                 decided: vec![[5.0, 6.0]],
                 blind: vec![[3.0, 4.0]],
+                decided_inside: Vec::new(),
                 possible: Vec::new(),
                 push: vec![[-7.5, 8.25]],
             },
