@@ -159,6 +159,21 @@ impl Cells {
     /// deeper than the exact one. About the local slope times `sqrt 2` times the
     /// pitch: it shrinks with the pitch.
     pub fn rise_near(&self, p: [f64; 3]) -> f64 {
+        self.rises_near(p).map_or(0.0, |(_, highest)| highest)
+    }
+
+    /// How much higher than the mesh point `p` the *lowest* node within
+    /// [`RISE_REACH`] pitches of it lies (mm, `>= 0`; `+inf` where no node
+    /// of the part is that near): the least by which the grid's best node
+    /// near a touched point can misjudge it.
+    pub fn rise_of_lowest_near(&self, p: [f64; 3]) -> f64 {
+        self.rises_near(p)
+            .map_or(f64::INFINITY, |(lowest, _)| lowest.max(0.0))
+    }
+
+    /// The least and the largest `h - y` over the nodes of the part within
+    /// [`RISE_REACH`] pitches of `p` in xz; `None` where there is none.
+    fn rises_near(&self, p: [f64; 3]) -> Option<(f64, f64)> {
         let spec = self.spec;
         let reach = RISE_REACH * spec.pitch;
         let index = |v: f64, origin: f64, n: usize| {
@@ -172,17 +187,18 @@ impl Cells {
                 lo as usize..hi as usize + 1
             }
         };
-        let mut rise: f64 = 0.0;
+        let mut found: Option<(f64, f64)> = None;
         for j in index(p[2], spec.z(0), spec.nz) {
             for i in index(p[0], spec.x(0), spec.nx) {
                 let (dx, dz) = (spec.x(i) - p[0], spec.z(j) - p[2]);
                 let h = self.heights[j * spec.nx + i];
                 if dx.hypot(dz) <= reach + CELL_TOL && h.is_finite() {
-                    rise = rise.max(h - p[1]);
+                    let r = h - p[1];
+                    found = Some(found.map_or((r, r), |(lo, hi)| (lo.min(r), hi.max(r))));
                 }
             }
         }
-        rise
+        found.map(|(lo, hi)| (lo, hi.max(0.0)))
     }
 }
 
@@ -261,6 +277,11 @@ pub struct Failure {
     pub side: Side,
     /// Whether it fails the verdict ([`Mechanism::fails_verdict`]).
     pub fails_verdict: bool,
+    /// Whether the value (a distance) is within `sqrt 2` pitches: a
+    /// sampling error of the size the grid makes at this pitch, which a
+    /// finer pitch shrinks where the figure converges (`results/`).
+    #[serde(default)]
+    pub within_pitch: bool,
 }
 
 impl Failure {
@@ -272,7 +293,18 @@ impl Failure {
             mechanism,
             side,
             fails_verdict: mechanism.fails_verdict(),
+            within_pitch: false,
         }
+    }
+
+    /// This failure, marked within `sqrt 2` pitches of `pitch` (mm) where
+    /// its value (a distance, not a count) is.
+    pub fn at_pitch(mut self, pitch: f64) -> Failure {
+        self.within_pitch = self.side != Side::Coverage
+            && self
+                .value
+                .is_some_and(|v| v <= std::f64::consts::SQRT_2 * pitch + 1e-9);
+        self
     }
 
     /// The figure in words, for a console line.
@@ -282,7 +314,12 @@ impl Failure {
             Some(v) => format!("{v:.3} mm"),
             None => "infinite".into(),
         };
-        format!("{} {value} ({})", self.metric, self.mechanism.name())
+        let pitch = if self.within_pitch {
+            ", within sqrt 2 pitches"
+        } else {
+            ""
+        };
+        format!("{} {value} ({}{pitch})", self.metric, self.mechanism.name())
     }
 }
 

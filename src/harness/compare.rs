@@ -936,6 +936,9 @@ impl Comparison {
             }
         }
         failures
+            .into_iter()
+            .map(|f| f.at_pitch(self.band.pitch))
+            .collect()
     }
 
     /// The oracle's failures by reason: how many pairs each.

@@ -65,7 +65,11 @@ impl Pairs {
 
 /// The tie band of a direct study's pitch, which has none (the knee does
 /// not slide): zero.
-pub(super) const NO_BAND: TieBand = TieBand { sigma: 0.0, m: 0.0 };
+pub(super) const NO_BAND: TieBand = TieBand {
+    sigma: 0.0,
+    m: 0.0,
+    pitch: 0.0,
+};
 
 /// One pitch of a share: its start-angle pairs, angle-major over the
 /// share's starts, and what was timed.

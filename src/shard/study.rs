@@ -488,6 +488,7 @@ fn decode(bin: &[u8], record: &StudyRecord) -> Result<StudyPart, String> {
         let band = TieBand {
             sigma: r.f64()?,
             m: r.f64()?,
+            pitch: p,
         };
         let (grid_s, seconds) = (r.f64()?, r.f64()?);
         let nodes = r.len()?;
