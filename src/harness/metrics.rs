@@ -606,7 +606,7 @@ const LEVEL_TOL: f64 = 1e-6;
 /// Compares a grid trace with the exact trace of the same start and angle.
 ///
 /// **Strikes on both sides.** The grid's strikes are SPEC's (rule 2 of the
-/// slide); the exact strikes are the contacts [`classify`] finds striking.
+/// slide); the exact strikes are the contacts SPEC's rule finds striking (`classify`).
 /// Over *all* strikes, a miss is an exact strike far from every grid
 /// strike, a false alarm a grid strike far from every exact strike. Over
 /// *decided* strikes, misses are counted only from exact contacts beyond
@@ -620,7 +620,7 @@ const LEVEL_TOL: f64 = 1e-6;
 ///
 /// **Level error.** Each grid strike not blind is checked against the
 /// exact level curve: its node's clearance `h - f*(s)` against
-/// [`level_bound`]'s bound. A false alarm within it is the level error's.
+/// the bound of [`LevelErrorBound`]. A false alarm within it is the level error's.
 ///
 /// The exact push contact counts as a point of the exact curve for false
 /// alarms: where the grid's push level is above the exact one (its nodes
