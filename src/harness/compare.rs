@@ -856,49 +856,37 @@ impl Comparison {
         }
         // Over all strikes: beyond the tolerance while the decided figure
         // is within it, through blind or undecided contacts.
+        // Each metric over all strikes, over the decided ones and the
+        // blind ones.
+        let stat = |m: &'static str, side| {
+            let of = |suffix: &str| max(&format!("{m}{suffix}"));
+            (m, of(""), of("_decided"), of("_blind"), side)
+        };
+        let area_of =
+            |m,
+             all: fn(&AreaDistance) -> f64,
+             decided: fn(&AreaDistance) -> f64,
+             blind: fn(&AreaDistance) -> f64,
+             side| { (m, area(&all), area(&decided), area(&blind), side) };
         let all: [(&str, f64, f64, f64, Side); 6] = [
-            (
-                "miss_distance",
-                max("miss_distance"),
-                max("miss_distance_decided"),
-                max("miss_distance_blind"),
-                Side::Miss,
-            ),
-            (
+            stat("miss_distance", Side::Miss),
+            area_of(
                 "area_miss_distance",
-                area(&|a| a.miss),
-                area(&|a| a.miss_decided),
-                area(&|a| a.miss_blind),
+                |a| a.miss,
+                |a| a.miss_decided,
+                |a| a.miss_blind,
                 Side::Miss,
             ),
-            (
-                "false_alarm_distance",
-                max("false_alarm_distance"),
-                max("false_alarm_distance_decided"),
-                max("false_alarm_distance_blind"),
-                Side::FalseAlarm,
-            ),
-            (
+            stat("false_alarm_distance", Side::FalseAlarm),
+            area_of(
                 "area_false_alarm_distance",
-                area(&|a| a.false_alarm),
-                area(&|a| a.false_alarm_decided),
-                area(&|a| a.false_alarm_blind),
+                |a| a.false_alarm,
+                |a| a.false_alarm_decided,
+                |a| a.false_alarm_blind,
                 Side::FalseAlarm,
             ),
-            (
-                "push_error",
-                max("push_error"),
-                max("push_error_decided"),
-                max("push_error_blind"),
-                Side::Level,
-            ),
-            (
-                "first_contact_error",
-                max("first_contact_error"),
-                max("first_contact_error_decided"),
-                max("first_contact_error_blind"),
-                Side::Level,
-            ),
+            stat("push_error", Side::Level),
+            stat("first_contact_error", Side::Level),
         ];
         for (m, v, decided, blind, side) in all {
             if v > tolerance && decided <= tolerance {
