@@ -128,14 +128,25 @@ pub fn print_verification(result: &Verification, out: &Path) -> ExitCode {
             let at = w.at.map_or(String::new(), |[x, z]| {
                 format!(" (the disagreement lies at x = {x:.1}, z = {z:.1} mm)")
             });
+            // A rim miss is the footprint's reach, not a feature's width.
+            let rim = s.failures.iter().any(|f| {
+                f.metric == w.metric
+                    && f.mechanism == kneeform::harness::causes::Mechanism::Rim
+                    && f.value.is_some_and(|v| (v - w.value).abs() < 1e-9)
+            });
+            let hint = if rim {
+                "; it lies in the knee-form's rim, between its outline and the grid's footprint, which reaches up to a pitch less far: a finer pitch narrows the rim".to_string()
+            } else {
+                resolving_pitch(s.pitch_mm, s.tolerance_mm, &w.metric, w.value)
+            };
+            let short = kneeform::limits::short;
             format!(
-                "; worst: {} = {:.3} mm, start ({}, {}) angle {}{at}{}",
+                "; worst: {} = {:.3} mm, start ({}, {}) angle {}{at}{hint}",
                 w.metric,
                 w.value,
-                w.x,
-                w.z,
-                w.angle_deg,
-                resolving_pitch(s.pitch_mm, s.tolerance_mm, &w.metric, w.value)
+                short(w.x),
+                short(w.z),
+                short(w.angle_deg),
             )
         });
         eprintln!(
