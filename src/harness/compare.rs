@@ -546,13 +546,7 @@ pub(crate) fn pair_results(
             let fp = &footprints[a];
             let trace = &traces[a * nodes.len() + s];
             let g = grid_trace(grid, fp, i, j, &options.rule, fault);
-            let cmp = compare(
-                &g,
-                trace,
-                &band,
-                ExactRule::of(&options.rule, spec.pitch),
-                &cells,
-            );
+            let cmp = compare(&g, trace, &band, ExactRule::of(&options.rule), &cells);
             let grid_placed = g.yr.is_finite();
             let status = match (trace.status, grid_placed) {
                 (StartStatus::Failed { .. }, _) => "oracle_failed",

@@ -205,23 +205,20 @@ pub enum ExactRule {
     /// than the node's rise, missed by 5.6 mm). So a contact is a decided
     /// strike when its drop exceeds `sigma W` by more than the drop's
     /// stated error plus that rise, a decided non-strike when it falls
-    /// short by
-    /// more than that error plus the bound of the grid's level error `W`
-    /// back (SPEC, "Ties at the threshold"). The band shrinks with the
-    /// pitch.
+    /// short by more than that error plus the bound of the grid's level
+    /// error `W` back (SPEC, "Ties at the threshold"). Both terms come from
+    /// the grid's cells ([`LevelErrorBound`]) and shrink with the pitch.
     Window {
         /// `W` (mm).
         window: f64,
-        /// The grid's pitch (mm).
-        pitch: f64,
     },
 }
 
 impl ExactRule {
-    /// The exact side of `rule` on a grid of pitch `pitch` (mm).
-    pub fn of(rule: &crate::strike::StrikeRule, pitch: f64) -> ExactRule {
+    /// The exact side of `rule`.
+    pub fn of(rule: &crate::strike::StrikeRule) -> ExactRule {
         match rule.window_mm() {
-            Some(window) => ExactRule::Window { window, pitch },
+            Some(window) => ExactRule::Window { window },
             None => ExactRule::Rate,
         }
     }
@@ -302,8 +299,8 @@ pub struct StartComparison {
     /// push error is then blind).
     pub push_blind: bool,
     /// Whether the push error lies within the grid's level error at the
-    /// push: at most the depth the exact push contact's cell hides between
-    /// its sampled corners.
+    /// push: at most the push contact's rise ([`LevelErrorBound`]), and not
+    /// below the exact push level.
     pub push_explained: bool,
     /// Grid travel to the first strike minus the exact travel to the first
     /// strike (mm), when both have one.
