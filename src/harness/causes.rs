@@ -17,10 +17,13 @@
 //! * **Oracle failure.** No exact answer for the pair: never counted
 //!   clear.
 //! * **Rim.** A missed exact strike lies outside the grid's footprint at
-//!   its travel: the knee-form's outline reaches up to a pitch past the
-//!   footprint's outermost nodes, and the exact knee-form's edge touched
-//!   the part in that rim (a surface sloping up towards the knee-form's
-//!   side). It shrinks with the pitch but is a miss: it fails the verdict.
+//!   its travel (the polygon through its rows' ends): the knee-form's
+//!   outline bulges past it, up to a pitch across the outline and several
+//!   millimetres along it where the outline runs almost along the slide,
+//!   and the exact knee-form's edge touched the part in that rim (a
+//!   surface sloping up towards the knee-form's side, a crease crossing a
+//!   rounded corner). It shrinks with the pitch, at half order along the
+//!   slide, but is a miss: it fails the verdict.
 //! * **Unexplained.** None of the above: a real disagreement.
 
 use serde::{Deserialize, Serialize};
@@ -127,25 +130,38 @@ impl Cells {
 
     /// Whether the mesh point `p` lies outside the grid's footprint after
     /// `travel` mm of slide, the footprint's rows at the push being `rows`
-    /// (`(j, i_lo, i_hi)`): beyond its first or last row, or beyond both
-    /// rows around it in x. The knee-form's outline reaches up to a pitch
-    /// past the footprint's outermost nodes; a point touched there lies in
-    /// that rim, where the grid has no node at this pitch.
+    /// (`(j, i_lo, i_hi)`): beyond its first or last row, or outside the
+    /// polygon through the ends of the two rows around it (their spans
+    /// interpolated linearly in z). The knee-form's outline bulges past
+    /// that polygon, by up to a pitch across the outline and, where the
+    /// outline runs almost along the slide (the rounded corners' sides),
+    /// by several millimetres along it (the sagitta's run, about
+    /// `sqrt(2 r p)` for a corner of plan radius `r`: half order); a point
+    /// touched there lies in that rim, where the grid has no node at this
+    /// pitch.
     pub fn outside_footprint(&self, p: [f64; 3], rows: &[(usize, i64, i64)], travel: f64) -> bool {
         let spec = self.spec;
         let t = CELL_TOL;
-        let span = |&(_, lo, hi): &(usize, i64, i64)| {
-            let x = |i: i64| spec.x(0) + i as f64 * spec.pitch - travel;
-            (x(lo) - t..=x(hi) + t).contains(&p[0])
-        };
+        let x = |i: i64| spec.x(0) + i as f64 * spec.pitch - travel;
         let below = rows.iter().filter(|r| spec.z(r.0) <= p[2] + t);
         let above = rows.iter().filter(|r| spec.z(r.0) >= p[2] - t);
         let nearest_below = below.max_by(|a, b| spec.z(a.0).total_cmp(&spec.z(b.0)));
         let nearest_above = above.min_by(|a, b| spec.z(a.0).total_cmp(&spec.z(b.0)));
-        match (nearest_below, nearest_above) {
-            (Some(b), Some(a)) => !(span(b) || span(a)),
-            _ => true,
-        }
+        let (Some(&(jb, lo_b, hi_b)), Some(&(ja, lo_a, hi_a))) = (nearest_below, nearest_above)
+        else {
+            return true;
+        };
+        let (zb, za) = (spec.z(jb), spec.z(ja));
+        // How far from the row below towards the row above `p` lies (0 on
+        // the row below; 0 when both are one row).
+        let u = if za > zb {
+            ((p[2] - zb) / (za - zb)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let lo = x(lo_b) + u * (x(lo_a) - x(lo_b));
+        let hi = x(hi_b) + u * (x(hi_a) - x(hi_b));
+        !(lo - t..=hi + t).contains(&p[0])
     }
 
     /// How much higher than the mesh point `p` (`[x, y, z]`, mm) the grid
@@ -406,6 +422,19 @@ mod tests {
         // After 3 mm of slide the footprint spans x = 3..9.
         assert!(inside(3.5, 5.0, 3.0));
         assert!(!inside(11.0, 5.0, 3.0));
+        // A footprint whose outline runs at a slant between two rows: row
+        // j = 2 spans x = 6..12, row j = 3 x = 12..18. Half way between
+        // them the footprint's polygon spans x = 9..15: x = 7 lies in the
+        // span of the row below but outside the polygon, in the rim (the
+        // console's 5.6 mm miss at 0.5 mm, where the outline's rounded
+        // corner runs almost along the slide between two rows).
+        let slanted = [(2, 3, 6), (3, 6, 9)];
+        let inside = |x: f64, z: f64| !cells.outside_footprint([x, 0.0, z], &slanted, 0.0);
+        assert!(!inside(7.0, 5.0));
+        assert!(inside(9.5, 5.0));
+        assert!(inside(14.5, 5.0));
+        assert!(!inside(15.5, 5.0));
+        assert!(inside(7.0, 4.0), "on the row below");
     }
 
     #[test]
