@@ -30,6 +30,8 @@ pub struct AssemblyFile {
     pub triangles: usize,
     /// Of those, skipped for zero area.
     pub degenerate: usize,
+    /// Bodies read from it ([`crate::mesh::Part::bodies`]).
+    pub bodies: usize,
     /// Disregarded by the regulation (`--ignore`): not in the height grid.
     pub ignored: bool,
 }
@@ -106,7 +108,7 @@ impl PartSource {
         let mut files = Vec::with_capacity(order.len());
         let mut file_of = Vec::new();
         let mut triangles = Vec::new();
-        let (mut file_triangles, mut degenerate) = (0, 0);
+        let (mut file_triangles, mut degenerate, mut bodies) = (0, 0, 0);
         for (index, (path, ignored)) in order.into_iter().enumerate() {
             let read = read_part_placed(&path, self.scale, &self.placement)?;
             files.push(AssemblyFile {
@@ -114,6 +116,7 @@ impl PartSource {
                 sha256: read.sha256.clone(),
                 triangles: read.part.file_triangles,
                 degenerate: read.part.degenerate,
+                bodies: read.part.bodies,
                 ignored,
             });
             if ignored {
@@ -121,6 +124,7 @@ impl PartSource {
             }
             file_triangles += read.part.file_triangles;
             degenerate += read.part.degenerate;
+            bodies += read.part.bodies;
             file_of.extend(std::iter::repeat_n(index as u32, read.part.triangles.len()));
             triangles.extend_from_slice(&read.part.triangles);
             merged.get_or_insert(read);
@@ -130,6 +134,7 @@ impl PartSource {
             triangles,
             file_triangles,
             degenerate,
+            bodies,
         };
         merged.sha256 = String::new();
         merged.assembly = Some(Assembly { files, file_of });

@@ -117,6 +117,10 @@ pub struct Part {
     pub file_triangles: usize,
     /// Triangles skipped because their area is zero.
     pub degenerate: usize,
+    /// Bodies read: an ASCII STL's `solid ... endsolid` blocks (CAD
+    /// exporters write one per body), 1 for a binary STL or a scenario;
+    /// the sum over an assembly's analysed files.
+    pub bodies: usize,
 }
 
 /// A part read from its file, with the file's identity: what a run, its
@@ -519,11 +523,13 @@ impl Part {
         scale: f64,
         side: Side,
     ) -> Result<Part, MeshError> {
-        let triangles = parse_stl(bytes).map_err(|reason| MeshError::Format {
+        let (triangles, bodies) = parse_stl(bytes).map_err(|reason| MeshError::Format {
             path: name.into(),
             reason,
         })?;
-        Part::from_triangles(name, triangles, scale, side)
+        let mut part = Part::from_triangles(name, triangles, scale, side)?;
+        part.bodies = bodies;
+        Ok(part)
     }
 
     /// Builds a part from triangles in the part's own frame and units.
@@ -550,6 +556,7 @@ impl Part {
             degenerate: file_triangles - kept.len(),
             triangles: kept,
             file_triangles,
+            bodies: 1,
         })
     }
 
@@ -582,16 +589,18 @@ fn is_degenerate(t: &Triangle) -> bool {
     c == [0.0; 3]
 }
 
-/// Parses binary or ASCII STL. Binary files may start with `solid` too, so
-/// a file is taken as binary when its size matches the triangle count in
-/// its header, and as ASCII otherwise.
-fn parse_stl(bytes: &[u8]) -> Result<Vec<Triangle>, String> {
+/// Parses binary or ASCII STL into its triangles and the count of bodies
+/// read. Binary files may start with `solid` too, so a file is taken as
+/// binary when its size matches the triangle count in its header, and as
+/// ASCII otherwise. An ASCII file is read body by body: every `solid ...
+/// endsolid` block (`stl_io` alone stops at the first `endsolid`, which
+/// read a small case and dropped the console after it).
+fn parse_stl(bytes: &[u8]) -> Result<(Vec<Triangle>, usize), String> {
     let kind = stl_kind(
         &bytes[..bytes.len().min(STL_HEADER)],
         Some(bytes.len() as u64),
     )?;
-    let text = bytes.trim_ascii_start();
-    let normalised: Vec<u8> = if let StlKind::Binary { triangles } = kind {
+    let bodies: Vec<Vec<u8>> = if let StlKind::Binary { triangles } = kind {
         if triangles > crate::limits::MAX_PART_TRIANGLES as u64 {
             return Err(format!(
                 "{triangles} triangles, more than the {} a part may have",
@@ -602,25 +611,79 @@ fn parse_stl(bytes: &[u8]) -> Result<Vec<Triangle>, String> {
         // ASCII; the binary header is free text, so blank it.
         let mut copy = bytes.to_vec();
         copy[..80].fill(0);
-        copy
+        vec![copy]
     } else {
-        // stl_io wants "solid " with a space; exporters also write a bare
-        // "solid" line.
-        let mut copy = b"solid ".to_vec();
-        copy.extend_from_slice(&text[5..]);
-        copy
+        ascii_bodies(bytes)?
+            .into_iter()
+            .map(|body| {
+                // stl_io wants "solid " with a space; exporters also write
+                // a bare "solid" line.
+                let mut copy = b"solid ".to_vec();
+                copy.extend_from_slice(&body[5..]);
+                copy
+            })
+            .collect()
     };
-    let mut cursor = std::io::Cursor::new(normalised);
-    let stl = stl_io::create_stl_reader(&mut cursor)
-        .and_then(|reader| reader.collect::<Result<Vec<_>, _>>())
-        .map_err(|e| e.to_string())?;
-    Ok(stl
-        .into_iter()
-        .map(|t| {
+    let mut triangles = Vec::new();
+    let count = bodies.len();
+    for (k, body) in bodies.into_iter().enumerate() {
+        let mut cursor = std::io::Cursor::new(body);
+        let stl = stl_io::create_stl_reader(&mut cursor)
+            .and_then(|reader| reader.collect::<Result<Vec<_>, _>>())
+            .map_err(|e| {
+                if count > 1 {
+                    format!("body {} of {count}: {e}", k + 1)
+                } else {
+                    e.to_string()
+                }
+            })?;
+        triangles.extend(stl.into_iter().map(|t| {
             t.vertices
                 .map(|v| [f64::from(v[0]), f64::from(v[1]), f64::from(v[2])])
-        })
-        .collect())
+        }));
+    }
+    Ok((triangles, count))
+}
+
+/// An ASCII STL's bodies: each from its `solid` line to the end of its
+/// `endsolid` line (the last to the end of the file). Whitespace (and NUL
+/// padding) after the last body is nothing; anything else between or
+/// after bodies is refused rather than skipped.
+fn ascii_bodies(bytes: &[u8]) -> Result<Vec<&[u8]>, String> {
+    let is_blank = |b: &[u8]| b.iter().all(|c| c.is_ascii_whitespace() || *c == 0);
+    let mut bodies = Vec::new();
+    let mut start: Option<usize> = None;
+    let mut at = 0;
+    while at < bytes.len() {
+        let end = bytes[at..]
+            .iter()
+            .position(|&c| c == b'\n')
+            .map_or(bytes.len(), |k| at + k + 1);
+        let line = bytes[at..end].trim_ascii_start();
+        match start {
+            None if is_blank(line) => {}
+            None if line.starts_with(b"solid") => start = Some(at + (end - at - line.len())),
+            None => {
+                return Err(format!(
+                    "ASCII STL: text outside a `solid ... endsolid` body after body {} (byte {at})",
+                    bodies.len()
+                ));
+            }
+            Some(s) if line.starts_with(b"endsolid") => {
+                bodies.push(&bytes[s..end]);
+                start = None;
+            }
+            Some(_) => {}
+        }
+        at = end;
+    }
+    if let Some(s) = start {
+        bodies.push(&bytes[s..]);
+    }
+    if bodies.is_empty() {
+        return Err("ASCII STL without a `solid` line".into());
+    }
+    Ok(bodies)
 }
 
 #[cfg(test)]
@@ -648,13 +711,57 @@ mod tests {
     #[test]
     fn binary_with_solid_header_reads_as_binary() {
         let bytes = binary_stl(&[TRI, TRI], b"solid but binary");
-        assert_eq!(parse_stl(&bytes).unwrap().len(), 2);
+        assert_eq!(parse_stl(&bytes).unwrap().0.len(), 2);
     }
 
     #[test]
     fn ascii_with_crlf_reads() {
         let text = "solid x\r\nfacet normal 0 0 0\r\nouter loop\r\nvertex 0 1 0\r\nvertex 1 1 0\r\nvertex 0 1 1\r\nendloop\r\nendfacet\r\nendsolid x\r\n";
-        assert_eq!(parse_stl(text.as_bytes()).unwrap().len(), 1);
+        assert_eq!(parse_stl(text.as_bytes()).unwrap(), (vec![TRI64], 1));
+    }
+
+    const TRI64: Triangle = [[0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 1.0]];
+
+    fn ascii_body(name: &str, facets: usize, dx: f64) -> String {
+        let mut s = format!("solid {name}\n");
+        for k in 0..facets {
+            let x = dx + k as f64;
+            s += &format!(
+                "  facet normal 0 -1 0\n    outer loop\n      vertex {x} 1 0\n      vertex {} 1 0\n      vertex {x} 1 1\n    endloop\n  endfacet\n",
+                x + 1.0
+            );
+        }
+        s + &format!("endsolid {name}\n")
+    }
+
+    /// CAD exporters write one `solid` block per body; every one is read
+    /// (trimesh's models/multibody.stl gave 12 of its 32 triangles before).
+    #[test]
+    fn every_body_of_an_ascii_stl_is_read() {
+        let text = ascii_body("case", 2, 0.0) + &ascii_body("console", 5, 100.0) + "\n\n";
+        let (triangles, bodies) = parse_stl(text.as_bytes()).unwrap();
+        assert_eq!((triangles.len(), bodies), (7, 2));
+        assert_eq!(
+            triangles[2][0],
+            [100.0, 1.0, 0.0],
+            "the second body's first facet"
+        );
+        let part = Part::from_stl_bytes("t", text.as_bytes(), 1.0, Side::Left).unwrap();
+        assert_eq!((part.file_triangles, part.bodies), (7, 2));
+        // A bare `solid` line and CRLF line ends, as some exporters write.
+        let crlf = (ascii_body("", 1, 0.0) + &ascii_body("b", 1, 5.0)).replace('\n', "\r\n");
+        assert_eq!(parse_stl(crlf.as_bytes()).unwrap().0.len(), 2);
+        // A broken second body is an error naming it, not a silent stop.
+        let broken = ascii_body("a", 1, 0.0) + "solid b\n  facet normal 0 0 0\n    outer loop\n";
+        let err = parse_stl(broken.as_bytes()).unwrap_err();
+        assert!(err.contains("body 2 of 2"), "{err}");
+        // Text after the last body that is not a body is refused.
+        let trailing = ascii_body("a", 1, 0.0) + "garbage\n";
+        assert!(
+            parse_stl(trailing.as_bytes())
+                .unwrap_err()
+                .contains("outside")
+        );
     }
 
     #[test]

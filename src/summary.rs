@@ -16,6 +16,12 @@ pub struct AngleSummary {
     pub colliding_area_mm2: f64,
 }
 
+/// What a `summary.json` written before bodies were counted read: the
+/// first body only.
+fn one_body() -> usize {
+    1
+}
+
 /// One file of an assembly ([`crate::assembly`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FileSummary {
@@ -27,6 +33,9 @@ pub struct FileSummary {
     pub triangles: usize,
     /// Of those, skipped for zero area.
     pub degenerate_triangles: usize,
+    /// Bodies read from it (an ASCII STL's `solid` blocks; 1 for binary).
+    #[serde(default = "one_body")]
+    pub bodies: usize,
     /// Disregarded by the regulation (`--ignore`: softer than 50 Shore
     /// A): not in the height grid, so it never collides.
     pub ignored: bool,
@@ -78,6 +87,12 @@ pub struct Summary {
     pub triangles: usize,
     /// Triangles skipped for zero area.
     pub degenerate_triangles: usize,
+    /// Bodies read: an ASCII STL's `solid ... endsolid` blocks, every one
+    /// (1 for a binary STL or a scenario; over an assembly's analysed
+    /// files, their sum). A summary written before bodies were counted
+    /// reads 1: such runs read the first body only.
+    #[serde(default = "one_body")]
+    pub bodies: usize,
     /// Part bounding box, smallest x, y, z (mm, part frame).
     pub bbox_min: [f64; 3],
     /// Part bounding box, largest x, y, z (mm, part frame).

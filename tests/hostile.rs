@@ -495,3 +495,92 @@ fn report_never_overwrites_a_part_or_a_run_file() {
     assert_eq!(std::fs::read(&summary).unwrap(), before);
     std::fs::remove_dir_all(&scratch).unwrap();
 }
+
+/// An ASCII STL of `bodies`, each a `solid ... endsolid` block.
+fn ascii_stl(bodies: &[(&str, &[kneeform::mesh::Triangle])]) -> String {
+    let mut text = String::new();
+    for (name, triangles) in bodies {
+        text += &format!("solid {name}\n");
+        for t in *triangles {
+            text += "  facet normal 0 0 0\n    outer loop\n";
+            for v in t {
+                text += &format!("      vertex {} {} {}\n", v[0], v[1], v[2]);
+            }
+            text += "    endloop\n  endfacet\n";
+        }
+        text += &format!("endsolid {name}\n");
+    }
+    text
+}
+
+/// Issue 25, item 1: an ASCII STL holding a small case and then the part
+/// was read up to the first `endsolid` (the case alone: 2 triangles, an
+/// area of nothing, exit 0). Every body is read, `summary.json` says how
+/// many, and `analyze` and `verify` give the answers of the part's
+/// triangles all in one body.
+#[test]
+fn every_body_of_an_ascii_stl_is_analysed_and_verified() {
+    let dir = scratch_dir("hostile-multibody");
+    let bump = kneeform::scenario::parse(
+        &std::fs::read_to_string(crate::util::scenario_file("bump")).unwrap(),
+        &crate::util::scenario_file("bump"),
+    )
+    .unwrap()
+    .triangulate(None);
+    // A small case far behind the part (y = 500, facing -y): nothing the
+    // knee-form reaches first, so the answers are the part's.
+    let case: Vec<kneeform::mesh::Triangle> = vec![
+        [[0.0, 500.0, 0.0], [10.0, 500.0, 0.0], [0.0, 500.0, 10.0]],
+        [[10.0, 500.0, 0.0], [10.0, 500.0, 10.0], [0.0, 500.0, 10.0]],
+    ];
+    let mut all = case.clone();
+    all.extend_from_slice(&bump);
+    let two = dir.join("case_and_part.stl");
+    let one = dir.join("one_body.stl");
+    std::fs::write(&two, ascii_stl(&[("case", &case), ("part", &bump)])).unwrap();
+    std::fs::write(&one, ascii_stl(&[("all", &all)])).unwrap();
+    let summary = |stl: &Path, name: &str| -> serde_json::Value {
+        let out = dir.join(name);
+        run_ok(&[
+            "analyze",
+            &stl.display().to_string(),
+            "--out",
+            &out.display().to_string(),
+            "--pitch",
+            "4",
+            "--angles=-30,0,30",
+        ]);
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap()
+    };
+    let (s2, s1) = (summary(&two, "two"), summary(&one, "one"));
+    assert_eq!(s2["bodies"], 2);
+    assert_eq!(s1["bodies"], 1);
+    assert_eq!(s2["triangles"], all.len());
+    let area = |s: &serde_json::Value| s["composite_area_mm2"].as_f64().unwrap();
+    assert!(area(&s1) > 0.0, "the bump collides");
+    assert_eq!(area(&s2), area(&s1));
+    let verify = |stl: &Path, name: &str| -> serde_json::Value {
+        let out = dir.join(name);
+        let o = kneeform(&[
+            "verify",
+            &stl.display().to_string(),
+            "--out",
+            &out.display().to_string(),
+            "--pitch",
+            "4",
+            "--angles=0",
+            "--starts",
+            "6",
+        ]);
+        assert!(
+            o.status.code().is_some_and(|c| c < 2),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        serde_json::from_slice(&std::fs::read(out.join("verify.json")).unwrap()).unwrap()
+    };
+    let (v2, v1) = (verify(&two, "v2"), verify(&one, "v1"));
+    assert!(v1["counts"]["exact_strikes"].as_u64().unwrap() > 0);
+    assert_eq!(v2["counts"], v1["counts"]);
+    assert_eq!(v2["metrics"], v1["metrics"]);
+}

@@ -64,6 +64,7 @@ pub fn to_direct_frame(triangles: &[Triangle]) -> Part {
         triangles: triangles.iter().map(|t| t.map(to_direct)).collect(),
         file_triangles: triangles.len(),
         degenerate: 0,
+        bodies: 1,
     }
 }
 

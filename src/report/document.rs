@@ -431,6 +431,7 @@ fn part_section(run: &Run) -> Markup {
                     code { (run.part_path.display().to_string()) } " (SHA-256 matches the run's)"
                 }))
                 (row("Triangles in the file", c("/triangles")))
+                (row("Bodies read (every `solid` block of an ASCII STL)", c("/bodies")))
                 (row("Degenerate triangles (zero area, skipped)", c("/degenerate_triangles")))
                 (row("Bounding box, min x, y, z (mm)", corner("bbox_min")))
                 (row("Bounding box, max x, y, z (mm)", corner("bbox_max")))

@@ -564,13 +564,14 @@ fn find_parts(
     }
     let mut first = None;
     let mut triangles = Vec::new();
-    let (mut file_triangles, mut degenerate) = (0, 0);
+    let (mut file_triangles, mut degenerate, mut bodies) = (0, 0, 0);
     for f in summary.files.iter().filter(|f| !f.ignored) {
         let (path, part) = find_part(dir, None, &f.path, &f.sha256, summary.scale)?;
         first.get_or_insert(path);
         triangles.extend(part.triangles);
         file_triangles += part.file_triangles;
         degenerate += part.degenerate;
+        bodies += part.bodies;
     }
     let first = first.ok_or_else(|| ReportError::Part {
         path: dir.join("summary.json"),
@@ -582,6 +583,7 @@ fn find_parts(
             triangles,
             file_triangles,
             degenerate,
+            bodies,
         },
     ))
 }
