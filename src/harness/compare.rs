@@ -365,6 +365,26 @@ pub struct Unexplained {
     /// `area_miss_distance_decided` from those strikes.
     #[serde(default, with = "crate::harness::compare::infinite_as_null")]
     pub area_miss_distance: f64,
+    /// The largest `first_contact_error_decided` the level error explains
+    /// (a grid first strike early, on a node within the bound).
+    #[serde(default)]
+    pub first_contact_level_error: f64,
+    /// The largest one the rim explains, wholly or in part (a grid first
+    /// strike late while the exact strikes before it lie in the rim).
+    #[serde(default)]
+    pub first_contact_rim: f64,
+    /// `unmatched_deflection_decided` over the exact strikes inside the
+    /// grid's footprint (not in the rim).
+    #[serde(default)]
+    pub unmatched_deflection: f64,
+    /// The largest `miss_distance_decided` of an exact strike in the rim.
+    #[serde(default)]
+    pub miss_rim: f64,
+    /// The largest one of a brief exact strike
+    /// ([`super::metrics::StartComparison::miss_brief`]): sampling in
+    /// travel.
+    #[serde(default)]
+    pub miss_brief: f64,
 }
 
 impl Unexplained {
@@ -636,10 +656,20 @@ pub fn assemble(
         // A grid first strike earlier than the exact one is a false alarm
         // at the first contact: the level error's when its node is within
         // the bound.
-        if let Some(e) = cmp.first_contact_error_decided
-            && !(e < 0.0 && cmp.first_contact_explained)
-        {
-            unexplained.first_contact_error = unexplained.first_contact_error.max(e.abs());
+        // One later than the exact interval is the rim's as far as the
+        // exact strikes before it lie in the rim.
+        if let Some(e) = cmp.first_contact_error_decided {
+            let left = if e < 0.0 && cmp.first_contact_explained {
+                unexplained.first_contact_level_error =
+                    unexplained.first_contact_level_error.max(-e);
+                0.0
+            } else if let Some(inside) = cmp.first_contact_late_inside.filter(|&i| i < e) {
+                unexplained.first_contact_rim = unexplained.first_contact_rim.max(e);
+                inside
+            } else {
+                e.abs()
+            };
+            unexplained.first_contact_error = unexplained.first_contact_error.max(left);
         }
         // A start the oracle failed on has no exact answer: it is counted
         // as a failure, not as grid strikes without an exact one.
@@ -647,10 +677,22 @@ pub fn assemble(
         let unmatched_exact = push("miss_distance", &cmp.miss);
         let unmatched_exact_decided = push("miss_distance_decided", &cmp.miss_decided);
         push("miss_distance_blind", &cmp.miss_blind);
-        for (&d, &rim) in cmp.miss_decided.iter().zip(&cmp.miss_rim) {
+        for ((&d, &rim), &brief) in cmp
+            .miss_decided
+            .iter()
+            .zip(&cmp.miss_rim)
+            .zip(&cmp.miss_brief)
+        {
             // (Infinite ones, no grid strike in the start, are the
             // unmatched counts and the unmatched deflection's.)
-            if !rim && d.is_finite() {
+            if !d.is_finite() {
+                continue;
+            }
+            if rim {
+                unexplained.miss_rim = unexplained.miss_rim.max(d);
+            } else if brief {
+                unexplained.miss_brief = unexplained.miss_brief.max(d);
+            } else {
                 unexplained.miss_distance = unexplained.miss_distance.max(d);
             }
         }
@@ -679,6 +721,10 @@ pub fn assemble(
             "unmatched_deflection_decided",
             &cmp.unmatched_deflection_decided,
         );
+        unexplained.unmatched_deflection = cmp
+            .unmatched_deflection_inside
+            .iter()
+            .fold(unexplained.unmatched_deflection, |a, &d| a.max(d));
         push(
             "unmatched_deflection_blind",
             &cmp.unmatched_deflection_blind,
@@ -787,24 +833,37 @@ impl Comparison {
         let area = |f: &dyn Fn(&AreaDistance) -> f64| self.area.iter().map(f).fold(0.0, f64::max);
         // Each decided figure, the mechanism that may explain it, and what
         // is left of it where that mechanism does not (mm).
-        let none = (Unexplained, f64::INFINITY);
         let decided: [(&str, f64, (Mechanism, f64), Side); 7] = [
             (
                 "miss_distance_decided",
                 max("miss_distance_decided"),
-                (Rim, u.miss_distance),
+                (
+                    if u.miss_brief > u.miss_rim {
+                        Sampling
+                    } else {
+                        Rim
+                    },
+                    u.miss_distance,
+                ),
                 Side::Miss,
             ),
             (
                 "unmatched_deflection_decided",
                 max("unmatched_deflection_decided"),
-                none,
+                (Rim, u.unmatched_deflection),
                 Side::Miss,
             ),
             (
                 "area_miss_distance_decided",
                 area(&|a| a.miss_decided),
-                (Rim, u.area_miss_distance),
+                (
+                    if u.miss_brief > u.miss_rim {
+                        Sampling
+                    } else {
+                        Rim
+                    },
+                    u.area_miss_distance,
+                ),
                 Side::Miss,
             ),
             (
@@ -828,7 +887,14 @@ impl Comparison {
             (
                 "first_contact_error_decided",
                 max("first_contact_error_decided"),
-                (LevelError, u.first_contact_error),
+                (
+                    if u.first_contact_rim > u.first_contact_level_error {
+                        Rim
+                    } else {
+                        LevelError
+                    },
+                    u.first_contact_error,
+                ),
                 Side::Level,
             ),
         ];

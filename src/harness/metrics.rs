@@ -4,7 +4,7 @@
 use kneeform_oracle::{ContactPoint, FailureReason, LevelCurve, StartStatus, StartTrace};
 use serde::{Deserialize, Serialize};
 
-use super::causes::Cells;
+use super::causes::{Cells, RISE_REACH};
 use super::trace::GridTrace;
 
 /// The metric names, as the rows of `converge.csv` and the keys of
@@ -198,11 +198,14 @@ pub enum ExactRule {
     /// the exact contacts; before any travel, the push error, bounded by
     /// the rise at the push contact). The grid's drop is therefore at
     /// least the exact one, but for the node itself: the grid judges the
-    /// nodes near the touched point, the lowest of which within `sqrt 2`
-    /// pitches may still lie higher than it
-    /// ([`Cells::rise_of_lowest_near`]; measured on the console at 0.5 mm: a strike
-    /// on a facet crease 0.11 mm from a node, decided by a margin smaller
-    /// than the node's rise, missed by 5.6 mm). So a contact is a decided
+    /// nodes near the touched point that its slide meets, the lowest of
+    /// which within `sqrt 2` pitches (met by `sqrt 2` pitches more of
+    /// travel) may still lie higher than it, and where it met none it
+    /// cannot judge the point at all ([`Cells::rise_of_lowest_near`];
+    /// measured on the console at 0.5 mm: a strike on a facet crease
+    /// crossing the outline's rounded corner, 0.11 mm from a node the
+    /// outline reaches 3 mm of travel later, the nodes met by then 0.36 mm
+    /// higher, missed by 5.6 mm). So a contact is a decided
     /// strike when its drop exceeds `sigma W` by more than the drop's
     /// stated error plus that rise, a decided non-strike when it falls
     /// short by more than that error plus the bound of the grid's level
@@ -314,15 +317,28 @@ pub struct StartComparison {
     /// Whether a grid first strike earlier than the exact interval is
     /// explained by the level error.
     pub first_contact_explained: bool,
+    /// What is left of a grid first strike later than the exact interval
+    /// once the decided exact strikes in the knee-form's rim are set
+    /// aside (mm, `>= 0`): the grid's first strike against the first
+    /// decided exact strike inside its footprint. `None` unless the grid
+    /// strikes late.
+    pub first_contact_late_inside: Option<f64>,
     /// For each exact strike, the xz distance to the nearest grid strike of
     /// the same start (mm); `+inf` where the grid has none.
     pub miss: Vec<f64>,
     /// The same for each decided exact strike not downstream of a blind
     /// spot.
     pub miss_decided: Vec<f64>,
-    /// Whether each of those lies in the knee-form's rim, outside the
-    /// grid's footprint at its travel ([`Cells::outside_footprint`]).
+    /// Whether each of those lies in the knee-form's rim: the slide meets
+    /// no node of the part near it by [`MEETING_REACH`] pitches more of
+    /// travel ([`Cells::samples_near`]).
     pub miss_rim: Vec<bool>,
+    /// Whether each of those is brief: the exact knee-form touches within
+    /// `sqrt 2` pitches of it for less than [`MEETING_REACH`] pitches of
+    /// travel, and then touches elsewhere (a drop under another part of
+    /// the knee-form): shorter than the travel the grid needs to meet a
+    /// node there, a sampling error in travel.
+    pub miss_brief: Vec<bool>,
     /// The same for each exact strike downstream of one, decided or not
     /// (blind is a category beside decided and undecided).
     pub miss_blind: Vec<f64>,
@@ -344,6 +360,8 @@ pub struct StartComparison {
     pub unmatched_deflection: Vec<f64>,
     /// The same for decided exact strikes not downstream of a blind spot.
     pub unmatched_deflection_decided: Vec<f64>,
+    /// The same for those inside the grid's footprint (not in the rim).
+    pub unmatched_deflection_inside: Vec<f64>,
     /// The same for exact strikes downstream of one, decided or not.
     pub unmatched_deflection_blind: Vec<f64>,
     /// For each grid strike not downstream of a blind spot: how far its
@@ -502,7 +520,8 @@ pub struct LevelErrorBound<'a> {
     curve: LevelCurve<'a>,
     travels: Vec<f64>,
     rises: Vec<f64>,
-    /// Per contact, the rise of the lowest node near it
+    /// Per contact, the rise of the lowest node near it that the slide met
+    /// by [`MEETING_REACH`] pitches more of travel
     /// ([`Cells::rise_of_lowest_near`]).
     lowest: Vec<f64>,
     push_rise: f64,
@@ -514,38 +533,51 @@ impl<'a> LevelErrorBound<'a> {
     /// the footprint rows `push_rows` ([`GridTrace::push_rows`]); `None`
     /// for a start that is not placed or failed.
     ///
-    /// Where no node of the part under the knee-form at the push lies
-    /// within `sqrt 2` pitches of the exact push contact (the knee-form's
-    /// rim cuts a sliver of the part, or an edge, narrower than the pitch),
-    /// the grid cannot sample what the exact knee-form rests on: the push
-    /// contact's rise is unbounded at this pitch (a finer grid samples it).
+    /// Where no node of the part under the knee-form lies within `sqrt 2`
+    /// pitches of an exact contact (at the push, or at the contact's
+    /// travel: the knee-form's rim cuts a sliver of the part, or an edge,
+    /// narrower than the pitch, or runs along the slide there), the grid
+    /// cannot sample what the exact knee-form rests on: that contact's
+    /// rise is unbounded at this pitch (a finer grid samples it).
     pub fn of(
         exact: &'a StartTrace,
         cells: &Cells,
-        push_rows: &[(usize, i64, i64)],
+        push_rows: &[super::trace::FootprintSpan],
     ) -> Option<LevelErrorBound<'a>> {
         let curve = LevelCurve::of(exact)?;
+        let pitch = cells.pitch();
+        // The nodes the slide has met near a touched point, or meets within
+        // about a pitch more of travel (a node ahead of the leading edge):
+        // not one the outline reaches only later, where it runs almost
+        // along the slide.
+        let ahead = |c: &ContactPoint| c.travel + MEETING_REACH * pitch;
         Some(LevelErrorBound {
             curve,
             travels: exact.contacts.iter().map(|c| c.travel).collect(),
             rises: exact
                 .contacts
                 .iter()
-                .map(|c| cells.rise_near(c.witness))
+                .map(|c| {
+                    if cells.samples_near(c.witness, push_rows, ahead(c)) {
+                        cells.rise_near(c.witness)
+                    } else {
+                        f64::INFINITY
+                    }
+                })
                 .collect(),
             lowest: exact
                 .contacts
                 .iter()
-                .map(|c| cells.rise_of_lowest_near(c.witness))
+                .map(|c| cells.rise_of_lowest_near(c.witness, push_rows, ahead(c)))
                 .collect(),
             push_rise: exact.push_witness.map_or(0.0, |w| {
-                if cells.samples_near(w, push_rows) {
+                if cells.samples_near(w, push_rows, 0.0) {
                     cells.rise_near(w)
                 } else {
                     f64::INFINITY
                 }
             }),
-            pitch: cells.pitch(),
+            pitch,
         })
     }
 
@@ -600,6 +632,40 @@ impl<'a> LevelErrorBound<'a> {
 /// A clearance within its bound, up to rounding (mm).
 const LEVEL_TOL: f64 = 1e-6;
 
+/// How much more travel than an exact contact's (in pitches) the grid may
+/// take to meet a node near the touched point and still be judging that
+/// point: a node ahead of the footprint within [`RISE_REACH`] pitches is
+/// met within about as much more travel. A node the footprint meets only
+/// later (where the knee-form's outline runs almost along the slide, a
+/// crease crossing its rounded corner: 3 mm later for a node 0.11 mm from
+/// the touched point on the console at 0.5 mm) judges another contact.
+pub const MEETING_REACH: f64 = RISE_REACH;
+
+/// Whether the exact contact `k` of `contacts` (a start's, in travel
+/// order) is brief at pitch `pitch`: the run of contacts around it whose
+/// witnesses lie within `sqrt 2` pitches of its own spans less than
+/// [`MEETING_REACH`] pitches of travel, and a contact elsewhere follows
+/// it. On the teapot at 1.24 mm the knee-form rode a crest at the push
+/// contact for 0.43 mm of travel, then its far end met a riser that
+/// dropped the level 2 mm: the grid met the nodes by the crest only
+/// after that, clear of them.
+fn brief(contacts: &[ContactPoint], k: usize, pitch: f64) -> bool {
+    let c = &contacts[k];
+    let reach = RISE_REACH * pitch + LEVEL_TOL;
+    let near = |d: &ContactPoint| {
+        (d.witness[0] - c.witness[0]).hypot(d.witness[2] - c.witness[2]) <= reach
+    };
+    let first = contacts[..k]
+        .iter()
+        .rev()
+        .take_while(|d| near(d))
+        .last()
+        .unwrap_or(c);
+    let run = contacts[k..].iter().take_while(|d| near(d)).count();
+    let last = &contacts[k + run - 1];
+    k + run < contacts.len() && last.travel - first.travel < MEETING_REACH * pitch
+}
+
 /// Compares a grid trace with the exact trace of the same start and angle.
 ///
 /// **Strikes on both sides.** The grid's strikes are SPEC's (rule 2 of the
@@ -632,7 +698,14 @@ pub fn compare(
     cells: &Cells,
 ) -> StartComparison {
     let placed = exact.status == StartStatus::Placed;
-    let bound = LevelErrorBound::of(exact, cells, &grid.push_rows);
+    // A start the grid did not place never slides: it meets no node, and
+    // judges none of the exact contacts.
+    let rows: &[super::trace::FootprintSpan] = if grid.yr.is_finite() {
+        &grid.push_rows
+    } else {
+        &[]
+    };
+    let bound = LevelErrorBound::of(exact, cells, rows);
     let classified = match &bound {
         Some(bound) => classify(exact, band, rule, bound),
         None => Vec::new(),
@@ -691,13 +764,23 @@ pub fn compare(
     };
     let decided_strike = |c: &ExactStrike| c.decision == Decision::Strike;
     let in_rim = |c: &ExactStrike| {
-        cells.outside_footprint(c.contact.witness, &grid.push_rows, c.contact.travel)
+        !cells.samples_near(
+            c.contact.witness,
+            rows,
+            c.contact.travel + MEETING_REACH * cells.pitch(),
+        )
     };
-    let decided_away: Vec<&ExactStrike> = classified
+    // The decided strikes away from blind spots, with their indices.
+    let decided_away: Vec<(usize, &ExactStrike)> = classified
         .iter()
-        .filter(|c| decided_strike(c) && !is_blind(c.contact.travel))
+        .enumerate()
+        .filter(|(_, c)| decided_strike(c) && !is_blind(c.contact.travel))
         .collect();
-    let miss_rim: Vec<bool> = decided_away.iter().map(|c| in_rim(c)).collect();
+    let miss_rim: Vec<bool> = decided_away.iter().map(|(_, c)| in_rim(c)).collect();
+    let miss_brief: Vec<bool> = decided_away
+        .iter()
+        .map(|&(k, _)| brief(&exact.contacts, k, cells.pitch()))
+        .collect();
     let pts = StartPoints {
         grid: grid.colliding.iter().map(|c| xz(c.point)).collect(),
         grid_decided,
@@ -708,9 +791,9 @@ pub fn compare(
         blind: points(&|c| c.strike && is_blind(c.contact.travel)),
         decided_inside: decided_away
             .iter()
-            .zip(&miss_rim)
-            .filter(|(_, rim)| !**rim)
-            .map(|(c, _)| xz(c.contact.witness))
+            .zip(miss_rim.iter().zip(&miss_brief))
+            .filter(|(_, (rim, brief))| !**rim && !**brief)
+            .map(|((_, c), _)| xz(c.contact.witness))
             .collect(),
         possible: points(&|c| c.decision != Decision::NoStrike),
         push,
@@ -759,6 +842,20 @@ pub fn compare(
             _ => None,
         };
     let first_blind = first_decided_error.is_some_and(|(_, at)| is_blind(at));
+    // A late grid first strike where the exact strikes before it lie in
+    // the rim, outside the footprint (an exact strike on a sliver of the
+    // part the grid's rows never reach): the late part is the rim's.
+    let first_contact_late_inside = match (first_decided_error, grid_first) {
+        (Some((e, _)), Some(g)) if e > 0.0 && !first_blind => Some(
+            classified
+                .iter()
+                .find(|c| {
+                    c.decision == Decision::Strike && !is_blind(c.contact.travel) && !in_rim(c)
+                })
+                .map_or(0.0, |c| (g.travel - c.contact.travel).clamp(0.0, e)),
+        ),
+        _ => None,
+    };
     let first_of = |blind: bool| {
         first_decided_error
             .filter(|_| first_blind == blind)
@@ -788,9 +885,11 @@ pub fn compare(
         first_contact_error_decided: first_of(false),
         first_contact_error_blind: first_of(true),
         first_contact_explained: first_grid_explained,
+        first_contact_late_inside,
         miss: miss_of(&pts.strikes),
         miss_decided: miss_of(&pts.decided),
         miss_rim,
+        miss_brief,
         miss_blind: miss_of(&pts.blind),
         false_alarm: false_alarm_of(grid_points, &strikes_or_push),
         false_alarm_decided: false_alarm_of(&pts.grid_decided, &possible_or_push),
@@ -799,6 +898,9 @@ pub fn compare(
         unmatched_deflection: deflection(&|c| c.strike),
         unmatched_deflection_decided: deflection(&|c| {
             decided_strike(c) && !is_blind(c.contact.travel)
+        }),
+        unmatched_deflection_inside: deflection(&|c| {
+            decided_strike(c) && !is_blind(c.contact.travel) && !in_rim(c)
         }),
         unmatched_deflection_blind: deflection(&|c| c.strike && is_blind(c.contact.travel)),
         level_clearance,

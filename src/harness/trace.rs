@@ -43,9 +43,39 @@ pub struct GridTrace {
     pub yr: f64,
     /// The colliding nodes in the order they are met.
     pub colliding: Vec<GridContact>,
-    /// The footprint's nodes at the push, per row of the grid: `(j, i_lo,
-    /// i_hi)` (columns inclusive, not clipped to the grid).
-    pub push_rows: Vec<(usize, i64, i64)>,
+    /// The footprint's rows at the push, one per row of the grid.
+    pub push_rows: Vec<FootprintSpan>,
+}
+
+/// One row of a start's footprint at the push.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FootprintSpan {
+    /// The grid row.
+    pub j: usize,
+    /// The columns under the knee-form at the push, `lo..=hi` (inclusive,
+    /// not clipped to the grid; empty when `hi < lo`).
+    pub lo: i64,
+    /// See `lo`.
+    pub hi: i64,
+    /// Where the knee-form's outline crosses the row in front at the push
+    /// (x, mm): the slide meets a node of the row in front, column `i <
+    /// lo`, after `front - x(i)` mm of travel.
+    pub front: f64,
+}
+
+impl FootprintSpan {
+    /// The travel (mm) at which the slide meets column `i` of this row,
+    /// whose x is `x_i`: 0 under the knee-form at the push, when its
+    /// outline reaches it in front, never (`None`) behind the footprint.
+    pub fn meets(&self, i: i64, x_i: f64) -> Option<f64> {
+        if i > self.hi {
+            None
+        } else if i >= self.lo {
+            Some(0.0)
+        } else {
+            Some((self.front - x_i).max(0.0))
+        }
+    }
 }
 
 /// Pushes and slides the start at node `(i0, j0)`, with an optional fault.
@@ -67,23 +97,32 @@ pub(crate) fn grid_trace(
     };
     let h = |i: usize, j: usize| grid.at(i, j) + offset;
     let leading = fp.rows.iter().min_by_key(|r| (r.kf, r.dj)).map(|r| r.dj);
+    let on_grid = |r: &crate::kneeform::FootprintRow| {
+        let j = j0 as i64 + i64::from(r.dj);
+        (0..spec.nz as i64).contains(&j).then_some((*r, j as usize))
+    };
+    // The footprint as SPEC has it, whatever fault the slide below
+    // injects: what the harness judges the grid by comes from here, never
+    // from the slide under test.
+    let push_rows = fp
+        .rows
+        .iter()
+        .filter_map(on_grid)
+        .map(|(row, j)| FootprintSpan {
+            j,
+            lo: i0 as i64 + i64::from(row.klo),
+            hi: i0 as i64 + i64::from(row.khi),
+            front: spec.x(i0) + f64::from(row.kf) * p + row.d0,
+        })
+        .collect();
     let rows = fp
         .rows
         .iter()
         .filter(|r| !(fault == Some(Fault::FootprintRowShort) && Some(r.dj) == leading))
-        .filter_map(|r| {
-            let j = j0 as i64 + i64::from(r.dj);
-            (0..spec.nz as i64).contains(&j).then_some((r, j as usize))
-        });
+        .filter_map(on_grid);
     let mut yr = f64::INFINITY;
     let mut front: Vec<(f64, usize, usize)> = Vec::new();
-    let mut push_rows = Vec::new();
     for (row, j) in rows {
-        push_rows.push((
-            j,
-            i0 as i64 + i64::from(row.klo),
-            i0 as i64 + i64::from(row.khi),
-        ));
         for k in row.klo..=row.khi {
             let i = i0 as i64 + i64::from(k);
             if (0..spec.nx as i64).contains(&i) {

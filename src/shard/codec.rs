@@ -68,6 +68,7 @@ pub(super) fn put_pair(out: &mut Vec<u8>, pair: &PairResult) {
         c.first_contact_error,
         c.first_contact_error_decided,
         c.first_contact_error_blind,
+        c.first_contact_late_inside,
     ] {
         put_opt(out, v);
     }
@@ -82,13 +83,14 @@ pub(super) fn put_pair(out: &mut Vec<u8>, pair: &PairResult) {
         &c.false_alarm_blind,
         &c.unmatched_deflection,
         &c.unmatched_deflection_decided,
+        &c.unmatched_deflection_inside,
         &c.unmatched_deflection_blind,
         &c.level_clearance,
         &c.level_bound,
     ] {
         put_f64s(out, v);
     }
-    for flags in [&c.false_alarm_explained, &c.miss_rim] {
+    for flags in [&c.false_alarm_explained, &c.miss_rim, &c.miss_brief] {
         put_u64(out, flags.len() as u64);
         out.extend(flags.iter().map(|&b| u8::from(b)));
     }
@@ -288,6 +290,7 @@ impl<'a> Reader<'a> {
         let (push_error, first_contact_error, first_contact_error_decided) =
             (self.opt()?, self.opt()?, self.opt()?);
         let first_contact_error_blind = self.opt()?;
+        let first_contact_late_inside = self.opt()?;
         let flags = self.u8()?;
         if flags >> 4 != 0 {
             return Err(format!("pair flags {flags}"));
@@ -308,6 +311,7 @@ impl<'a> Reader<'a> {
             first_contact_error_decided,
             first_contact_error_blind,
             first_contact_explained: flags & 8 != 0,
+            first_contact_late_inside,
             miss: self.f64s()?,
             miss_decided: self.f64s()?,
             miss_blind: self.f64s()?,
@@ -316,11 +320,13 @@ impl<'a> Reader<'a> {
             false_alarm_blind: self.f64s()?,
             unmatched_deflection: self.f64s()?,
             unmatched_deflection_decided: self.f64s()?,
+            unmatched_deflection_inside: self.f64s()?,
             unmatched_deflection_blind: self.f64s()?,
             level_clearance: self.f64s()?,
             level_bound: self.f64s()?,
             false_alarm_explained: self.bools()?,
             miss_rim: self.bools()?,
+            miss_brief: self.bools()?,
             oracle_failure,
             exact_strikes: self.len()?,
             undecided: self.len()?,
@@ -353,9 +359,11 @@ mod tests {
             first_contact_error_decided: Some(f64::MIN_POSITIVE),
             first_contact_error_blind: Some(-2.0),
             first_contact_explained: true,
+            first_contact_late_inside: Some(0.75),
             miss: vec![1.5, f64::INFINITY],
             miss_decided: vec![f64::INFINITY],
             miss_rim: vec![true],
+            miss_brief: vec![false],
             miss_blind: vec![0.5],
             false_alarm: vec![0.1 + 0.2, 7.0],
             false_alarm_decided: vec![0.3],
@@ -363,6 +371,7 @@ mod tests {
             false_alarm_blind: vec![7.0],
             unmatched_deflection: vec![3.0],
             unmatched_deflection_decided: vec![-0.0],
+            unmatched_deflection_inside: vec![2.5],
             unmatched_deflection_blind: Vec::new(),
             level_clearance: vec![0.01],
             level_bound: vec![0.25],

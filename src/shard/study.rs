@@ -71,9 +71,9 @@ pub struct StudyRecord {
 }
 
 /// The format [`write_study_shard`] writes and [`merge_study`] reads.
-pub const FORMAT: u32 = 2;
+pub const FORMAT: u32 = 3;
 
-const MAGIC: &[u8; 16] = b"kneeform study 2";
+const MAGIC: &[u8; 16] = b"kneeform study 3";
 
 /// The largest `shard.bin` read (bytes): far beyond a study's (a few
 /// hundred bytes per start and angle), short of exhausting memory.
