@@ -81,6 +81,18 @@ pub enum MeshError {
         /// Its largest coordinate (mm, absolute).
         distance: f64,
     },
+    /// A vertex lies beyond [`crate::limits::MAX_COORD_MM`] once placed by
+    /// the part's frame (`--frame`).
+    #[error("{path}: triangle {index} lies {} mm from the origin once placed by --frame, beyond the {} mm a part may span (a translation in the wrong unit?)", crate::limits::short(*distance), crate::limits::short(crate::limits::MAX_COORD_MM))]
+    PlacedTooFar {
+        /// The file.
+        path: String,
+        /// The triangle's index in the file.
+        index: usize,
+        /// Its largest coordinate once placed (mm, absolute; `inf` for a
+        /// non-finite one).
+        distance: f64,
+    },
     /// The file holds more triangles than [`crate::limits::MAX_PART_TRIANGLES`].
     #[error(
         "{path} holds {count} triangles, more than the {} a part may have",
@@ -469,6 +481,30 @@ pub fn read_part_placed(
     let mut file = read_part(path, scale, Side::Left)?;
     for v in file.part.triangles.iter_mut().flatten() {
         *v = placement.to_analysis(*v);
+    }
+    // Whatever the frame holds (a translation of 1e17 mm collapses the
+    // part in f64 and still ran), the placed part obeys the bound the
+    // file's own coordinates do.
+    let reach = |t: &Triangle| {
+        t.iter().flatten().fold(0.0f64, |m, c| {
+            if c.is_finite() {
+                m.max(c.abs())
+            } else {
+                f64::INFINITY
+            }
+        })
+    };
+    if let Some(index) = file
+        .part
+        .triangles
+        .iter()
+        .position(|t| reach(t) > crate::limits::MAX_COORD_MM)
+    {
+        return Err(MeshError::PlacedTooFar {
+            path: path.display().to_string(),
+            index,
+            distance: reach(&file.part.triangles[index]),
+        });
     }
     file.side = placement.side;
     file.frame = placement.frame.clone();

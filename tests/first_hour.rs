@@ -306,7 +306,9 @@ fn an_existing_out_is_refused_without_force_and_replaced_whole_with_it() {
     step_part(&dir, "part.stl");
     ok(kneeform(&dir, &quick("part.stl", "run", &[])), "first run");
     let before = std::fs::read(dir.join("run/summary.json")).unwrap();
-    std::fs::write(dir.join("run/stale.txt"), "from an earlier run").unwrap();
+    // A file of an earlier run that this one does not write (it was run
+    // with --points).
+    std::fs::write(dir.join("run/colliding_points.csv"), "from an earlier run").unwrap();
 
     let out = kneeform(&dir, &quick("part.stl", "run", &[]));
     refused(&out, "--force", "second run without --force");
@@ -317,7 +319,10 @@ fn an_existing_out_is_refused_without_force_and_replaced_whole_with_it() {
         "--force",
     );
     let files = entries(&dir.join("run"));
-    assert!(!files.contains(&"stale.txt".to_string()), "{files:?}");
+    assert!(
+        !files.contains(&"colliding_points.csv".to_string()),
+        "{files:?}"
+    );
     assert!(files.contains(&"summary.json".to_string()), "{files:?}");
     // Nothing staged or set aside is left beside it.
     assert_eq!(entries(&dir), ["part.stl", "run"]);
@@ -328,6 +333,15 @@ fn an_existing_out_is_refused_without_force_and_replaced_whole_with_it() {
     let out = kneeform(&dir, &quick("part.stl", "photos", &["--force"]));
     refused(&out, "not a kneeform run directory", "--force on photos");
     assert_eq!(entries(&dir.join("photos")), ["holiday.jpg"]);
+    // Nor a run directory holding a file kneeform did not write.
+    std::fs::write(dir.join("run/notes.txt"), "mine").unwrap();
+    let out = kneeform(&dir, &quick("part.stl", "run", &["--force"]));
+    refused(
+        &out,
+        "notes.txt, which kneeform did not write",
+        "--force on notes",
+    );
+    assert!(dir.join("run/notes.txt").is_file());
     std::fs::remove_dir_all(dir).unwrap();
 }
 

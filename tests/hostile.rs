@@ -584,3 +584,212 @@ fn every_body_of_an_ascii_stl_is_analysed_and_verified() {
     assert_eq!(v2["counts"], v1["counts"]);
     assert_eq!(v2["metrics"], v1["metrics"]);
 }
+
+/// Issue 25, item 2: a `--frame` matrix whose translation puts the part
+/// beyond the 10 km a part may span ran with exit 0 (1e17 mm: 25 struck
+/// nodes instead of 39; 1e18: none, a collapsed box). The placed part is
+/// bounded as the file's own coordinates are, for `analyze` and `verify`
+/// alike; a translation within the bound still runs.
+#[test]
+fn a_frame_placing_the_part_beyond_the_bound_is_refused() {
+    let dir = scratch_dir("hostile-frame-bound");
+    let part = scenario("bump");
+    for offset in ["1e12", "1e17", "1e18"] {
+        let matrix = dir.join(format!("shift_{offset}.txt"));
+        std::fs::write(
+            &matrix,
+            format!("1 0 0 {offset}\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"),
+        )
+        .unwrap();
+        let frame = format!("@{}", matrix.display());
+        for command in ["analyze", "verify"] {
+            let out = dir.join(format!("{command}_{offset}"));
+            let o = kneeform(&[
+                command,
+                &part,
+                "--frame",
+                &frame,
+                "--out",
+                &out.display().to_string(),
+                "--pitch",
+                "4",
+                "--angles=0",
+            ]);
+            let err = assert_refused(&o, &dir, &format!("{command} {offset}"));
+            assert!(err.contains("once placed by --frame"), "{err}");
+            assert!(!out.exists(), "{command} {offset}: wrote {}", out.display());
+        }
+    }
+    // A shift of 1 km is a placement, not a mistake.
+    let matrix = dir.join("shift_1km.txt");
+    std::fs::write(&matrix, "1 0 0 1e6\n0 1 0 0\n0 0 1 0\n0 0 0 1\n").unwrap();
+    run_ok(&[
+        "analyze",
+        &part,
+        "--frame",
+        &format!("@{}", matrix.display()),
+        "--out",
+        &dir.join("ok").display().to_string(),
+        "--pitch",
+        "4",
+        "--angles=0",
+    ]);
+}
+
+/// Issue 25, item 13: `--force` deleted a user's folder that merely held
+/// a file named `summary.json` beside their own (`thesis.tex`). Only a
+/// directory of kneeform's files is replaced; the user's folder is left
+/// as it was, with a one-line refusal naming the file. A run with its
+/// report beside it is still replaced.
+#[test]
+fn force_replaces_only_a_directory_of_kneeform_files() {
+    let dir = scratch_dir("hostile-force-foreign");
+    let folder = dir.join("thesis");
+    std::fs::create_dir_all(folder.join("figures")).unwrap();
+    std::fs::write(folder.join("summary.json"), "{}").unwrap();
+    std::fs::write(folder.join("thesis.tex"), "\\documentclass{article}").unwrap();
+    let o = kneeform(&[
+        "analyze",
+        &scenario("bump"),
+        "--out",
+        &folder.display().to_string(),
+        "--force",
+        "--pitch",
+        "4",
+        "--angles=0",
+    ]);
+    let err = assert_refused(&o, &dir, "a user's folder");
+    assert!(
+        err.contains("figures") || err.contains("thesis.tex"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(folder.join("summary.json")).unwrap(),
+        "{}"
+    );
+    assert!(folder.join("thesis.tex").is_file());
+    assert!(folder.join("figures").is_dir());
+    // A subdirectory alone is enough to refuse.
+    std::fs::remove_file(folder.join("thesis.tex")).unwrap();
+    let o = kneeform(&[
+        "analyze",
+        &scenario("bump"),
+        "--out",
+        &folder.display().to_string(),
+        "--force",
+        "--pitch",
+        "4",
+        "--angles=0",
+    ]);
+    assert!(assert_refused(&o, &dir, "a subdirectory").contains("figures"));
+    // A run with its report beside it is kneeform's own: replaced.
+    let run = dir.join("run");
+    small_run(&run, &[]);
+    std::fs::write(run.join("report.html"), "<html></html>").unwrap();
+    small_run(&run, &["--force"]);
+    assert!(!run.join("report.html").exists(), "replaced whole");
+}
+
+/// Runs `kneeform batch` on `manifest`, returning its output.
+fn batch(manifest: &Path) -> Output {
+    kneeform(&["batch", &manifest.display().to_string()])
+}
+
+/// Issue 25, item 6: a batch item's fingerprint left out the files its
+/// arguments name (`--ignore FILE`, `--frame @FILE`, a second part among
+/// `args`), so after one of them changed the item was skipped on stale
+/// results. Each change now runs the item again; an unchanged batch still
+/// skips it.
+#[test]
+fn a_batch_item_runs_again_when_any_of_its_input_files_changes() {
+    let dir = scratch_dir("hostile-batch-inputs");
+    std::fs::copy(scenario("bump"), dir.join("bump.toml")).unwrap();
+    std::fs::copy(scenario("wave"), dir.join("soft.toml")).unwrap();
+    std::fs::write(
+        dir.join("frame.txt"),
+        "1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n",
+    )
+    .unwrap();
+    let manifest = dir.join("manifest.toml");
+    std::fs::write(
+        &manifest,
+        r#"[defaults]
+pitch = 4
+angles = "0"
+
+[[item]]
+part = "bump.toml"
+out = "runs/bump"
+args = ["--ignore", "soft.toml", "--frame", "@frame.txt"]
+"#,
+    )
+    .unwrap();
+    let ran = |what: &str| {
+        let o = batch(&manifest);
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert!(o.status.success(), "{what}: {err}");
+        err.contains("1 items run")
+    };
+    assert!(ran("first"));
+    assert!(!ran("unchanged"), "an unchanged item is skipped");
+    // The ignored file changes (a softer part, still disregarded).
+    std::fs::write(
+        dir.join("soft.toml"),
+        std::fs::read_to_string(scenario("wave")).unwrap() + "\n# edited\n",
+    )
+    .unwrap();
+    assert!(ran("--ignore's file changed"));
+    // The frame file changes (a shift of 10 mm).
+    std::fs::write(
+        dir.join("frame.txt"),
+        "1 0 0 10\n0 1 0 0\n0 0 1 0\n0 0 0 1\n",
+    )
+    .unwrap();
+    assert!(ran("--frame's file changed"));
+    assert!(!ran("unchanged again"));
+}
+
+/// Issue 25, items 7 and 11: two items writing one directory (`dd/x` and
+/// `./dd/x`) replaced each other's result and both ran again on every
+/// resume; a part that is a FIFO hung the batch (its fingerprint drained
+/// the pipe). Both manifests are refused in one line before any work.
+#[test]
+fn a_batch_with_two_items_on_one_directory_or_a_fifo_part_is_refused() {
+    let dir = scratch_dir("hostile-batch-outs");
+    std::fs::copy(scenario("bump"), dir.join("bump.toml")).unwrap();
+    let manifest = dir.join("manifest.toml");
+    for (a, b) in [
+        ("dd/x", "./dd/x"),
+        ("dd/x", "dd/../dd/x"),
+        ("dd/x", "dd/x/"),
+    ] {
+        std::fs::write(
+            &manifest,
+            format!(
+                "[defaults]\npitch = 4\nangles = \"0\"\n\n[[item]]\npart = \"bump.toml\"\nout = \"{a}\"\n\n[[item]]\npart = \"bump.toml\"\nout = \"{b}\"\n"
+            ),
+        )
+        .unwrap();
+        let err = assert_refused(&batch(&manifest), &dir, &format!("{a} and {b}"));
+        assert!(err.contains("item 2") && err.contains("item 1"), "{err}");
+        assert!(!dir.join("dd").exists(), "{a} and {b}: ran before refusing");
+    }
+    #[cfg(unix)]
+    {
+        let fifo = dir.join("pipe.stl");
+        assert!(
+            Command::new("mkfifo")
+                .arg(&fifo)
+                .status()
+                .unwrap()
+                .success()
+        );
+        std::fs::write(
+            &manifest,
+            "[[item]]\npart = \"pipe.stl\"\nout = \"fifo\"\npitch = 4\n",
+        )
+        .unwrap();
+        let err = assert_refused(&batch(&manifest), &dir, "a FIFO part");
+        assert!(err.contains("not a regular file"), "{err}");
+    }
+}

@@ -763,7 +763,7 @@ fn a_bad_manifest_is_one_line() {
         ("", "no [[item]]"),
         (
             "[[item]]\npart = \"a.stl\"\nout = \"r\"\n[[item]]\npart = \"b.stl\"\nout = \"r\"\n",
-            "as an earlier item",
+            "the directory item 1 writes to",
         ),
         (
             "[[item]]\npart = \"missing.stl\"\nout = \"r\"\n",

@@ -25,6 +25,7 @@ fn smooth_part() -> PartFile {
         file_triangles: triangles.len(),
         triangles,
         degenerate: 0,
+        bodies: 1,
     };
     PartFile::in_memory("smooth-facing-plus-x", part)
 }

@@ -238,7 +238,8 @@ pub struct AnalyzeArgs {
     pub out: PathBuf,
     /// Replace an existing --out directory of an earlier run (one holding
     /// summary.json, a study's verify.json or converge.json, or a shard's
-    /// shard.json; or empty) with this run's results, whole.
+    /// shard.json, and no file kneeform did not write; or empty) with this
+    /// run's results, whole.
     #[arg(long)]
     pub force: bool,
     /// Also write the evidence report, `report.html`, into the output
@@ -286,7 +287,8 @@ pub struct MergeArgs {
     pub out: PathBuf,
     /// Replace an existing --out directory of an earlier run (one holding
     /// summary.json, a study's verify.json or converge.json, or a shard's
-    /// shard.json; or empty) with the merged results, whole.
+    /// shard.json, and no file kneeform did not write; or empty) with the
+    /// merged results, whole.
     #[arg(long)]
     pub force: bool,
     /// Also write colliding_points.csv (as `analyze --points-csv`; an

@@ -108,15 +108,19 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let mut outs = std::collections::BTreeSet::new();
+    // Outputs compared as the directories they are (`dd/x`, `./dd/x` and
+    // `dd/../dd/x` are one): two items on one directory would replace
+    // each other's result and both run again on every resume.
+    let mut outs = std::collections::BTreeMap::new();
     for (k, item) in manifest.items.iter().enumerate() {
-        ensure!(
-            outs.insert(&item.out),
-            "manifest {}: item {} writes to {}, as an earlier item does",
-            args.manifest.display(),
-            k + 1,
-            item.out.display()
-        );
+        if let Some(earlier) = outs.insert(resolved(&base.join(&item.out)), k + 1) {
+            bail!(
+                "manifest {}: item {} writes to {}, the directory item {earlier} writes to",
+                args.manifest.display(),
+                k + 1,
+                item.out.display()
+            );
+        }
     }
     let exe = std::env::current_exe().context("cannot find this kneeform binary")?;
     let total = manifest.items.len();
@@ -178,8 +182,44 @@ fn is_done(out: &Path, fingerprint: &str) -> bool {
     complete && recorded.is_some_and(|r| r.fingerprint == fingerprint)
 }
 
-/// SHA-256 over this kneeform's version, `argv` and each part file's
-/// SHA-256.
+/// `path` made absolute and normal: `.` and `..` resolved, and the part
+/// of it that exists followed through links (the rest kept as written).
+fn resolved(path: &Path) -> PathBuf {
+    use std::path::Component;
+    let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    let mut normal = PathBuf::new();
+    for c in absolute.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                normal.pop();
+            }
+            c => normal.push(c),
+        }
+    }
+    // The longest existing ancestor, canonical, with the rest after it.
+    let mut rest = Vec::new();
+    let mut head = normal.as_path();
+    loop {
+        if let Ok(real) = head.canonicalize() {
+            return rest.iter().rev().fold(real, |p, c| p.join(c));
+        }
+        match (head.file_name(), head.parent()) {
+            (Some(name), Some(parent)) => {
+                rest.push(name.to_os_string());
+                head = parent;
+            }
+            _ => return normal,
+        }
+    }
+}
+
+/// SHA-256 over this kneeform's version, `argv` and the SHA-256 of every
+/// input file of the item: its parts, and every file an argument names
+/// (`--ignore FILE`, `--frame @FILE`, a part path among `args`; an
+/// argument naming a regular file, relative to the manifest's directory,
+/// counts whatever flag it belongs to). A part that is not a regular file
+/// (a FIFO, a device) is refused: it would be read twice, or for ever.
 fn fingerprint(base: &Path, parts: &[PathBuf], argv: &[String]) -> anyhow::Result<String> {
     let mut hash = Sha256::new();
     hash.update(env!("CARGO_PKG_VERSION").as_bytes());
@@ -187,11 +227,35 @@ fn fingerprint(base: &Path, parts: &[PathBuf], argv: &[String]) -> anyhow::Resul
         hash.update((a.len() as u64).to_le_bytes());
         hash.update(a.as_bytes());
     }
+    let read = |path: &Path| -> anyhow::Result<String> {
+        let bytes = kneeform::limits::read_bounded(path, kneeform::limits::MAX_PART_FILE_BYTES)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        Ok(kneeform::mesh::sha256_hex(&bytes))
+    };
     for p in parts {
         let path = base.join(p);
-        let bytes = kneeform::limits::read_bounded(&path, kneeform::limits::MAX_PART_FILE_BYTES)
+        let meta = std::fs::metadata(&path)
             .with_context(|| format!("cannot read the part {}", path.display()))?;
-        hash.update(kneeform::mesh::sha256_hex(&bytes).as_bytes());
+        ensure!(
+            meta.is_file(),
+            "the part {} is not a regular file",
+            path.display()
+        );
+        hash.update(read(&path)?.as_bytes());
+    }
+    // Every other file an argument names.
+    for a in argv.iter().skip(1) {
+        let value = a.split_once('=').map_or(a.as_str(), |(_, v)| v);
+        let value = value.strip_prefix('@').unwrap_or(value);
+        if value.is_empty() || parts.iter().any(|p| p.as_os_str() == value) {
+            continue;
+        }
+        let path = base.join(value);
+        if std::fs::metadata(&path).is_ok_and(|m| m.is_file()) {
+            hash.update((value.len() as u64).to_le_bytes());
+            hash.update(value.as_bytes());
+            hash.update(read(&path)?.as_bytes());
+        }
     }
     Ok(hash.finalize().iter().map(|b| format!("{b:02x}")).collect())
 }

@@ -163,7 +163,9 @@ pub fn stage_output(out: &Path, force: bool) -> anyhow::Result<OutputDir> {
                 "--out {} already exists: pass --force to replace it, or choose another --out",
                 out.display()
             );
-            // A run's directory, a study's, or a shard's.
+            // A run's directory, a study's, or a shard's, holding nothing
+            // but kneeform's files: a folder of the user's with a
+            // summary.json beside their own files is not replaced.
             let is_run = ["summary.json", "shard.json", "verify.json", "converge.json"]
                 .iter()
                 .any(|f| out.join(f).is_file());
@@ -176,6 +178,15 @@ pub fn stage_output(out: &Path, force: bool) -> anyhow::Result<OutputDir> {
                 "--out {} is not a kneeform run directory (no summary.json, verify.json, converge.json or shard.json), so --force will not replace it: choose another --out",
                 out.display()
             );
+            if let Some(name) = kneeform::output::foreign_entry(out)
+                .with_context(|| format!("cannot read --out {}", out.display()))?
+            {
+                bail!(
+                    "--out {} holds {}, which kneeform did not write, so --force will not replace it: move it out or choose another --out",
+                    out.display(),
+                    name.to_string_lossy()
+                );
+            }
         }
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
         Err(e) => return Err(e).with_context(|| format!("cannot use --out {}", out.display())),

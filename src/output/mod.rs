@@ -49,6 +49,54 @@ pub use self::results::{
 pub(crate) use self::stl::to_stl_triangle;
 pub use self::stl::write_colliding_area;
 
+/// The files kneeform writes into a result directory: a run's, a
+/// verification's, a convergence study's, a shard's, the report, and a
+/// batch item's fingerprint.
+pub const OWN_FILES: [&str; 18] = [
+    "summary.json",
+    "composite.csv",
+    "colliding_points.csv",
+    "colliding_area.stl",
+    "colliding_area.ply",
+    "composite.png",
+    "depth.png",
+    "blind_spots.csv",
+    "report.html",
+    "shard.json",
+    "shard.bin",
+    "verify.csv",
+    "verify.json",
+    "converge.csv",
+    "converge.json",
+    "error_vs_pitch.png",
+    "time_vs_pitch.png",
+    "batch-item.json",
+];
+
+/// Whether `name` is a file kneeform writes into a result directory
+/// ([`OWN_FILES`], or a study's `verify_<pitch>mm.csv`).
+pub fn is_own_file(name: &str) -> bool {
+    OWN_FILES.contains(&name)
+        || name
+            .strip_prefix("verify_")
+            .and_then(|rest| rest.strip_suffix("mm.csv"))
+            .is_some_and(|pitch| pitch.parse::<f64>().is_ok())
+}
+
+/// The first entry of the directory `dir` that kneeform did not write (a
+/// file of another name, or any directory): what `--force` must not
+/// delete. `None` when every entry is kneeform's.
+pub fn foreign_entry(dir: &Path) -> io::Result<Option<std::ffi::OsString>> {
+    let mut names: Vec<(std::ffi::OsString, bool)> = std::fs::read_dir(dir)?
+        .map(|e| e.and_then(|e| Ok((e.file_name(), e.file_type()?.is_file()))))
+        .collect::<io::Result<_>>()?;
+    names.sort();
+    Ok(names
+        .into_iter()
+        .find(|(name, is_file)| !(*is_file && name.to_str().is_some_and(is_own_file)))
+        .map(|(name, _)| name))
+}
+
 /// Why a result could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum WriteError {
