@@ -793,3 +793,145 @@ fn a_batch_with_two_items_on_one_directory_or_a_fifo_part_is_refused() {
         assert!(err.contains("not a regular file"), "{err}");
     }
 }
+
+/// `text` with the first occurrence of `from` replaced by `to`.
+fn edited(text: &str, from: &str, to: &str) -> String {
+    assert!(text.contains(from), "{from:?} not in the file");
+    text.replacen(from, to, 1)
+}
+
+/// Issue 25, items 4 and 8: `merge` took an edited `shard.json` (a
+/// per-angle area changed, a regulation warning dropped) with exit 0, and
+/// one edited integer (a shard count or a study's `starts` of 2^64-1,
+/// 2^32, 2^40) panicked, aborted leaving `.partial` and `.lock`, or took
+/// 16 GiB before refusing. `shard.json` now carries the SHA-256 of its own
+/// content, and every number is bounded before it sizes anything: each
+/// edit is a one-line refusal with nothing left behind.
+#[test]
+fn merge_refuses_an_edited_shard_json_in_one_line() {
+    let dir = scratch_dir("hostile-merge-edited");
+    // An analysis's two shards, and a verification's.
+    let part = scenario("bump");
+    let shards: Vec<PathBuf> = (1..=2)
+        .map(|k| {
+            let out = dir.join(format!("a{k}"));
+            run_ok(&[
+                "analyze",
+                &part,
+                "--pitch",
+                "4",
+                "--angles=-30,0,30",
+                "--shard",
+                &format!("{k}/2"),
+                "--out",
+                &out.display().to_string(),
+            ]);
+            out
+        })
+        .collect();
+    let studies: Vec<PathBuf> = (1..=2)
+        .map(|k| {
+            let out = dir.join(format!("v{k}"));
+            let o = kneeform(&[
+                "verify",
+                &part,
+                "--pitch",
+                "4",
+                "--angles=0",
+                "--starts",
+                "6",
+                "--shard",
+                &format!("{k}/2"),
+                "--out",
+                &out.display().to_string(),
+            ]);
+            assert!(o.status.code().is_some_and(|c| c < 2));
+            out
+        })
+        .collect();
+    let merge = |shards: &[PathBuf], what: &str| {
+        let out = dir.join("merged");
+        let mut args = vec!["merge".to_string()];
+        args.extend(shards.iter().map(|s| s.display().to_string()));
+        args.extend(["--out".into(), out.display().to_string()]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = kneeform(&args);
+        let err = assert_refused(&o, &dir, what);
+        assert!(!out.exists(), "{what}: wrote {}", out.display());
+        assert!(!dir.join(".merged.lock").exists(), "{what}: left its lock");
+        err
+    };
+    let json = |d: &Path| std::fs::read_to_string(d.join("shard.json")).unwrap();
+    let (a1, v1) = (json(&shards[0]), json(&studies[0]));
+    let summary: serde_json::Value = serde_json::from_str(&a1).unwrap();
+    let area = summary["summary"]["per_angle"][0]["colliding_area_mm2"].to_string();
+    let count = |n: &str| format!("\"count\": {n}");
+    let mut edits: Vec<(PathBuf, String, &str)> = vec![
+        (
+            shards[0].clone(),
+            edited(&a1, &area, &format!("{area}1")),
+            "an area",
+        ),
+        (
+            shards[0].clone(),
+            edited(&a1, "\"count\": 2", &count("18446744073709551615")),
+            "a count of 2^64-1",
+        ),
+        (
+            shards[0].clone(),
+            edited(&a1, "\"count\": 2", &count("4294967296")),
+            "a count of 2^32",
+        ),
+        (
+            studies[0].clone(),
+            edited(&v1, "\"starts\": 6", "\"starts\": 4294967296"),
+            "starts of 2^32",
+        ),
+        (
+            studies[0].clone(),
+            edited(&v1, "\"starts\": 6", "\"starts\": 18446744073709551615"),
+            "starts of 2^64-1",
+        ),
+        (
+            studies[0].clone(),
+            edited(&v1, "\"count\": 2", &count("1099511627776")),
+            "a study count of 2^40",
+        ),
+    ];
+    if summary["base_warnings"]
+        .as_array()
+        .is_some_and(|w| !w.is_empty())
+    {
+        let w = summary["base_warnings"][0].to_string();
+        edits.push((
+            shards[0].clone(),
+            edited(&a1, &format!("{w},"), ""),
+            "a dropped warning",
+        ));
+    }
+    for (target, text, what) in edits {
+        let original = json(&target);
+        std::fs::write(target.join("shard.json"), &text).unwrap();
+        let set = if target.starts_with(&shards[0]) {
+            &shards
+        } else {
+            &studies
+        };
+        merge(set, what);
+        std::fs::write(target.join("shard.json"), original).unwrap();
+    }
+    // Unedited, both merge.
+    for set in [&shards, &studies] {
+        let out = dir.join("merged");
+        let mut args = vec!["merge".to_string()];
+        args.extend(set.iter().map(|s| s.display().to_string()));
+        args.extend(["--out".into(), out.display().to_string(), "--force".into()]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = kneeform(&args);
+        assert!(
+            o.status.code().is_some_and(|c| c < 2),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+}

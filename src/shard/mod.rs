@@ -83,6 +83,56 @@ impl Shard {
     pub fn indices(&self, items: usize) -> Vec<usize> {
         (self.index - 1..items).step_by(self.count).collect()
     }
+
+    /// Whether `indices` are this shard's among `items` ([`Shard::indices`]),
+    /// checked without building them (a shard.json's numbers are not
+    /// trusted to size anything): `1 <= index <= count <= max(items, 1)`
+    /// and `indices[m] = index - 1 + m * count`.
+    pub fn holds(&self, items: usize, indices: &[usize]) -> bool {
+        let Shard { index, count } = *self;
+        if index == 0 || index > count || count > items.max(1) {
+            return false;
+        }
+        let expected = items.saturating_sub(index - 1).div_ceil(count);
+        indices.len() == expected
+            && indices.iter().enumerate().all(|(m, &k)| {
+                m.checked_mul(count).and_then(|o| o.checked_add(index - 1)) == Some(k)
+            })
+    }
+}
+
+/// The SHA-256 (hex) of a `shard.json`'s content with its
+/// `record_sha256` left out (keys sorted, compact JSON): what
+/// `record_sha256` holds, so that an edited `shard.json` (a per-angle
+/// area, a dropped warning) is refused as `shard.bin` is by its checksum.
+pub(crate) fn record_digest(value: &serde_json::Value) -> String {
+    let mut v = value.clone();
+    if let Some(o) = v.as_object_mut() {
+        o.remove("record_sha256");
+    }
+    hex_sha256(&serde_json::to_vec(&v).unwrap_or_default())
+}
+
+/// `record` as `shard.json`'s text, its `record_sha256` set
+/// ([`record_digest`]).
+pub(crate) fn sealed_json(mut record: serde_json::Value) -> String {
+    let digest = record_digest(&record);
+    if let Some(o) = record.as_object_mut() {
+        o.insert("record_sha256".into(), digest.into());
+    }
+    serde_json::to_string_pretty(&record).unwrap_or_default() + "\n"
+}
+
+/// `shard.json`'s text parsed, its `record_sha256` checked against its
+/// content; the reason when it does not hold.
+pub(crate) fn unsealed_json(text: &[u8]) -> Result<serde_json::Value, String> {
+    let value: serde_json::Value =
+        serde_json::from_slice(text).map_err(|e| format!("not a kneeform shard.json: {e}"))?;
+    match value.get("record_sha256").and_then(|d| d.as_str()) {
+        Some(d) if d == record_digest(&value) => Ok(value),
+        Some(_) => Err("edited: its content is not what its record_sha256 says".into()),
+        None => Err("no record_sha256 (written by an older kneeform? run the shard again)".into()),
+    }
 }
 
 impl std::fmt::Display for Shard {
@@ -142,15 +192,18 @@ pub struct ShardRecord {
     pub data_sha256: String,
     /// SHA-256 of `shard.bin`'s common part: grid, files, blind spots.
     pub common_sha256: String,
+    /// SHA-256 of this record's own content ([`record_digest`]).
+    #[serde(default)]
+    pub record_sha256: String,
     /// The whole run's summary as this shard knows it: every parameter
     /// and the part's identity; counts of its own angles only.
     pub summary: Summary,
 }
 
 /// The format [`write_shard`] writes and [`merge`] reads.
-pub const FORMAT: u32 = 1;
+pub const FORMAT: u32 = 2;
 
-const MAGIC: &[u8; 16] = b"kneeform shard 1";
+const MAGIC: &[u8; 16] = b"kneeform shard 2";
 
 /// The masks of `footprints` (one per angle of the run) computed at the
 /// angles `only` (indices into `footprints`): the others are empty, with
@@ -245,13 +298,14 @@ pub fn write_shard(out: &OutputDir, analysis: &Analysis, shard: Shard) -> Result
         base_warnings: warnings[..warnings.len().saturating_sub(tail)].to_vec(),
         data_sha256: hex_sha256(&bin),
         common_sha256,
+        record_sha256: String::new(),
         summary,
     };
     let path = out.path("shard.bin");
     std::fs::write(&path, &bin).map_err(WriteError::at(&path))?;
     let path = out.path("shard.json");
-    let text = serde_json::to_string_pretty(&record).map_err(WriteError::at(&path))? + "\n";
-    std::fs::write(&path, text).map_err(WriteError::at(&path))
+    let value = serde_json::to_value(&record).map_err(WriteError::at(&path))?;
+    std::fs::write(&path, sealed_json(value)).map_err(WriteError::at(&path))
 }
 
 /// The warnings an analysis adds once its masks are known: blind spots
@@ -603,8 +657,11 @@ fn read_shard(dir: &Path) -> Result<ShardFiles, ShardError> {
         path: json_path.clone(),
         reason,
     };
-    let record: ShardRecord = serde_json::from_slice(&text)
-        .map_err(|e| corrupt(format!("not a kneeform shard.json: {e}")))?;
+    let record: ShardRecord = unsealed_json(&text)
+        .and_then(|v| {
+            serde_json::from_value(v).map_err(|e| format!("not a kneeform shard.json: {e}"))
+        })
+        .map_err(corrupt)?;
     if record.format != FORMAT {
         return Err(corrupt(format!(
             "shard format {}, this kneeform reads {FORMAT}",
@@ -616,10 +673,7 @@ fn read_shard(dir: &Path) -> Result<ShardFiles, ShardError> {
     Summary::from_json(&summary_text).map_err(|e| corrupt(e.to_string()))?;
     let angles = record.summary.angles_deg.len();
     let shard = record.shard;
-    if shard.index == 0
-        || shard.index > shard.count
-        || record.angle_indices != shard.angle_indices(angles)
-    {
+    if shard.count > crate::limits::MAX_ANGLES || !shard.holds(angles, &record.angle_indices) {
         return Err(corrupt(format!(
             "shard {}/{} of {angles} angles does not hold angles {:?}",
             shard.index, shard.count, record.angle_indices
@@ -824,6 +878,49 @@ pub fn write_merged(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_shard_holds_its_indices_checked_without_building_them() {
+        let s = Shard { index: 2, count: 3 };
+        for items in [3, 4, 7, 100] {
+            assert!(s.holds(items, &s.indices(items)), "{items}");
+        }
+        // More shards than items: no writer writes one.
+        assert!(!s.holds(2, &s.indices(2)));
+        assert!(s.holds(7, &[1, 4]));
+        assert!(!s.holds(7, &[1, 4, 7]), "one too many");
+        assert!(!s.holds(7, &[1, 5]), "a wrong index");
+        assert!(!s.holds(8, &[1, 4]), "one too few: 7 is the shard's");
+        // Numbers no writer would write are refused, never sized.
+        let huge = Shard {
+            index: 1,
+            count: usize::MAX,
+        };
+        assert!(!huge.holds(7, &[0]));
+        assert!(!Shard { index: 0, count: 3 }.holds(7, &[]));
+        assert!(!Shard { index: 4, count: 3 }.holds(7, &[]));
+        assert!(!Shard { index: 1, count: 1 }.holds(usize::MAX, &[]));
+    }
+
+    #[test]
+    fn an_edited_record_is_told_by_its_own_digest() {
+        let record = serde_json::json!({"format": 2, "area": 0.1, "warnings": ["a", "b"]});
+        let text = sealed_json(record);
+        assert!(unsealed_json(text.as_bytes()).is_ok());
+        for (from, to) in [("0.1", "0.10000000000000002"), ("\"a\",", ""), ("2,", "3,")] {
+            let edited = text.replacen(from, to, 1);
+            assert_ne!(edited, text, "{from}");
+            assert!(
+                unsealed_json(edited.as_bytes())
+                    .unwrap_err()
+                    .contains("edited"),
+                "{from}"
+            );
+        }
+        // Whitespace is not content.
+        let compact = text.replace("\n  ", "");
+        assert!(unsealed_json(compact.as_bytes()).is_ok());
+    }
 
     #[test]
     fn shards_take_every_nth_angle() {

@@ -68,6 +68,9 @@ pub struct StudyRecord {
     pub data_sha256: String,
     /// SHA-256 of `shard.bin`'s common part: grid, angles, starts.
     pub common_sha256: String,
+    /// SHA-256 of this record's own content ([`super::record_digest`]).
+    #[serde(default)]
+    pub record_sha256: String,
 }
 
 /// The format [`write_study_shard`] writes and [`merge_study`] reads.
@@ -131,13 +134,12 @@ pub fn write_study_shard(out: &OutputDir, part: &StudyPart) -> Result<(), WriteE
         oracle_s: part.oracle_s,
         data_sha256: hex_sha256(&bin),
         common_sha256,
+        record_sha256: String::new(),
     };
     let path = out.path("shard.bin");
     std::fs::write(&path, &bin).map_err(WriteError::at(&path))?;
     let path = out.path("shard.json");
-    let text =
-        serde_json::to_string_pretty(&to_json(&record)).map_err(WriteError::at(&path))? + "\n";
-    std::fs::write(&path, text).map_err(WriteError::at(&path))
+    std::fs::write(&path, super::sealed_json(to_json(&record))).map_err(WriteError::at(&path))
 }
 
 /// What a shard directory holds, by its `shard.json`.
@@ -297,7 +299,7 @@ fn to_json(record: &StudyRecord) -> serde_json::Value {
 /// `shard.json`'s record, its [`merged_keys`] set to those of a study of
 /// no start (the merge sets them from every shard's pairs).
 fn from_json(text: &[u8]) -> Result<StudyRecord, String> {
-    let mut v: serde_json::Value = serde_json::from_slice(text).map_err(|e| e.to_string())?;
+    let mut v = super::unsealed_json(text)?;
     let kind = v.pointer("/study/kind").and_then(|k| k.as_str());
     let neutral = match kind {
         Some("verify") => serde_json::json!({
@@ -360,6 +362,7 @@ fn identity(record: &StudyRecord) -> serde_json::Value {
             "sample_s",
             "oracle_s",
             "data_sha256",
+            "record_sha256",
         ] {
             map.remove(key);
         }
@@ -394,8 +397,7 @@ fn read_study(dir: &Path) -> Result<StudyFiles, ShardError> {
         path: json_path.clone(),
         reason,
     };
-    let record =
-        from_json(&text).map_err(|e| corrupt(format!("not a kneeform study shard.json: {e}")))?;
+    let record = from_json(&text).map_err(|e| corrupt(format!("a study shard.json: {e}")))?;
     if record.format != FORMAT {
         return Err(corrupt(format!(
             "study shard format {}, this kneeform reads {FORMAT}",
@@ -403,10 +405,8 @@ fn read_study(dir: &Path) -> Result<StudyFiles, ShardError> {
         )));
     }
     let shard = record.shard;
-    if shard.index == 0
-        || shard.index > shard.count
-        || shard.count > record.starts
-        || record.start_indices != shard.indices(record.starts)
+    if record.starts > crate::limits::MAX_GRID_NODES
+        || !shard.holds(record.starts, &record.start_indices)
     {
         return Err(corrupt(format!(
             "shard {}/{} of {} starts does not hold starts {:?}",
