@@ -340,12 +340,13 @@ impl Setup {
                     need_gib,
                     limit_gib: limit / GIB,
                 },
-                Limit::Machine(machine) => GridError::BeyondMachine {
+                Limit::Machine(machine, what) => GridError::BeyondMachine {
                     nx,
                     nz,
                     angles,
                     need_gib,
                     machine_gib: machine / GIB,
+                    what,
                 },
             }
         })?;
@@ -366,7 +367,8 @@ const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 /// Which limit an estimate broke (bytes).
 enum Limit {
     Allowed(f64),
-    Machine(f64),
+    /// The system's limit, and which one ([`crate::memory::limit_bytes`]).
+    Machine(f64, &'static str),
 }
 
 /// Whether `estimate` fits `allowed` bytes and the machine's memory.
@@ -375,8 +377,8 @@ fn check_estimate(estimate: &MemoryEstimate, allowed: f64) -> Result<(), Limit> 
     if need > allowed {
         return Err(Limit::Allowed(allowed));
     }
-    match crate::memory::physical_bytes() {
-        Some(machine) if need > machine => Err(Limit::Machine(machine)),
+    match crate::memory::limit_bytes() {
+        Some((machine, what)) if need > machine => Err(Limit::Machine(machine, what)),
         _ => Ok(()),
     }
 }
@@ -395,7 +397,7 @@ pub enum AnalysisError {
     Part(#[from] MeshError),
     /// Reading the part would take more memory than allowed.
     #[error(
-        "reading {path} needs about {need_gib:.2} GiB, more than the {limit_gib:.2} GiB {what}"
+        "reading {path} needs about {need_gib:.2} GiB, more than the {limit_gib:.2} GiB of {what}"
     )]
     ReadTooLarge {
         /// The part file.
@@ -542,8 +544,8 @@ impl Analysis {
             .join(" + ");
         check_estimate(&reading, setup.max_memory_bytes).map_err(|limit| {
             let (limit_gib, what) = match limit {
-                Limit::Allowed(b) => (b / GIB, "allowed by --max-memory"),
-                Limit::Machine(b) => (b / GIB, "this machine has"),
+                Limit::Allowed(b) => (b / GIB, "--max-memory"),
+                Limit::Machine(b, what) => (b / GIB, what),
             };
             AnalysisError::ReadTooLarge {
                 path: shown.clone(),

@@ -47,7 +47,7 @@ pub enum GridError {
     },
     /// The run would need more memory than the machine has.
     #[error(
-        "this run needs about {need_gib:.2} GiB ({nx} x {nz} grid, {angles} angles), more than this machine's {machine_gib:.2} GiB of memory; use a coarser --pitch, fewer --angles or a smaller --grid-size"
+        "this run needs about {need_gib:.2} GiB ({nx} x {nz} grid, {angles} angles), more than the {machine_gib:.2} GiB of {what}; use a coarser --pitch, fewer --angles or a smaller --grid-size"
     )]
     BeyondMachine {
         /// Nodes along x.
@@ -58,8 +58,11 @@ pub enum GridError {
         angles: usize,
         /// Estimated memory need.
         need_gib: f64,
-        /// The machine's physical memory.
+        /// The least of the machine's memory and its limits
+        /// ([`crate::memory::limit_bytes`]).
         machine_gib: f64,
+        /// Which limit, in words.
+        what: &'static str,
     },
     /// The grid has more nodes than [`crate::limits::MAX_GRID_NODES`].
     #[error(

@@ -147,6 +147,63 @@ pub fn physical_bytes() -> Option<f64> {
     proc_field("/proc/meminfo", "MemTotal:")
 }
 
+/// The memory this process may still take (bytes), and which limit sets
+/// it, in words: the least of the machine's physical memory
+/// ([`physical_bytes`]), the cgroup's limit (v2 `memory.max`, v1
+/// `memory.limit_in_bytes`: a Slurm job's or a Kubernetes pod's) and the
+/// address space `ulimit -v` leaves (`RLIMIT_AS` less what this process
+/// has mapped already). `None` where the system says none of them.
+pub fn limit_bytes() -> Option<(f64, &'static str)> {
+    let mut limits: Vec<(f64, &'static str)> = Vec::new();
+    if let Some(b) = physical_bytes() {
+        limits.push((b, "this machine's memory"));
+    }
+    if let Some(b) = cgroup_limit_bytes() {
+        limits.push((b, "the memory its cgroup allows (memory.max)"));
+    }
+    if let Some(b) = address_space_left_bytes() {
+        limits.push((b, "the address space ulimit -v leaves"));
+    }
+    limits.into_iter().min_by(|a, b| a.0.total_cmp(&b.0))
+}
+
+/// Limits at or above this (bytes) are none (cgroup v1 writes its
+/// "unlimited" as a page-rounded 2^63).
+const NO_LIMIT_BYTES: f64 = (1u64 << 60) as f64;
+
+/// This process's cgroup memory limit (bytes), v2 or v1, where one is set.
+fn cgroup_limit_bytes() -> Option<f64> {
+    let read = |path: &str| {
+        let text = crate::limits::read_bounded(std::path::Path::new(path), 4096).ok()?;
+        let value: f64 = std::str::from_utf8(&text).ok()?.trim().parse().ok()?;
+        (value < NO_LIMIT_BYTES).then_some(value)
+    };
+    // v2: /proc/self/cgroup's "0::/PATH" under /sys/fs/cgroup.
+    let own = std::fs::read_to_string("/proc/self/cgroup").ok();
+    let v2 = own.as_deref().and_then(|t| {
+        t.lines()
+            .find_map(|l| l.strip_prefix("0::"))
+            .and_then(|p| read(&format!("/sys/fs/cgroup{}/memory.max", p.trim_end_matches('/'))))
+    });
+    v2.or_else(|| read("/sys/fs/cgroup/memory.max"))
+        .or_else(|| read("/sys/fs/cgroup/memory/memory.limit_in_bytes"))
+}
+
+/// `RLIMIT_AS` (`ulimit -v`) less this process's mapped address space
+/// (`VmSize`), where a limit is set (bytes).
+fn address_space_left_bytes() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let line = text.lines().find(|l| l.starts_with("Max address space"))?;
+    let soft: f64 = line
+        .trim_start_matches("Max address space")
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()?;
+    let used = proc_field("/proc/self/status", "VmSize:").unwrap_or(0.0);
+    Some((soft - used).max(0.0))
+}
+
 /// A `/proc` line `KEY:   1234 kB` as bytes.
 fn proc_field(file: &str, key: &str) -> Option<f64> {
     let text = std::fs::read_to_string(file).ok()?;
@@ -158,6 +215,15 @@ fn proc_field(file: &str, key: &str) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_limit_is_at_most_the_machine_memory() {
+        if cfg!(target_os = "linux") {
+            let (limit, what) = limit_bytes().unwrap();
+            assert!(limit <= physical_bytes().unwrap(), "{what}");
+            assert!(limit > 0.0);
+        }
+    }
 
     #[test]
     fn this_process_has_a_peak_and_the_machine_memory() {

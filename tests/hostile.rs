@@ -935,3 +935,30 @@ fn merge_refuses_an_edited_shard_json_in_one_line() {
         );
     }
 }
+
+/// Issue 25, item 10: the memory check read only the machine's memory,
+/// so a run under `ulimit -v` (a Slurm job's or a Kubernetes pod's limit
+/// alike) aborted part way, leaving `.partial` and `.lock`. The effective
+/// limit is read and the run refused before the work, in one line.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_run_beyond_ulimit_v_is_refused_before_the_work() {
+    let dir = scratch_dir("hostile-ulimit");
+    let out = dir.join("run");
+    // The console at 0.5 mm needs about 1.5 GiB; 1 GB of address space
+    // is far short of it, and far more than reading the part takes.
+    let o = Command::new("bash")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 1000000 && exec {} analyze {} --pitch 0.5 --out {}",
+            env!("CARGO_BIN_EXE_kneeform"),
+            scenario("console"),
+            out.display()
+        ))
+        .output()
+        .unwrap();
+    let err = assert_refused(&o, &dir, "under ulimit -v");
+    assert!(err.contains("ulimit -v"), "{err}");
+    assert!(!out.exists());
+    assert!(!dir.join(".run.lock").exists());
+}
