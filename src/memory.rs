@@ -181,9 +181,12 @@ fn cgroup_limit_bytes() -> Option<f64> {
     // v2: /proc/self/cgroup's "0::/PATH" under /sys/fs/cgroup.
     let own = std::fs::read_to_string("/proc/self/cgroup").ok();
     let v2 = own.as_deref().and_then(|t| {
-        t.lines()
-            .find_map(|l| l.strip_prefix("0::"))
-            .and_then(|p| read(&format!("/sys/fs/cgroup{}/memory.max", p.trim_end_matches('/'))))
+        t.lines().find_map(|l| l.strip_prefix("0::")).and_then(|p| {
+            read(&format!(
+                "/sys/fs/cgroup{}/memory.max",
+                p.trim_end_matches('/')
+            ))
+        })
     });
     v2.or_else(|| read("/sys/fs/cgroup/memory.max"))
         .or_else(|| read("/sys/fs/cgroup/memory/memory.limit_in_bytes"))

@@ -91,7 +91,7 @@ pub enum Warning {
     /// Features between the nodes, unseen by the grid, that the
     /// knee-form meets.
     #[error(
-        "{count} blind spots the knee-form meets (angles {angles}): the part sticks out up to {depth_mm:.2} mm past the grid's nodes where the grid cannot see it, first at x = {x:.1}, y = {y:.1}, z = {z:.1} mm (part coordinates); their strikes are missing from the result; --pitch {pitch} resolves them (blind_spots.csv)"
+        "{count} blind spots the knee-form meets (angles {angles}): the part sticks out up to {depth_mm:.2} mm past the grid's nodes where the grid cannot see it, first at x = {x:.1}, y = {y:.1}, z = {z:.1} mm (part coordinates); their strikes are missing from the result; {resolves} (blind_spots.csv)"
     )]
     BlindSpotsMet {
         /// Cells the knee-form meets.
@@ -106,8 +106,9 @@ pub enum Warning {
         y: f64,
         /// Its z (mm).
         z: f64,
-        /// The pitch resolving every one of them (mm).
-        pitch: f64,
+        /// Which pitch resolves every one of them, in words
+        /// ([`resolving_phrase`]).
+        resolves: String,
     },
     /// Nothing is struck.
     #[error(
@@ -244,11 +245,30 @@ pub fn blind_spot_warnings(
         x,
         y,
         z,
-        pitch: near
-            .iter()
-            .map(|s| s.resolving_pitch_mm)
-            .fold(f64::INFINITY, f64::min),
+        resolves: resolving_phrase(
+            near.iter()
+                .map(|s| s.resolving_pitch_mm)
+                .fold(f64::INFINITY, f64::min),
+        ),
     }]
+}
+
+/// The advice for blind spots resolved at `pitch` mm: a pitch kneeform
+/// accepts, rounded down to three significant digits (rounded up, it might
+/// not resolve them), or, below [`crate::limits::MIN_PITCH_MM`], that none
+/// does (a feature narrower than that: an edge seen edge-on, a sheet of no
+/// thickness).
+pub fn resolving_phrase(pitch: f64) -> String {
+    let min = crate::limits::MIN_PITCH_MM;
+    if pitch.is_nan() || pitch < min {
+        return format!(
+            "no pitch kneeform accepts (down to {min} mm) resolves them: they are narrower than that (an edge seen edge-on, a sheet of no thickness)"
+        );
+    }
+    let digits = 2 - pitch.log10().floor() as i32;
+    let scale = 10f64.powi(digits);
+    let readable = ((pitch * scale).floor() / scale).max(min);
+    format!("--pitch {} resolves them", crate::limits::short(readable))
 }
 
 /// Angles as ranges of whole degrees where they run on: `-30..-12, 0, 7`.
@@ -285,6 +305,20 @@ pub fn result_warnings(composite_nodes: usize) -> Vec<Warning> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_resolving_pitch_is_one_the_tool_accepts_and_reads_short() {
+        assert_eq!(resolving_phrase(0.5), "--pitch 0.5 resolves them");
+        assert_eq!(resolving_phrase(0.0078125), "--pitch 0.00781 resolves them");
+        assert_eq!(resolving_phrase(0.15625), "--pitch 0.156 resolves them");
+        assert_eq!(resolving_phrase(1.0), "--pitch 1 resolves them");
+        for tiny in [5.774e-10, 3.7e-9, 1.9e-9, 0.0, f64::NAN] {
+            assert!(
+                resolving_phrase(tiny).starts_with("no pitch kneeform accepts"),
+                "{tiny}"
+            );
+        }
+    }
     use crate::mesh::Triangle;
 
     /// A w x w square in the plane y = 0, wound to face -y (`toward_minus`)

@@ -962,3 +962,47 @@ fn a_run_beyond_ulimit_v_is_refused_before_the_work() {
     assert!(!out.exists());
     assert!(!dir.join(".run.lock").exists());
 }
+
+/// Issue 25, item 18: the blind-spot warning recommended pitches the tool
+/// refuses (`--pitch 0.000000001862645149230957` for a fin of no
+/// thickness). A sheet seen edge-on has no resolving pitch: the warning
+/// says so; a real one is a pitch the tool accepts, short.
+#[test]
+fn a_blind_spot_with_no_resolving_pitch_says_so() {
+    let dir = scratch_dir("hostile-fin");
+    let quad = |a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]| [[a, b, c], [a, c, d]];
+    // A wall facing -y, and a fin of no thickness at x = 50 (between the
+    // 4 mm grid's columns) standing 5 mm towards the knee.
+    let mut triangles = quad(
+        [0.0, 0.0, 0.0],
+        [200.0, 0.0, 0.0],
+        [200.0, 0.0, 150.0],
+        [0.0, 0.0, 150.0],
+    )
+    .to_vec();
+    triangles.extend(quad(
+        [50.0, 0.0, 20.0],
+        [50.0, -5.0, 20.0],
+        [50.0, -5.0, 130.0],
+        [50.0, 0.0, 130.0],
+    ));
+    let stl = dir.join("fin.stl");
+    std::fs::write(&stl, ascii_stl(&[("fin", &triangles)])).unwrap();
+    let o = kneeform(&[
+        "analyze",
+        &stl.display().to_string(),
+        "--pitch",
+        "4",
+        "--angles=0",
+        "--out",
+        &dir.join("run").display().to_string(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let line = err
+        .lines()
+        .find(|l| l.contains("blind spots"))
+        .expect("a blind-spot warning");
+    assert!(line.contains("no pitch kneeform accepts"), "{line}");
+    assert!(!line.contains("--pitch 0.0000"), "{line}");
+}
