@@ -16,16 +16,16 @@
 //!   either answer is right at this pitch.
 //! * **Oracle failure.** No exact answer for the pair: never counted
 //!   clear.
-//! * **Rim.** A missed exact strike where the grid has no sample: no node
-//!   of the part within `sqrt 2` pitches of the touched point is met by the
+//! * **Rim.** A missed exact strike the grid samples late: no node of
+//!   the part within `sqrt 2` pitches of the touched point is met by the
 //!   slide within `sqrt 2` pitches more of travel (a sliver of the part
-//!   between the knee-form's outline and the footprint's outermost row, or
-//!   a crease crossing the outline where it runs almost along the slide:
-//!   on the console at 0.5 mm, a node 0.11 mm from the touched point met 3
-//!   mm of travel later). Under the window rule such a strike is
-//!   undecided (the grid's drop error there is unbounded: the tie band's
-//!   strike side takes the lowest node the slide met near it); the rim
-//!   names it under `--rate x-slope`, and fails the verdict.
+//!   between the knee-form's outline and the footprint's outermost row;
+//!   under the window rule such a strike is undecided, the grid's drop
+//!   error there being unbounded), or the nearest one is met only later
+//!   (the outline crossing the grid's rows at a shallow angle, a rounded
+//!   corner's side over a crease: on the console at 0.5 mm, the node 0.02
+//!   mm from the touched point met 1.3 mm of travel later, the one 0.11 mm
+//!   away 3 mm later). It fails the verdict.
 //! * **Sampling.** An unexplained residual within `sqrt 2` pitches: the
 //!   grid's first-order error at this pitch. It fails the verdict (the
 //!   pitch is too coarse for the tolerance).
@@ -116,7 +116,15 @@ impl Cells {
     /// [`RISE_REACH`] pitches of `p` in xz: whether the grid samples the
     /// part under the knee-form near the point the exact knee-form touches.
     pub fn samples_near(&self, p: [f64; 3], rows: &[FootprintSpan], travel: f64) -> bool {
-        self.rises_near(p, Some((rows, travel))).is_some()
+        self.rises_near(p, Some((rows, travel, false))).is_some()
+    }
+
+    /// As [`Cells::samples_near`], counting only the nodes met during the
+    /// slide (not those under the knee-form at the push, which set the
+    /// pushed level and are never struck, SPEC): whether the grid may
+    /// strike near `p` by `travel` mm.
+    pub fn strikes_near(&self, p: [f64; 3], rows: &[FootprintSpan], travel: f64) -> bool {
+        self.rises_near(p, Some((rows, travel, true))).is_some()
     }
 
     /// How much higher than the mesh point `p` (`[x, y, z]`, mm) the grid
@@ -138,20 +146,59 @@ impl Cells {
     /// (the start's footprint rows at the push `rows`) lies (mm, `>= 0`;
     /// `+inf` where the slide met no node of the part that near): the least
     /// by which the grid's best node near a touched point can misjudge it.
-    /// Only the nodes the grid has met count.
+    /// Only the nodes the grid meets in the slide count: those under the
+    /// knee-form at the push are never struck (SPEC).
     pub fn rise_of_lowest_near(&self, p: [f64; 3], rows: &[FootprintSpan], travel: f64) -> f64 {
-        self.rises_near(p, Some((rows, travel)))
+        self.rises_near(p, Some((rows, travel, true)))
             .map_or(f64::INFINITY, |(lowest, _)| lowest.max(0.0))
     }
 
+    /// When the slide meets the node of the part nearest `p` in xz (within
+    /// [`RISE_REACH`] pitches), the start's footprint rows at the push
+    /// being `rows` (mm of travel: 0 for one under the knee-form at the
+    /// push; `+inf` where it never does, or no node of the part is that
+    /// near).
+    pub fn nearest_node_met_at(&self, p: [f64; 3], rows: &[FootprintSpan]) -> f64 {
+        let spec = self.spec;
+        let reach = RISE_REACH * spec.pitch + CELL_TOL;
+        let (ci, cj) = (
+            ((p[0] - spec.x(0)) / spec.pitch).round(),
+            ((p[2] - spec.z(0)) / spec.pitch).round(),
+        );
+        let mut best: Option<(f64, f64)> = None;
+        for dj in -2..=2 {
+            for di in -2..=2 {
+                let (i, j) = (ci + f64::from(di), cj + f64::from(dj));
+                if i < 0.0 || j < 0.0 || i >= spec.nx as f64 || j >= spec.nz as f64 {
+                    continue;
+                }
+                let (i, j) = (i as usize, j as usize);
+                let d = (spec.x(i) - p[0]).hypot(spec.z(j) - p[2]);
+                if d > reach || !self.heights[j * spec.nx + i].is_finite() {
+                    continue;
+                }
+                let met = rows
+                    .iter()
+                    .filter(|r| r.j == j)
+                    .find_map(|r| r.meets(i as i64, spec.x(i)))
+                    .unwrap_or(f64::INFINITY);
+                if best.is_none_or(|(bd, _)| d < bd) {
+                    best = Some((d, met));
+                }
+            }
+        }
+        best.map_or(f64::INFINITY, |(_, met)| met)
+    }
+
     /// The least and the largest `h - y` over the nodes of the part within
-    /// [`RISE_REACH`] pitches of `p` in xz (and, given `(rows, travel)`,
-    /// met by the slide of the footprint whose rows at the push are `rows`
-    /// by `travel` mm); `None` where there is none.
+    /// [`RISE_REACH`] pitches of `p` in xz (and, given `(rows, travel,
+    /// slide_only)`, met by the slide of the footprint whose rows at the
+    /// push are `rows` by `travel` mm: under it at the push too unless
+    /// `slide_only`); `None` where there is none.
     fn rises_near(
         &self,
         p: [f64; 3],
-        footprint: Option<(&[FootprintSpan], f64)>,
+        footprint: Option<(&[FootprintSpan], f64, bool)>,
     ) -> Option<(f64, f64)> {
         let spec = self.spec;
         let reach = RISE_REACH * spec.pitch;
@@ -172,10 +219,11 @@ impl Cells {
                 let (dx, dz) = (spec.x(i) - p[0], spec.z(j) - p[2]);
                 let h = self.heights[j * spec.nx + i];
                 let covered = || {
-                    footprint.is_none_or(|(rows, travel)| {
+                    footprint.is_none_or(|(rows, travel, slide_only)| {
                         rows.iter().filter(|r| r.j == j).any(|r| {
-                            r.meets(i as i64, spec.x(i))
-                                .is_some_and(|m| m <= travel + CELL_TOL)
+                            r.meets(i as i64, spec.x(i)).is_some_and(|m| {
+                                m <= travel + CELL_TOL && !(slide_only && m <= CELL_TOL)
+                            })
                         })
                     })
                 };
@@ -202,14 +250,12 @@ pub enum Mechanism {
     Undecided,
     /// Pairs the oracle failed on.
     OracleFailure,
-    /// Exact strikes in the knee-form's rim: no node of the part within
-    /// `sqrt 2` pitches of the touched point is met by the slide within
-    /// `sqrt 2` pitches more of travel (a sliver between the outline and
-    /// the footprint's outermost row, an outline running along the slide);
-    /// the grid has no sample there at this pitch (misses, on the unsafe
-    /// side: they fail the verdict). Under the window rule such strikes
-    /// are undecided, the grid's drop error there being unbounded; the
-    /// rim names them under `--rate x-slope`.
+    /// Exact strikes in the knee-form's rim, which the grid samples late:
+    /// no node of the part within `sqrt 2` pitches of the touched point,
+    /// or not the nearest one, is met by the slide within `sqrt 2` pitches
+    /// more of travel (a sliver between the outline and the footprint's
+    /// outermost row, an outline crossing the rows at a shallow angle).
+    /// Misses, on the unsafe side: they fail the verdict.
     Rim,
     /// A residual no mechanism above explains, within `sqrt 2` pitches:
     /// the size of error the grid makes at this pitch, which a finer pitch
@@ -425,7 +471,15 @@ mod tests {
         assert!(!cells.samples_near([15.0, 0.0, 5.0], &rows, 30.0));
         // The lowest met node's rise: on this flat part, 0 where sampled,
         // +inf where not.
-        assert_eq!(cells.rise_of_lowest_near([5.0, 0.0, 5.0], &rows, 0.0), 0.0);
+        // Only nodes met in the slide judge: none by travel 0 (those under
+        // the knee-form at the push are never struck), x = 4 from 1 mm.
+        assert_eq!(
+            cells.rise_of_lowest_near([5.0, 0.0, 5.0], &rows, 0.0),
+            f64::INFINITY
+        );
+        assert_eq!(cells.rise_of_lowest_near([5.0, 0.0, 5.0], &rows, 1.0), 0.0);
+        assert!(!cells.strikes_near([5.0, 0.0, 5.0], &rows, 0.0));
+        assert!(cells.strikes_near([5.0, 0.0, 5.0], &rows, 1.0));
         assert_eq!(
             cells.rise_of_lowest_near([2.0, 0.0, 5.0], &rows, 0.0),
             f64::INFINITY
@@ -436,6 +490,18 @@ mod tests {
             f64::INFINITY
         );
         assert_eq!(cells.rise_of_lowest_near([1.0, 0.0, 5.0], &rows, 3.0), 0.0);
+        // The nearest node's meeting: x = 4 is met after 1 mm, x = 12 at
+        // the push, x = 30 (behind the footprint) never.
+        assert_eq!(cells.nearest_node_met_at([3.9, 0.0, 4.1], &rows), 1.0);
+        assert_eq!(cells.nearest_node_met_at([12.2, 0.0, 6.1], &rows), 0.0);
+        assert_eq!(
+            cells.nearest_node_met_at([30.0, 0.0, 5.0], &rows),
+            f64::INFINITY
+        );
+        assert_eq!(
+            cells.nearest_node_met_at([500.0, 0.0, 5.0], &rows),
+            f64::INFINITY
+        );
     }
 
     #[test]

@@ -330,8 +330,9 @@ pub struct StartComparison {
     /// spot.
     pub miss_decided: Vec<f64>,
     /// Whether each of those lies in the knee-form's rim: the slide meets
-    /// no node of the part near it by [`MEETING_REACH`] pitches more of
-    /// travel ([`Cells::samples_near`]).
+    /// no node of the part near it, or not the nearest one, by
+    /// [`MEETING_REACH`] pitches more of travel ([`Cells::samples_near`],
+    /// [`Cells::nearest_node_met_at`]).
     pub miss_rim: Vec<bool>,
     /// Whether each of those is brief: the exact knee-form touches within
     /// `sqrt 2` pitches of it for less than [`MEETING_REACH`] pitches of
@@ -763,12 +764,15 @@ pub fn compare(
             .collect()
     };
     let decided_strike = |c: &ExactStrike| c.decision == Decision::Strike;
+    // In the rim: the slide meets no node near the touched point by
+    // then, or not its nearest one (the outline crossing the grid's rows
+    // at a shallow angle, a rounded corner's side; or the nearest node
+    // under the knee-form since the push, never struck).
     let in_rim = |c: &ExactStrike| {
-        !cells.samples_near(
-            c.contact.witness,
-            rows,
-            c.contact.travel + MEETING_REACH * cells.pitch(),
-        )
+        let by = c.contact.travel + MEETING_REACH * cells.pitch();
+        let nearest = cells.nearest_node_met_at(c.contact.witness, rows);
+        !cells.strikes_near(c.contact.witness, rows, by)
+            || !(LEVEL_TOL..=by + LEVEL_TOL).contains(&nearest)
     };
     // The decided strikes away from blind spots, with their indices.
     let decided_away: Vec<(usize, &ExactStrike)> = classified

@@ -192,7 +192,8 @@ pub struct ShardRecord {
     pub data_sha256: String,
     /// SHA-256 of `shard.bin`'s common part: grid, files, blind spots.
     pub common_sha256: String,
-    /// SHA-256 of this record's own content ([`record_digest`]).
+    /// SHA-256 of this record's own content, keys sorted, compact JSON,
+    /// this field left out.
     #[serde(default)]
     pub record_sha256: String,
     /// The whole run's summary as this shard knows it: every parameter

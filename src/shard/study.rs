@@ -68,7 +68,8 @@ pub struct StudyRecord {
     pub data_sha256: String,
     /// SHA-256 of `shard.bin`'s common part: grid, angles, starts.
     pub common_sha256: String,
-    /// SHA-256 of this record's own content ([`super::record_digest`]).
+    /// SHA-256 of this record's own content, keys sorted, compact JSON,
+    /// this field left out.
     #[serde(default)]
     pub record_sha256: String,
 }
