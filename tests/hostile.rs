@@ -1006,3 +1006,38 @@ fn a_blind_spot_with_no_resolving_pitch_says_so() {
     assert!(line.contains("no pitch kneeform accepts"), "{line}");
     assert!(!line.contains("--pitch 0.0000"), "{line}");
 }
+
+/// Issue 25, item 17: manifest values such as `pitch = -1` printed clap's
+/// multi-line usage, `part = []` too, and `--deflection 1e9` was reported
+/// as "got -80". Each is now a line naming the value given.
+#[test]
+fn manifest_values_and_flags_are_refused_naming_what_was_given() {
+    let dir = scratch_dir("hostile-values");
+    std::fs::copy(scenario("bump"), dir.join("bump.toml")).unwrap();
+    let manifest = dir.join("manifest.toml");
+    for (item, needle) in [
+        ("part = \"bump.toml\"\nout = \"r\"\npitch = -1\n", "--pitch"),
+        ("part = []\nout = \"r\"\n", "has no part"),
+    ] {
+        std::fs::write(&manifest, format!("[[item]]\n{item}")).unwrap();
+        let o = batch(&manifest);
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert_eq!(o.status.code(), Some(2), "{item}: {err}");
+        assert!(!err.contains("Usage"), "{item}: clap's usage: {err}");
+        assert!(err.contains(needle), "{item}: {err}");
+        assert!(
+            err.lines().all(|l| l.starts_with("kneeform")),
+            "{item}: {err}"
+        );
+    }
+    let o = kneeform(&[
+        "analyze",
+        &scenario("bump"),
+        "--deflection",
+        "1e9",
+        "--out",
+        &dir.join("d").display().to_string(),
+    ]);
+    let err = assert_refused(&o, &dir, "--deflection 1e9");
+    assert!(err.contains("got 1e9"), "{err}");
+}

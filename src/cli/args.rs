@@ -507,6 +507,11 @@ impl SetupArgs {
             },
             _ => GridPlacement::AroundPart,
         };
+        // The rule keeps tan(--deflection): a value beyond 90 degrees
+        // would come back as another angle (1e9 was reported as -80).
+        if !(self.deflection.is_finite() && (0.0..45.0).contains(&self.deflection)) {
+            return Err(with_flag(SetupError::Deflection(self.deflection)));
+        }
         let setup = Setup {
             // `auto`: a placeholder until the pitch study chooses.
             pitch: match self.pitch {

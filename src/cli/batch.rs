@@ -66,14 +66,16 @@ impl Flags {
     /// Appends the flags of `item` over `defaults`: its `pitch`, `angles`
     /// and `side` replace the defaults', its `args` follow theirs.
     fn push_onto(defaults: &Flags, item: &Flags, argv: &mut Vec<String>) {
+        // `--flag=value`: a value such as -1 is the flag's, not another
+        // flag (clap printed its usage for `pitch = -1`).
         if let Some(p) = item.pitch.or(defaults.pitch) {
-            argv.extend(["--pitch".into(), p.to_string()]);
+            argv.push(format!("--pitch={p}"));
         }
         if let Some(a) = item.angles.as_ref().or(defaults.angles.as_ref()) {
             argv.push(format!("--angles={a}"));
         }
         if let Some(s) = item.side.as_ref().or(defaults.side.as_ref()) {
-            argv.extend(["--side".into(), s.clone()]);
+            argv.push(format!("--side={s}"));
         }
         argv.extend(defaults.args.iter().chain(&item.args).cloned());
     }
@@ -130,6 +132,12 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
             PartPaths::One(p) => vec![p.clone()],
             PartPaths::Many(p) => p.clone(),
         };
+        ensure!(
+            !parts.is_empty(),
+            "manifest {}: item {} has no part (part = [])",
+            args.manifest.display(),
+            k + 1
+        );
         let mut argv = vec!["analyze".to_string()];
         argv.extend(parts.iter().map(|p| p.display().to_string()));
         argv.extend(["--out".into(), item.out.display().to_string()]);

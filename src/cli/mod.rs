@@ -131,7 +131,24 @@ pub fn one_line(err: &anyhow::Error) -> String {
         }
         line.push_str(&text);
     }
-    line
+    cap(line, MAX_LINE_CHARS)
+}
+
+/// The longest error line said whole (characters): a message listing
+/// thousands of indices (a damaged shard's) was 11 KB.
+const MAX_LINE_CHARS: usize = 600;
+
+/// `line` cut to `max` characters at a word, saying how many were left
+/// out.
+fn cap(line: String, max: usize) -> String {
+    let count = line.chars().count();
+    if count <= max {
+        return line;
+    }
+    let cut: String = line.chars().take(max).collect();
+    let cut = cut.rsplit_once(' ').map_or(cut.as_str(), |(head, _)| head);
+    let left = count - cut.chars().count();
+    format!("{cut} ... ({left} more characters left out)")
 }
 
 /// Sizes rayon's global pool (default: one thread per CPU).
@@ -204,6 +221,24 @@ mod tests {
     struct Quoting {
         path: String,
         source: std::io::Error,
+    }
+
+    #[test]
+    fn a_long_line_is_cut_saying_how_much_is_left_out() {
+        assert_eq!(cap("short".into(), 600), "short");
+        let long = (0..3000).map(|k| k.to_string()).collect::<Vec<_>>().join(", ");
+        let line = cap(format!("shard 1/4 does not hold starts [{long}]"), 600);
+        assert!(line.len() < 700, "{}", line.len());
+        assert!(line.ends_with("more characters left out)"), "{line}");
+        let left: usize = line
+            .rsplit_once(" ... (")
+            .and_then(|(_, t)| t.split(' ').next())
+            .and_then(|n| n.parse().ok())
+            .unwrap();
+        assert_eq!(
+            line.chars().count() - " ... ( more characters left out)".len() - left.to_string().len() + left,
+            format!("shard 1/4 does not hold starts [{long}]").chars().count()
+        );
     }
 
     #[test]
