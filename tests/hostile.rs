@@ -1041,3 +1041,111 @@ fn manifest_values_and_flags_are_refused_naming_what_was_given() {
     let err = assert_refused(&o, &dir, "--deflection 1e9");
     assert!(err.contains("got 1e9"), "{err}");
 }
+
+/// Issue 25, item 5: `report` presented an edited `summary.json` as
+/// evidence (5 nodes stated while 39 were drawn, an area of -1 mm2, 1e300
+/// printed as 301 digits). What it states is checked against what it
+/// draws from `composite.csv`; an inconsistent run is refused in one line.
+#[test]
+fn report_refuses_a_summary_that_contradicts_its_composite() {
+    let scratch = scratch_dir("hostile-report-counts");
+    let d = scratch.join("out");
+    small_run(&d, &[]);
+    let path = d.join("summary.json");
+    let original = std::fs::read_to_string(&path).unwrap();
+    let summary: serde_json::Value = serde_json::from_str(&original).unwrap();
+    let nodes = summary["composite_nodes"].as_u64().unwrap();
+    assert!(nodes > 5, "the bump collides");
+    let html = scratch.join("r.html");
+    let report = || {
+        kneeform(&[
+            "report",
+            d.to_str().unwrap(),
+            "--out",
+            html.to_str().unwrap(),
+        ])
+    };
+    assert!(report().status.success(), "the run as written reports");
+    std::fs::remove_file(&html).unwrap();
+    for (pointer, value) in [
+        ("/composite_nodes", serde_json::json!(5)),
+        ("/composite_area_mm2", serde_json::json!(-1.0)),
+        ("/composite_area_mm2", serde_json::json!(1e300)),
+        ("/per_angle/0/colliding_nodes", serde_json::json!(nodes + 1)),
+        ("/per_angle/1/colliding_area_mm2", serde_json::json!(0.5)),
+    ] {
+        let mut tampered = summary.clone();
+        *tampered.pointer_mut(pointer).unwrap() = value.clone();
+        std::fs::write(&path, tampered.to_string()).unwrap();
+        let line = assert_refused(&report(), &scratch, pointer);
+        assert!(
+            line.contains("states") || line.contains("sum"),
+            "{pointer}: {line}"
+        );
+        assert!(!line.contains(&"0".repeat(100)), "{line}");
+        assert!(!html.exists());
+    }
+}
+
+/// Issue 25, item 3: `report` took no care of a run replaced while it read
+/// it (`analyze --force` on the same directory): 46 of 63 reports showed
+/// one run's numbers beside the other's pictures, exit 0. Every report
+/// run against a directory rewritten in a loop by two different runs
+/// either refuses in one line or states the numbers of the composite it
+/// draws.
+#[test]
+fn a_report_reads_one_run_whole_or_refuses() {
+    let scratch = scratch_dir("hostile-report-race");
+    let d = scratch.join("out");
+    small_run(&d, &[]);
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let writer = {
+        let (d, stop) = (d.clone(), stop.clone());
+        std::thread::spawn(move || {
+            let mut k = 0;
+            while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+                // Two runs of different areas, one after the other.
+                let angles = if k % 2 == 0 {
+                    "--angles=-30,0,30"
+                } else {
+                    "--angles=0"
+                };
+                let _ = kneeform(&[
+                    "analyze",
+                    &scenario("bump"),
+                    "--out",
+                    d.to_str().unwrap(),
+                    "--pitch",
+                    "4",
+                    angles,
+                    "--force",
+                ]);
+                k += 1;
+            }
+        })
+    };
+    let html = scratch.join("r.html");
+    for _ in 0..30 {
+        let out = kneeform(&[
+            "report",
+            d.to_str().unwrap(),
+            "--out",
+            html.to_str().unwrap(),
+        ]);
+        match out.status.code() {
+            Some(0) => {}
+            // Refused in one line: replaced while read, or busy.
+            Some(2) => {
+                let err = String::from_utf8_lossy(&out.stderr);
+                assert_eq!(err.lines().count(), 1, "{err}");
+                assert!(err.starts_with("kneeform: error: "), "{err}");
+            }
+            c => panic!(
+                "report exited {c:?}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            ),
+        }
+    }
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    writer.join().unwrap();
+}

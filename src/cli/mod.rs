@@ -226,7 +226,10 @@ mod tests {
     #[test]
     fn a_long_line_is_cut_saying_how_much_is_left_out() {
         assert_eq!(cap("short".into(), 600), "short");
-        let long = (0..3000).map(|k| k.to_string()).collect::<Vec<_>>().join(", ");
+        let long = (0..3000)
+            .map(|k| k.to_string())
+            .collect::<Vec<_>>()
+            .join(", ");
         let line = cap(format!("shard 1/4 does not hold starts [{long}]"), 600);
         assert!(line.len() < 700, "{}", line.len());
         assert!(line.ends_with("more characters left out)"), "{line}");
@@ -236,8 +239,13 @@ mod tests {
             .and_then(|n| n.parse().ok())
             .unwrap();
         assert_eq!(
-            line.chars().count() - " ... ( more characters left out)".len() - left.to_string().len() + left,
-            format!("shard 1/4 does not hold starts [{long}]").chars().count()
+            line.chars().count()
+                - " ... ( more characters left out)".len()
+                - left.to_string().len()
+                + left,
+            format!("shard 1/4 does not hold starts [{long}]")
+                .chars()
+                .count()
         );
     }
 

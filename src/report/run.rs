@@ -163,6 +163,11 @@ impl Run {
     /// is the run's is used ([`crate::mesh::read_part_bytes`]).
     pub fn read(dir: &Path, part: Option<&Path>) -> Result<Run, ReportError> {
         let summary_path = dir.join("summary.json");
+        // A run replaced while it is read (`analyze --force` renames a
+        // whole new directory into place) would give one run's numbers
+        // beside another's pictures: the directory read is the one there
+        // before and after, or the report refuses.
+        let identity_before = dir_identity(dir);
         let text = read_text(&summary_path)?;
         let json = |source| ReportError::Json {
             path: summary_path.clone(),
@@ -203,6 +208,16 @@ impl Run {
         } else {
             Vec::new()
         };
+        check_counts(&summary, &composite).map_err(|reason| ReportError::Inconsistent {
+            path: summary_path.clone(),
+            reason,
+        })?;
+        if dir_identity(dir) != identity_before || read_text(&summary_path).ok() != Some(text) {
+            return Err(ReportError::Inconsistent {
+                path: dir.to_path_buf(),
+                reason: "the run was replaced while the report read it (a run with --force on it?); run the report again".into(),
+            });
+        }
         Ok(Run {
             dir: dir.to_path_buf(),
             summary,
@@ -343,6 +358,71 @@ pub fn same_coordinate(v: f64, node: f64, pitch: f64) -> bool {
 /// coordinate, and through a `--frame` rotation up to sqrt(3) times that
 /// in one vehicle coordinate (0.87 um); 1 um bounds both.
 pub const ROUNDED_TOL_MM: f64 = 1e-3;
+
+/// The directory's identity (device and inode), where the system has one.
+fn dir_identity(dir: &Path) -> Option<(u64, u64)> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        std::fs::metadata(dir).ok().map(|m| (m.dev(), m.ino()))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = dir;
+        None
+    }
+}
+
+/// Whether what `summary` states agrees with the composite drawn from
+/// `composite.csv`: its node count, its area (nodes times the pitch
+/// squared), every angle's area from its count, and the angles' counts
+/// summed against the composite's per-node angle counts. An edited
+/// summary (5 nodes stated while 39 are drawn, an area of -1 mm^2) or a
+/// mix of two runs is refused, never presented as evidence.
+fn check_counts(summary: &Summary, composite: &NodeCounts) -> Result<(), String> {
+    let area = |nodes: usize| nodes as f64 * summary.pitch_mm * summary.pitch_mm;
+    let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs().max(1.0);
+    let drawn = composite.count.iter().filter(|&&c| c > 0).count();
+    if summary.composite_nodes != drawn {
+        return Err(format!(
+            "it states {} composite nodes, composite.csv holds {drawn}",
+            summary.composite_nodes
+        ));
+    }
+    if !same(summary.composite_area_mm2, area(drawn)) {
+        return Err(format!(
+            "it states a composite area of {} mm2, its {drawn} nodes at {} mm make {} mm2",
+            crate::limits::short(summary.composite_area_mm2),
+            crate::limits::short(summary.pitch_mm),
+            crate::limits::short(area(drawn))
+        ));
+    }
+    if summary.per_angle.len() != summary.angles_deg.len() {
+        return Err(format!(
+            "it states {} angles and {} per-angle results",
+            summary.angles_deg.len(),
+            summary.per_angle.len()
+        ));
+    }
+    for a in &summary.per_angle {
+        if a.colliding_nodes > drawn || !same(a.colliding_area_mm2, area(a.colliding_nodes)) {
+            return Err(format!(
+                "at {} degrees it states {} nodes and {} mm2, beside {drawn} composite nodes",
+                a.angle_deg,
+                a.colliding_nodes,
+                crate::limits::short(a.colliding_area_mm2)
+            ));
+        }
+    }
+    let stated: usize = summary.per_angle.iter().map(|a| a.colliding_nodes).sum();
+    let counted: usize = composite.count.iter().map(|&c| usize::from(c)).sum();
+    if stated != counted {
+        return Err(format!(
+            "its angles' colliding nodes sum to {stated}, composite.csv's angle counts to {counted}"
+        ));
+    }
+    Ok(())
+}
 
 fn read_composite(
     path: &Path,
