@@ -160,7 +160,7 @@ impl Frame {
     }
 
     fn from_file(path: &Path, given: &str) -> Result<Frame, FrameError> {
-        let text = std::fs::read_to_string(path).map_err(|source| FrameError::Io {
+        let text = crate::limits::read_text_bounded(path).map_err(|source| FrameError::Io {
             path: path.to_path_buf(),
             source,
         })?;

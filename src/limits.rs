@@ -105,6 +105,41 @@ pub fn read_bounded(path: &std::path::Path, max_bytes: u64) -> std::io::Result<V
     Ok(bytes)
 }
 
+/// The largest text file read whole (bytes): a manifest, a frame's
+/// matrix, a scenario, a batch item's fingerprint; far beyond any such
+/// file, short of the memory `/dev/zero` given as one would take.
+pub const MAX_TEXT_FILE_BYTES: u64 = 16 << 20;
+
+/// The text of the file at `path`, at most [`MAX_TEXT_FILE_BYTES`] long
+/// ([`read_bounded`]), as UTF-8.
+pub fn read_text_bounded(path: &std::path::Path) -> std::io::Result<String> {
+    let bytes = read_bounded(path, MAX_TEXT_FILE_BYTES)?;
+    String::from_utf8(bytes).map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+}
+
+/// The file at `path` opened for streaming, when it is a regular file of
+/// at most `max_bytes` (a link to `/dev/zero` would be read for ever).
+pub fn open_bounded(path: &std::path::Path, max_bytes: u64) -> std::io::Result<std::fs::File> {
+    let file = std::fs::File::open(path)?;
+    let meta = file.metadata()?;
+    if !meta.is_file() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            "not a regular file",
+        ));
+    }
+    if meta.len() > max_bytes {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "{} bytes, more than the {max_bytes} bytes read at most",
+                meta.len()
+            ),
+        ));
+    }
+    Ok(file)
+}
+
 /// `len` copies of `value`, or an error where the allocation fails,
 /// rather than the abort of `vec![value; len]`: for buffers sized by a
 /// file or a user's number.

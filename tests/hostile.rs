@@ -1149,3 +1149,41 @@ fn a_report_reads_one_run_whole_or_refuses() {
     stop.store(true, std::sync::atomic::Ordering::Relaxed);
     writer.join().unwrap();
 }
+
+/// Issue 25, item 9: `batch /dev/zero` and `--frame @/dev/zero` grew until
+/// memory ran out, a batch item whose part is `/dev/zero` read 8 GiB, and
+/// `report` with `composite.csv` linked to `/dev/zero` aborted with a
+/// backtrace. Every file read has a size bound: each is a one-line
+/// refusal.
+#[cfg(unix)]
+#[test]
+fn dev_zero_in_place_of_any_file_is_refused_in_one_line() {
+    let dir = scratch_dir("hostile-dev-zero");
+    let zero = "/dev/zero";
+    let o = kneeform(&["batch", zero]);
+    assert!(assert_refused(&o, &dir, "batch /dev/zero").contains("/dev/zero"));
+    let o = kneeform(&[
+        "analyze",
+        &scenario("bump"),
+        "--frame",
+        "@/dev/zero",
+        "--out",
+        &dir.join("f").display().to_string(),
+    ]);
+    assert!(assert_refused(&o, &dir, "--frame @/dev/zero").contains("/dev/zero"));
+    let manifest = dir.join("manifest.toml");
+    std::fs::write(&manifest, "[[item]]\npart = \"/dev/zero\"\nout = \"z\"\n").unwrap();
+    let o = batch(&manifest);
+    assert!(assert_refused(&o, &dir, "a /dev/zero part").contains("not a regular file"));
+    let run = dir.join("run");
+    small_run(&run, &[]);
+    std::fs::remove_file(run.join("composite.csv")).unwrap();
+    std::os::unix::fs::symlink(zero, run.join("composite.csv")).unwrap();
+    let o = kneeform(&[
+        "report",
+        run.to_str().unwrap(),
+        "--out",
+        dir.join("r.html").to_str().unwrap(),
+    ]);
+    assert!(assert_refused(&o, &dir, "composite.csv -> /dev/zero").contains("not a regular file"));
+}

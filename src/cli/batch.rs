@@ -94,7 +94,7 @@ struct Fingerprint {
 const FINGERPRINT_FILE: &str = "batch-item.json";
 
 pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
-    let text = std::fs::read_to_string(&args.manifest)
+    let text = kneeform::limits::read_text_bounded(&args.manifest)
         .with_context(|| format!("cannot read the manifest {}", args.manifest.display()))?;
     let manifest: Manifest = toml::from_str(&text)
         .map_err(|e| anyhow::anyhow!("{}", e.message()))
@@ -183,7 +183,7 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
 /// Whether `out` holds a complete run (or shard: `--shard` in the item's
 /// flags) of this fingerprint.
 fn is_done(out: &Path, fingerprint: &str) -> bool {
-    let recorded = std::fs::read_to_string(out.join(FINGERPRINT_FILE))
+    let recorded = kneeform::limits::read_text_bounded(&out.join(FINGERPRINT_FILE))
         .ok()
         .and_then(|t| serde_json::from_str::<Fingerprint>(&t).ok());
     let complete = out.join("summary.json").is_file() || out.join("shard.json").is_file();

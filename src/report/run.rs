@@ -500,10 +500,12 @@ struct CsvRows {
 
 impl CsvRows {
     fn open(path: &Path, wanted: &[&str]) -> Result<CsvRows, ReportError> {
-        let file = std::fs::File::open(path).map_err(|source| ReportError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let file = crate::limits::open_bounded(path, crate::limits::MAX_RUN_TABLE_BYTES).map_err(
+            |source| ReportError::Io {
+                path: path.to_path_buf(),
+                source,
+            },
+        )?;
         let mut reader = csv::Reader::from_reader(file);
         let bad = |reason: String| ReportError::Inconsistent {
             path: path.to_path_buf(),

@@ -98,7 +98,7 @@ pub enum ScenarioError {
 
 /// Reads and checks the scenario file at `path`.
 pub fn load(path: &Path) -> Result<ScenarioFile, ScenarioError> {
-    let text = std::fs::read_to_string(path).map_err(|cause| ScenarioError::Read {
+    let text = crate::limits::read_text_bounded(path).map_err(|cause| ScenarioError::Read {
         path: path.to_owned(),
         cause,
     })?;
