@@ -1187,3 +1187,39 @@ fn dev_zero_in_place_of_any_file_is_refused_in_one_line() {
     ]);
     assert!(assert_refused(&o, &dir, "composite.csv -> /dev/zero").contains("not a regular file"));
 }
+
+/// Issue 25, item 12: `--pitch auto` ignored `--budget-s` during its own
+/// study (`--tolerance 1e-9 --budget-s 5` ran 300 s; `--tolerance 2`
+/// refused only after 28 s). A tolerance no studied pitch can show is
+/// refused before any work, and the study's oracle and pitches count
+/// against the budget.
+#[test]
+fn the_pitch_study_keeps_within_its_budget() {
+    let dir = scratch_dir("hostile-auto-budget");
+    for (extra, needle) in [
+        (
+            ["--tolerance", "1e-9", "--budget-s", "5"],
+            "beyond what --pitch auto can show",
+        ),
+        (
+            ["--tolerance", "1", "--budget-s", "0.001"],
+            "--budget-s 0.001",
+        ),
+    ] {
+        let out = dir.join("run");
+        let mut args = vec![
+            "analyze".to_string(),
+            scenario("bump"),
+            "--pitch".into(),
+            "auto".into(),
+            "--out".into(),
+            out.display().to_string(),
+        ];
+        args.extend(extra.iter().map(|s| s.to_string()));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = kneeform(&args);
+        let err = assert_refused(&o, &dir, needle);
+        assert!(err.contains(needle), "{err}");
+        assert!(!out.exists());
+    }
+}

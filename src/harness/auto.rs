@@ -135,6 +135,16 @@ pub fn choose_pitch(
     let pitches: Vec<f64> = (0..=MAX_HALVINGS)
         .map(|k| p0 / f64::from(1u32 << k))
         .collect();
+    // The grid's error is of the order of its pitch: a tolerance below the
+    // finest pitch tried is never met, and would only cost the study's
+    // finest oracle (1e-9 mm ran 300 s against a budget of 5).
+    let finest = pitches[pitches.len() - 1];
+    if auto.tolerance < finest {
+        return Err(HarnessError::ToleranceTooFine {
+            tolerance: auto.tolerance,
+            finest,
+        });
+    }
     let angles = study_angles(&setup.angles);
     let ladder = Ladder::new(
         input,
@@ -150,6 +160,7 @@ pub fn choose_pitch(
         },
         TieBand::DEFAULT_PER_MM,
         None,
+        Some(auto.budget_s),
         progress,
     )?;
     let scale = setup.angles.len() as f64 / angles.len() as f64;
@@ -162,7 +173,26 @@ pub fn choose_pitch(
     let mut rows: Vec<PitchStudyRow> = Vec::new();
     // The struck points per angle at the previous (coarser) pitch.
     let mut previous: Option<Vec<Vec<[f64; 2]>>> = None;
+    // The study's own time counts against the budget: the whole command
+    // stays within it (the exact traces are taken once, then each pitch
+    // costs about 8 times the coarser one's).
+    let mut last_measure_s: Option<f64> = None;
     for &p in &pitches {
+        let spent_s = started.elapsed().as_secs_f64();
+        let next_s = last_measure_s.map_or(0.0, |s| 8.0 * s);
+        if spent_s + next_s > auto.budget_s {
+            return Err(HarnessError::StudyBudget {
+                tolerance: auto.tolerance,
+                spent_s,
+                next: if next_s > 0.0 {
+                    format!(" and {p} mm would take about {next_s:.0} s more")
+                } else {
+                    String::new()
+                },
+                budget_s: auto.budget_s,
+                studied: studied(&rows),
+            });
+        }
         let spec = ladder.spec_at(p);
         let need = memory(&spec);
         // Cost grows as p^-3 (nodes p^-2, footprint rows p^-1).
@@ -178,7 +208,9 @@ pub fn choose_pitch(
                 studied: studied(&rows),
             });
         }
+        let measuring = Instant::now();
         let (result, masks, grid) = ladder.measure(p, progress)?;
+        last_measure_s = Some(measuring.elapsed().as_secs_f64());
         let (comparison, seconds) = (&result.comparison, result.seconds);
         // Judged: misses from decided strikes away from blind spots, and
         // false alarms the level error does not explain.

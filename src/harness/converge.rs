@@ -197,6 +197,53 @@ pub(super) struct Ladder<'a> {
     compare: CompareOptions,
 }
 
+/// The exact traces of `starts` at `angles` (in [`run_oracle`]'s order),
+/// taken a few starts at a time and given up as soon as `budget_s`
+/// seconds are spent, with what the rest would take: a pitch study keeps
+/// within its budget, the oracle included (a 5 s budget once ran 300 s).
+fn traces_within(
+    triangles: &[Triangle],
+    starts: &[[f64; 2]],
+    angles: &[f64],
+    options: &kneeform_oracle::OracleOptions,
+    budget_s: f64,
+    progress: &dyn Progress,
+) -> Result<(Vec<StartTrace>, f64), HarnessError> {
+    let started = Instant::now();
+    let part = kneeform_oracle::Part::from_triangles(triangles)?;
+    let pairs = starts.len() * angles.len();
+    progress.begin(
+        &format!(
+            "exact oracle: {} starts x {} angles",
+            starts.len(),
+            angles.len()
+        ),
+        Some(pairs as u64),
+    );
+    let chunk = (2 * rayon::current_num_threads()).max(4);
+    let mut traces = Vec::with_capacity(pairs);
+    for &angle in angles {
+        for share in starts.chunks(chunk) {
+            let spent_s = started.elapsed().as_secs_f64();
+            if spent_s > budget_s {
+                progress.end();
+                let done = traces.len().max(1) as f64;
+                return Err(HarnessError::OracleBudget {
+                    predicted_s: spent_s * pairs as f64 / done,
+                    pairs,
+                    budget_s,
+                });
+            }
+            traces.extend(kneeform_oracle::evaluate(&part, share, &[angle], options)?);
+            for _ in share {
+                progress.step();
+            }
+        }
+    }
+    progress.end();
+    Ok((traces, started.elapsed().as_secs_f64()))
+}
+
 impl<'a> Ladder<'a> {
     /// The coarsest grid of `setup` (its pitch) on `input`, the starts of
     /// `selection` on it (`shard`'s share of them when given), and their
@@ -209,6 +256,7 @@ impl<'a> Ladder<'a> {
         selection: &StartSelection,
         tie_band_per_mm: f64,
         shard: Option<Shard>,
+        oracle_budget_s: Option<f64>,
         progress: &dyn Progress,
     ) -> Result<Ladder<'a>, HarnessError> {
         setup.validate()?;
@@ -219,7 +267,17 @@ impl<'a> Ladder<'a> {
         drop(coarse_grid);
         let starts = super::sharded::share(&all_starts, shard)?;
         let oracle = oracle_options(&setup.knee, finest, coarse.x(0));
-        let (traces, oracle_s) = run_oracle(triangles, &starts, &setup.angles, &oracle, progress)?;
+        let (traces, oracle_s) = match oracle_budget_s {
+            None => run_oracle(triangles, &starts, &setup.angles, &oracle, progress)?,
+            Some(budget_s) => traces_within(
+                triangles,
+                &starts,
+                &setup.angles,
+                &oracle,
+                budget_s,
+                progress,
+            )?,
+        };
         Ok(Ladder {
             triangles,
             setup: setup.clone(),
@@ -425,6 +483,7 @@ pub fn converge(
         pitches[pitches.len() - 1],
         &options.selection,
         options.tie_band_per_mm,
+        None,
         None,
         progress,
     )?;

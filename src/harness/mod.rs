@@ -142,6 +142,45 @@ pub enum HarnessError {
         /// The study so far, in words.
         studied: String,
     },
+    /// The pitch study itself ran past the time budget.
+    #[error(
+        "the pitch study for a tolerance of {tolerance} mm took {spent_s:.1} s{next}, beyond --budget-s {budget_s} (raise it, or accept a larger --tolerance); decided area distance to the exact knee-form at the pitches studied: {studied}"
+    )]
+    StudyBudget {
+        /// The tolerance (mm).
+        tolerance: f64,
+        /// Seconds spent.
+        spent_s: f64,
+        /// What the next step would add, in words (or nothing).
+        next: String,
+        /// The budget (s).
+        budget_s: f64,
+        /// The study so far, in words.
+        studied: String,
+    },
+    /// The exact traces of a pitch study would take longer than its
+    /// budget.
+    #[error(
+        "the pitch study's exact traces ({pairs} start-angle pairs) would take about {predicted_s:.0} s at the rate they ran, beyond --budget-s {budget_s} (raise it, or accept a larger --tolerance: a coarser finest pitch makes the oracle's casts cheaper)"
+    )]
+    OracleBudget {
+        /// The predicted oracle time (s).
+        predicted_s: f64,
+        /// Start-angle pairs to trace.
+        pairs: usize,
+        /// The budget (s).
+        budget_s: f64,
+    },
+    /// A tolerance finer than the study's finest pitch can show.
+    #[error(
+        "a tolerance of {tolerance} mm is beyond what --pitch auto can show: its finest pitch is {finest} mm, and the grid's error is of the order of the pitch (accept a tolerance of {finest} mm or more)"
+    )]
+    ToleranceTooFine {
+        /// The tolerance (mm).
+        tolerance: f64,
+        /// The finest pitch the study would try (mm).
+        finest: f64,
+    },
     /// No pitch of the study meets the tolerance.
     #[error(
         "no pitch down to {finest} mm meets a tolerance of {tolerance} mm: decided area distance to the exact knee-form {studied} (results/README.md says what does not converge)"

@@ -274,6 +274,7 @@ pub fn converge_shard(
         &options.selection,
         options.tie_band_per_mm,
         Some(shard),
+        None,
         progress,
     )?;
     let sample_s = (t.elapsed().as_secs_f64() - ladder.oracle_s).max(0.0);
