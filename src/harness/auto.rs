@@ -159,8 +159,10 @@ pub fn choose_pitch(
             seed: 1,
         },
         TieBand::DEFAULT_PER_MM,
-        None,
-        Some(auto.budget_s),
+        super::converge::Share {
+            shard: None,
+            oracle_budget_s: Some(auto.budget_s),
+        },
         progress,
     )?;
     let scale = setup.angles.len() as f64 / angles.len() as f64;

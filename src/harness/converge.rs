@@ -197,6 +197,16 @@ pub(super) struct Ladder<'a> {
     compare: CompareOptions,
 }
 
+/// Which of a ladder's starts to trace, and within what time.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Share {
+    /// A shard's share of the starts (all of them when `None`).
+    pub shard: Option<Shard>,
+    /// Seconds the oracle may take (a pitch study's budget; unbounded
+    /// when `None`).
+    pub oracle_budget_s: Option<f64>,
+}
+
 /// The exact traces of `starts` at `angles` (in [`run_oracle`]'s order),
 /// taken a few starts at a time and given up as soon as `budget_s`
 /// seconds are spent, with what the rest would take: a pitch study keeps
@@ -255,10 +265,13 @@ impl<'a> Ladder<'a> {
         finest: f64,
         selection: &StartSelection,
         tie_band_per_mm: f64,
-        shard: Option<Shard>,
-        oracle_budget_s: Option<f64>,
+        share: Share,
         progress: &dyn Progress,
     ) -> Result<Ladder<'a>, HarnessError> {
+        let Share {
+            shard,
+            oracle_budget_s,
+        } = share;
         setup.validate()?;
         let triangles = &input.part.triangles;
         let coarse = setup.grid_spec(&input.part)?;
@@ -483,8 +496,7 @@ pub fn converge(
         pitches[pitches.len() - 1],
         &options.selection,
         options.tie_band_per_mm,
-        None,
-        None,
+        Share::default(),
         progress,
     )?;
     for &p in pitches {

@@ -273,8 +273,10 @@ pub fn converge_shard(
         pitches[pitches.len() - 1],
         &options.selection,
         options.tie_band_per_mm,
-        Some(shard),
-        None,
+        super::converge::Share {
+            shard: Some(shard),
+            oracle_budget_s: None,
+        },
         progress,
     )?;
     let sample_s = (t.elapsed().as_secs_f64() - ladder.oracle_s).max(0.0);
