@@ -18,8 +18,20 @@ fn main() -> ExitCode {
     // An interrupted run leaves nothing behind: its staged results and
     // temporary files are removed (a commit in progress finishes first).
     let handler = ctrlc::set_handler(|| {
-        kneeform::output::remove_staged();
-        eprintln!("kneeform: interrupted; partial results removed");
+        use kneeform::output::Interrupted;
+        // A batch's running item ends first: its lock must not outlive
+        // the batch (an immediate resume was refused by it).
+        cli::batch::end_running_child();
+        // What is true when the signal came: a merge interrupted in its
+        // final commit has written its result whole.
+        eprintln!(
+            "kneeform: interrupted; {}",
+            match kneeform::output::remove_staged() {
+                Interrupted::PartialRemoved => "partial results removed",
+                Interrupted::AfterCommit => "its results were already written whole",
+                Interrupted::BeforeAnyResult => "nothing was written",
+            }
+        );
         std::process::exit(INTERRUPTED);
     });
     if let Err(err) = handler {

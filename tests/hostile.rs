@@ -309,6 +309,11 @@ fn a_signal_removes_the_staged_results() {
         let status = child.wait().unwrap();
         assert_eq!(status.code(), Some(130), "SIG{signal}");
         assert!(!d.exists(), "SIG{signal}: an output directory");
+        // Issue 25, item 14: the lock file's name went with the run.
+        assert!(
+            !scratch.join(".out.lock").exists(),
+            "SIG{signal}: .out.lock left behind"
+        );
         assert!(
             leftovers(&scratch).is_empty(),
             "SIG{signal}: {:?}",
@@ -1222,4 +1227,62 @@ fn the_pitch_study_keeps_within_its_budget() {
         assert!(err.contains(needle), "{err}");
         assert!(!out.exists());
     }
+}
+
+/// Issue 25, item 15: SIGTERM to `batch` left its running item going, and
+/// an immediate resume was refused by that item's lock. The batch ends its
+/// item first: nothing of it is left, and the resume runs at once.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_batch_ended_by_a_signal_ends_its_item_and_resumes_at_once() {
+    let dir = scratch_dir("hostile-batch-term");
+    std::fs::copy(scenario("wave"), dir.join("wave.toml")).unwrap();
+    let manifest = dir.join("manifest.toml");
+    // One item slow enough to be caught running.
+    std::fs::write(
+        &manifest,
+        "[[item]]\npart = \"wave.toml\"\nout = \"runs/slow\"\npitch = 1\n",
+    )
+    .unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_kneeform"))
+        .args(["batch", manifest.to_str().unwrap()])
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let runs = dir.join("runs");
+    let staged = || {
+        std::fs::read_dir(&runs).is_ok_and(|d| {
+            d.flatten().any(|e| {
+                e.file_name()
+                    .to_string_lossy()
+                    .starts_with(".slow.partial-")
+            })
+        })
+    };
+    while !staged() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "ended before its item staged"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    // The batch alone, not its process group: as a scheduler's TERM to
+    // the job's main process.
+    let kill = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    assert_eq!(child.wait().unwrap().code(), Some(130));
+    assert!(
+        !runs.join(".slow.lock").exists(),
+        "the item's lock outlived the batch"
+    );
+    assert!(leftovers(&runs).is_empty(), "{:?}", leftovers(&runs));
+    let o = batch(&manifest);
+    assert!(
+        o.status.success(),
+        "the resume: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 }

@@ -81,6 +81,42 @@ impl Flags {
     }
 }
 
+/// The item's run in progress (its process id): a batch ended by a
+/// signal ends it first ([`end_running_child`]), so that a resumed batch
+/// does not find its lock held.
+static RUNNING_CHILD: std::sync::Mutex<Option<u32>> = std::sync::Mutex::new(None);
+
+/// Set by [`end_running_child`]: the batch is ending on a signal.
+static STOPPING: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+fn running_child() -> std::sync::MutexGuard<'static, Option<u32>> {
+    RUNNING_CHILD
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// Sends the running item's process SIGTERM and waits (up to a minute)
+/// for it to end, having removed its staged results: for the batch's
+/// signal handler. Nothing when no item runs.
+pub fn end_running_child() {
+    let Some(pid) = *running_child() else {
+        return;
+    };
+    STOPPING.store(true, std::sync::atomic::Ordering::SeqCst);
+    let _ = Command::new("kill")
+        .args(["-TERM", &pid.to_string()])
+        .stderr(std::process::Stdio::null())
+        .status();
+    let proc_dir = PathBuf::from(format!("/proc/{pid}"));
+    for _ in 0..600 {
+        // The batch's main thread reaps it (it waits on it).
+        if running_child().is_none() || !proc_dir.exists() {
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+}
+
 /// `batch-item.json`: what an item's run was made from.
 #[derive(Debug, Serialize, Deserialize, PartialEq)]
 struct Fingerprint {
@@ -153,12 +189,21 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
         eprintln!("kneeform: {what}: kneeform {}", argv.join(" "));
         // --force: an earlier run of another fingerprint is replaced whole
         // (never a directory of other files: analyze refuses those).
-        let status = Command::new(&exe)
+        let mut child = Command::new(&exe)
             .args(&argv)
             .arg("--force")
             .current_dir(&base)
-            .status()
+            .spawn()
             .with_context(|| format!("{what}: cannot start {}", exe.display()))?;
+        *running_child() = Some(child.id());
+        let status = child.wait();
+        *running_child() = None;
+        // Ended by the batch's own signal handler: it exits the batch (130)
+        // once the item is gone; this thread must not report a failure.
+        while STOPPING.load(std::sync::atomic::Ordering::SeqCst) {
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        }
+        let status = status.with_context(|| format!("{what}: lost its run"))?;
         if !status.success() {
             bail!(
                 "{what} failed ({status}); the items before it are complete, and `kneeform batch` again resumes here"

@@ -226,6 +226,7 @@ impl DirLock {
                 Err(std::fs::TryLockError::Error(e)) => return Err(e),
             }
             if still_named(&file, &path) {
+                held_locks().push(path.clone());
                 return Ok(DirLock { file, path });
             }
         }
@@ -251,6 +252,7 @@ fn still_named(_file: &std::fs::File, path: &Path) -> bool {
 impl Drop for DirLock {
     fn drop(&mut self) {
         // The name first, then the lock (when `file` closes).
+        held_locks().retain(|p| p != &self.path);
         let _ = std::fs::remove_file(&self.path);
         let _ = self.file.unlock();
     }
@@ -293,13 +295,40 @@ fn forget_staged(path: &Path) {
     staged_paths().retain(|p| p != path);
 }
 
+/// The lock files this process holds ([`DirLock`]): a signal handler
+/// removes their names as a release does (the locks themselves end with
+/// the process).
+static HELD_LOCKS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn held_locks() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    HELD_LOCKS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// Result directories this process has committed: what an interrupted
+/// process may say it finished.
+static COMMITTED: AtomicUsize = AtomicUsize::new(0);
+
+/// What [`remove_staged`] found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Interrupted {
+    /// Staged results were removed.
+    PartialRemoved,
+    /// Nothing was staged, and some result was committed whole before.
+    AfterCommit,
+    /// Nothing was staged or committed.
+    BeforeAnyResult,
+}
+
 /// Removes every staging directory and temporary file this process has
 /// not committed: for a signal handler (SIGINT, SIGTERM) before it exits,
 /// so that an interrupted run leaves nothing behind. A commit in progress
 /// finishes first (it holds the same lock), so a directory is either
 /// committed whole or removed.
-pub fn remove_staged() {
+pub fn remove_staged() -> Interrupted {
     let mut paths = staged_paths();
+    let removed = !paths.is_empty();
     for path in paths.drain(..) {
         let _ = if path.is_dir() {
             std::fs::remove_dir_all(&path)
@@ -307,8 +336,20 @@ pub fn remove_staged() {
             std::fs::remove_file(&path)
         };
     }
+    // The lock files' names go too (the locks end with the process): an
+    // interrupted run left `.NAME.lock` behind.
+    for lock in held_locks().drain(..) {
+        let _ = std::fs::remove_file(&lock);
+    }
     // Held until the process exits: no commit may start after this.
     std::mem::forget(paths);
+    if removed {
+        Interrupted::PartialRemoved
+    } else if COMMITTED.load(Ordering::SeqCst) > 0 {
+        Interrupted::AfterCommit
+    } else {
+        Interrupted::BeforeAnyResult
+    }
 }
 
 /// Removes the stagings of `name` in `parent` left by processes that no
@@ -443,6 +484,7 @@ impl OutputDir {
             std::fs::remove_dir(&self.staging)?;
         }
         self.committed = true;
+        COMMITTED.fetch_add(1, Ordering::SeqCst);
         staged.retain(|p| p != &self.staging);
         drop(staged);
         sync_path(&self.final_dir)?;
