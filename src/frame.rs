@@ -164,6 +164,12 @@ impl Frame {
             path: path.to_path_buf(),
             source,
         })?;
+        Frame::from_matrix_text(&text, path, given)
+    }
+
+    /// The frame of a matrix file's `text` (`path` and `given` for
+    /// messages): a 4x4 or 3x4 matrix, row by row, `#` comments.
+    pub fn from_matrix_text(text: &str, path: &Path, given: &str) -> Result<Frame, FrameError> {
         let bad = |reason: String| FrameError::Matrix {
             path: path.to_path_buf(),
             reason,

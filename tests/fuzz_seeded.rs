@@ -143,6 +143,15 @@ fn seeds(target: &str) -> Vec<Vec<u8>> {
             .map(|p| coarsened(&String::from_utf8(read(p)).expect("UTF-8")).into_bytes())
             .collect(),
         "summary" => vec![summary_json()],
+        "frame" => [
+            "# part to vehicle\n0 1 0 0\n0 0 1 0\n1 0 0 0\n0 0 0 1\n",
+            "0.8660254038 0 0.5 250\n0 1 0 -700\n-0.5 0 0.8660254038 410\n",
+            "1,0,0,0\n0,-1,0,0\n0,0,-1,0\n0,0,0,1\n",
+        ]
+        .iter()
+        .map(|t| t.as_bytes().to_vec())
+        .collect(),
+        "shard_json" => vec![shard_json()],
         _ => unreachable!("no target {target}"),
     };
     seeds.extend(regressions(target));
@@ -180,6 +189,25 @@ fn summary_json() -> Vec<u8> {
     )
     .expect("bump.toml analyses");
     serde_json::to_vec_pretty(&analysis.summary()).expect("a summary serialises")
+}
+
+/// The `shard.json` of shard 1 of 2 of a small real run: bump.toml at an
+/// 8 mm pitch and three angles.
+fn shard_json() -> Vec<u8> {
+    let out = scratch_dir("fuzz-shard-seed").join("shard");
+    let o = crate::cli::kneeform(&[
+        "analyze",
+        repo().join("scenarios/bump.toml").to_str().unwrap(),
+        "--pitch",
+        "8",
+        "--angles=-30,0,30",
+        "--shard",
+        "1/2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    read(&out.join("shard.json"))
 }
 
 /// A small random number below `n` (`n > 0`).
@@ -313,6 +341,16 @@ fn scenario_mutants_do_not_panic() {
 #[test]
 fn summary_mutants_do_not_panic() {
     mutation_loop("summary", &seeds("summary"), entry::summary);
+}
+
+#[test]
+fn frame_mutants_do_not_panic() {
+    mutation_loop("frame", &seeds("frame"), entry::frame);
+}
+
+#[test]
+fn shard_json_mutants_do_not_panic() {
+    mutation_loop("shard_json", &seeds("shard_json"), entry::shard_json);
 }
 
 /// Every committed reproducer, as it was found (unmutated), through the

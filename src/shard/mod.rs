@@ -646,6 +646,35 @@ const HEADER_LEN: usize = 16 + 5 * 8 + 1 + 8;
 /// Per blind spot: i, j and six f64.
 const BLIND_LEN: usize = 8 * 8;
 
+/// An analysis shard's `shard.json` checked as [`merge`] checks it before
+/// it reads `shard.bin`: its own digest, its fields, its summary's bounds
+/// and its angle indices. For the fuzz targets.
+pub fn check_record(text: &[u8]) -> Result<ShardRecord, String> {
+    let record: ShardRecord = unsealed_json(text).and_then(|v| {
+        serde_json::from_value(v).map_err(|e| format!("not a kneeform shard.json: {e}"))
+    })?;
+    if record.format != FORMAT {
+        return Err(format!("shard format {}", record.format));
+    }
+    let summary_text = serde_json::to_string(&record.summary).unwrap_or_default();
+    Summary::from_json(&summary_text).map_err(|e| e.to_string())?;
+    let angles = record.summary.angles_deg.len();
+    if record.shard.count > crate::limits::MAX_ANGLES
+        || !record.shard.holds(angles, &record.angle_indices)
+    {
+        return Err("its shard does not hold its angles".into());
+    }
+    Ok(record)
+}
+
+/// `text` with its `record_sha256` made its content's again: a mutated
+/// shard.json that still parses, sealed, so that a fuzzer reaches the
+/// checks past the digest.
+pub fn reseal(text: &[u8]) -> Option<Vec<u8>> {
+    let value: serde_json::Value = serde_json::from_slice(text).ok()?;
+    Some(sealed_json(value).into_bytes())
+}
+
 fn read_shard(dir: &Path) -> Result<ShardFiles, ShardError> {
     let json_path = dir.join("shard.json");
     let io = |path: &Path| {

@@ -73,3 +73,46 @@ pub fn summary(data: &[u8]) -> bool {
     );
     true
 }
+
+/// `data` read as a `--frame @FILE` matrix file; whether it made a frame.
+/// An accepted frame maps a point there and back within rounding.
+pub fn frame(data: &[u8]) -> bool {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return false;
+    };
+    let Ok(frame) =
+        kneeform::frame::Frame::from_matrix_text(text, Path::new("fuzz.txt"), "@fuzz.txt")
+    else {
+        return false;
+    };
+    let p = [12.5, -3.0, 400.0];
+    let v = frame.to_vehicle(p);
+    // A translation near f64's end overflows: the placed-coordinate bound
+    // refuses such a part (read_part_placed), so nothing to map back.
+    if !v.iter().all(|c| c.is_finite()) {
+        return true;
+    }
+    let back = frame.to_part(v);
+    let scale = p
+        .iter()
+        .chain(&frame.to_vehicle(p))
+        .fold(1.0f64, |m, c| m.max(c.abs()));
+    assert!(
+        back.iter()
+            .zip(p)
+            .all(|(a, b)| (a - b).abs() <= 1e-6 * scale),
+        "a frame does not map back: {p:?} -> {back:?}"
+    );
+    true
+}
+
+/// `data` read as an analysis shard's `shard.json`, resealed (its own
+/// SHA-256 made its content's again, so that the checks past it are
+/// reached) and checked as `merge` checks it before sizing anything by
+/// it; whether it was accepted.
+pub fn shard_json(data: &[u8]) -> bool {
+    let Some(sealed) = kneeform::shard::reseal(data) else {
+        return false;
+    };
+    kneeform::shard::check_record(&sealed).is_ok()
+}

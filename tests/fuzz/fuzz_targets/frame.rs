@@ -1,0 +1,12 @@
+//! Any bytes read as a `--frame @FILE` matrix file
+//! (`entry::frame`, shared with the stable seeded run in the test suite).
+
+#![no_main]
+
+#[allow(dead_code)] // each target calls one of the entry points
+#[path = "../entry.rs"]
+mod entry;
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    entry::frame(data);
+});
