@@ -653,17 +653,19 @@ fn force_replaces_only_a_directory_of_kneeform_files() {
     std::fs::create_dir_all(folder.join("figures")).unwrap();
     std::fs::write(folder.join("summary.json"), "{}").unwrap();
     std::fs::write(folder.join("thesis.tex"), "\\documentclass{article}").unwrap();
-    let o = kneeform(&[
-        "analyze",
-        &scenario("bump"),
-        "--out",
-        &folder.display().to_string(),
-        "--force",
-        "--pitch",
-        "4",
-        "--angles=0",
-    ]);
-    let err = assert_refused(&o, &dir, "a user's folder");
+    let force_into_folder = || {
+        kneeform(&[
+            "analyze",
+            &scenario("bump"),
+            "--out",
+            &folder.display().to_string(),
+            "--force",
+            "--pitch",
+            "4",
+            "--angles=0",
+        ])
+    };
+    let err = assert_refused(&force_into_folder(), &dir, "a user's folder");
     assert!(
         err.contains("figures") || err.contains("thesis.tex"),
         "{err}"
@@ -676,17 +678,7 @@ fn force_replaces_only_a_directory_of_kneeform_files() {
     assert!(folder.join("figures").is_dir());
     // A subdirectory alone is enough to refuse.
     std::fs::remove_file(folder.join("thesis.tex")).unwrap();
-    let o = kneeform(&[
-        "analyze",
-        &scenario("bump"),
-        "--out",
-        &folder.display().to_string(),
-        "--force",
-        "--pitch",
-        "4",
-        "--angles=0",
-    ]);
-    assert!(assert_refused(&o, &dir, "a subdirectory").contains("figures"));
+    assert!(assert_refused(&force_into_folder(), &dir, "a subdirectory").contains("figures"));
     // A run with its report beside it is kneeform's own: replaced.
     let run = dir.join("run");
     small_run(&run, &[]);
