@@ -128,16 +128,20 @@ pub fn print_verification(result: &Verification, out: &Path) -> ExitCode {
             let at = w.at.map_or(String::new(), |[x, z]| {
                 format!(" (the disagreement lies at x = {x:.1}, z = {z:.1} mm)")
             });
-            // A rim miss is the footprint's reach, not a feature's width.
-            let rim = s.failures.iter().any(|f| {
-                f.metric == w.metric
-                    && f.mechanism == kneeform::harness::causes::Mechanism::Rim
-                    && f.value.is_some_and(|v| (v - w.value).abs() < 1e-9)
-            });
-            let hint = if rim {
-                "; it lies in the knee-form's rim, between its outline and the grid's footprint, which reaches up to a pitch less far: a finer pitch narrows the rim".to_string()
-            } else {
-                resolving_pitch(s.pitch_mm, s.tolerance_mm, &w.metric, w.value)
+            // The hint follows the figure's mechanism: a rim or a brief
+            // strike is the grid's sampling, not a feature's width.
+            use kneeform::harness::causes::Mechanism;
+            let mechanism = s
+                .failures
+                .iter()
+                .find(|f| {
+                    f.metric == w.metric && f.value.is_some_and(|v| (v - w.value).abs() < 1e-9)
+                })
+                .map(|f| f.mechanism);
+            let hint = match mechanism {
+                Some(Mechanism::Rim) => "; it lies in the knee-form's rim, which the grid samples late (the nearest node met more than sqrt 2 pitches of travel after the touch, where the outline crosses the grid's rows at a shallow angle): a finer pitch narrows the rim, at half order along the slide".to_string(),
+                Some(Mechanism::Sampling) if w.value > std::f64::consts::SQRT_2 * s.pitch_mm => "; a strike lasting less than sqrt 2 pitches of travel before the knee-form touches elsewhere (brief): the grid meets its nodes after it; a finer pitch resolves it".to_string(),
+                _ => resolving_pitch(s.pitch_mm, s.tolerance_mm, &w.metric, w.value),
             };
             let short = kneeform::limits::short;
             format!(

@@ -1034,8 +1034,17 @@ impl Comparison {
     /// `n`.
     ///
     /// Pairs whose worst metric is one of `failing` (the figures that fail
-    /// the verdict) come first: they are where a reader looks.
-    pub fn worst(&self, n: usize, failing: &[&str]) -> Vec<(VerifyRow, String, f64)> {
+    /// the verdict, each with its failing value) come first: they are where
+    /// a reader looks. A pair's value above its metric's failing value is
+    /// explained by a mechanism that does not fail (the level error's 176
+    /// mm first contact beside a failing 1.7 mm rest of it): it does not
+    /// count as failing.
+    pub fn worst(&self, n: usize, failing: &[(&str, f64)]) -> Vec<(VerifyRow, String, f64)> {
+        let fails = |m: &str, v: f64| {
+            failing
+                .iter()
+                .any(|&(f, limit)| f == m && v <= limit + 1e-9)
+        };
         let mut scored: Vec<(VerifyRow, String, f64)> = self
             .rows
             .iter()
@@ -1057,16 +1066,18 @@ impl Comparison {
                     .into_iter()
                     .filter_map(|(m, v)| v.map(|v| (m, v.abs())))
                     .max_by(|a, b| {
-                        failing
-                            .contains(&a.0)
-                            .cmp(&failing.contains(&b.0))
+                        fails(a.0, a.1)
+                            .cmp(&fails(b.0, b.1))
                             .then(a.1.total_cmp(&b.1))
                     })?;
                 Some((r.clone(), name.to_string(), v))
             })
             .collect();
-        let fails = |m: &str| failing.contains(&m);
-        scored.sort_by(|a, b| fails(&b.1).cmp(&fails(&a.1)).then(b.2.total_cmp(&a.2)));
+        scored.sort_by(|a, b| {
+            fails(&b.1, b.2)
+                .cmp(&fails(&a.1, a.2))
+                .then(b.2.total_cmp(&a.2))
+        });
         scored.truncate(n);
         scored
     }

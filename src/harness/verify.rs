@@ -361,8 +361,8 @@ impl VerifySummary {
                     .failures
                     .iter()
                     .filter(|f| f.fails_verdict)
-                    .map(|f| f.metric.as_str())
-                    .collect::<Vec<&str>>(),
+                    .map(|f| (f.metric.as_str(), f.value.unwrap_or(f64::INFINITY)))
+                    .collect::<Vec<(&str, f64)>>(),
             )
             .into_iter()
             .map(|(row, metric, value)| WorstStart {
