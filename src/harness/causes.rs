@@ -159,35 +159,36 @@ impl Cells {
     /// push; `+inf` where it never does, or no node of the part is that
     /// near).
     pub fn nearest_node_met_at(&self, p: [f64; 3], rows: &[FootprintSpan]) -> f64 {
+        self.nodes_near(p)
+            .min_by(|a, b| a.2.total_cmp(&b.2))
+            .and_then(|(i, j, _, _)| met_at(rows, i, j, self.spec.x(i)))
+            .unwrap_or(f64::INFINITY)
+    }
+
+    /// The nodes of the part within [`RISE_REACH`] pitches of `p` in xz:
+    /// `(i, j, distance, height)`.
+    fn nodes_near(&self, p: [f64; 3]) -> impl Iterator<Item = (usize, usize, f64, f64)> + '_ {
         let spec = self.spec;
-        let reach = RISE_REACH * spec.pitch + CELL_TOL;
-        let (ci, cj) = (
-            ((p[0] - spec.x(0)) / spec.pitch).round(),
-            ((p[2] - spec.z(0)) / spec.pitch).round(),
-        );
-        let mut best: Option<(f64, f64)> = None;
-        for dj in -2..=2 {
-            for di in -2..=2 {
-                let (i, j) = (ci + f64::from(di), cj + f64::from(dj));
-                if i < 0.0 || j < 0.0 || i >= spec.nx as f64 || j >= spec.nz as f64 {
-                    continue;
-                }
-                let (i, j) = (i as usize, j as usize);
-                let d = (spec.x(i) - p[0]).hypot(spec.z(j) - p[2]);
-                if d > reach || !self.heights[j * spec.nx + i].is_finite() {
-                    continue;
-                }
-                let met = rows
-                    .iter()
-                    .filter(|r| r.j == j)
-                    .find_map(|r| r.meets(i as i64, spec.x(i)))
-                    .unwrap_or(f64::INFINITY);
-                if best.is_none_or(|(bd, _)| d < bd) {
-                    best = Some((d, met));
-                }
+        let reach = RISE_REACH * spec.pitch;
+        let index = move |v: f64, origin: f64, n: usize| {
+            let lo = ((v - reach - origin) / spec.pitch).ceil().max(0.0);
+            let hi = ((v + reach - origin) / spec.pitch)
+                .floor()
+                .min(n as f64 - 1.0);
+            if hi < lo || !lo.is_finite() || !hi.is_finite() {
+                0..0
+            } else {
+                lo as usize..hi as usize + 1
             }
-        }
-        best.map_or(f64::INFINITY, |(_, met)| met)
+        };
+        let columns = index(p[0], spec.x(0), spec.nx);
+        index(p[2], spec.z(0), spec.nz)
+            .flat_map(move |j| columns.clone().map(move |i| (i, j)))
+            .filter_map(move |(i, j)| {
+                let d = (spec.x(i) - p[0]).hypot(spec.z(j) - p[2]);
+                let h = self.heights[j * spec.nx + i];
+                (d <= reach + CELL_TOL && h.is_finite()).then_some((i, j, d, h))
+            })
     }
 
     /// The least and the largest `h - y` over the nodes of the part within
@@ -200,41 +201,29 @@ impl Cells {
         p: [f64; 3],
         footprint: Option<(&[FootprintSpan], f64, bool)>,
     ) -> Option<(f64, f64)> {
-        let spec = self.spec;
-        let reach = RISE_REACH * spec.pitch;
-        let index = |v: f64, origin: f64, n: usize| {
-            let lo = ((v - reach - origin) / spec.pitch).ceil().max(0.0);
-            let hi = ((v + reach - origin) / spec.pitch)
-                .floor()
-                .min(n as f64 - 1.0);
-            if hi < lo || !lo.is_finite() || !hi.is_finite() {
-                0..0
-            } else {
-                lo as usize..hi as usize + 1
-            }
+        let covered = |i: usize, j: usize| {
+            footprint.is_none_or(|(rows, travel, slide_only)| {
+                met_at(rows, i, j, self.spec.x(i))
+                    .is_some_and(|m| m <= travel + CELL_TOL && !(slide_only && m <= CELL_TOL))
+            })
         };
-        let mut found: Option<(f64, f64)> = None;
-        for j in index(p[2], spec.z(0), spec.nz) {
-            for i in index(p[0], spec.x(0), spec.nx) {
-                let (dx, dz) = (spec.x(i) - p[0], spec.z(j) - p[2]);
-                let h = self.heights[j * spec.nx + i];
-                let covered = || {
-                    footprint.is_none_or(|(rows, travel, slide_only)| {
-                        rows.iter().filter(|r| r.j == j).any(|r| {
-                            r.meets(i as i64, spec.x(i)).is_some_and(|m| {
-                                m <= travel + CELL_TOL && !(slide_only && m <= CELL_TOL)
-                            })
-                        })
-                    })
-                };
-                if dx.hypot(dz) <= reach + CELL_TOL && h.is_finite() && covered() {
-                    let r = h - p[1];
-                    found = Some(found.map_or((r, r), |(lo, hi)| (lo.min(r), hi.max(r))));
-                }
-            }
-        }
-        found.map(|(lo, hi)| (lo, hi.max(0.0)))
+        self.nodes_near(p)
+            .filter(|&(i, j, _, _)| covered(i, j))
+            .map(|(_, _, _, h)| h - p[1])
+            .fold(None, |found: Option<(f64, f64)>, r| {
+                Some(found.map_or((r, r), |(lo, hi)| (lo.min(r), hi.max(r))))
+            })
+            .map(|(lo, hi)| (lo, hi.max(0.0)))
     }
+}
+
+/// When the slide meets node `(i, j)` (its x `x_i`), by the start's
+/// footprint rows at the push `rows` ([`FootprintSpan::meets`]); `None`
+/// where it never does.
+fn met_at(rows: &[FootprintSpan], i: usize, j: usize, x_i: f64) -> Option<f64> {
+    rows.iter()
+        .filter(|r| r.j == j)
+        .find_map(|r| r.meets(i as i64, x_i))
 }
 
 /// Why a figure fails its tolerance.

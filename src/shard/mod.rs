@@ -647,22 +647,29 @@ const HEADER_LEN: usize = 16 + 5 * 8 + 1 + 8;
 const BLIND_LEN: usize = 8 * 8;
 
 /// An analysis shard's `shard.json` checked as [`merge`] checks it before
-/// it reads `shard.bin`: its own digest, its fields, its summary's bounds
-/// and its angle indices. For the fuzz targets.
+/// it reads `shard.bin` (its own digest, its fields, its summary's bounds
+/// and its angle indices); the reason when it fails. [`merge`] and the
+/// fuzz targets call it.
 pub fn check_record(text: &[u8]) -> Result<ShardRecord, String> {
     let record: ShardRecord = unsealed_json(text).and_then(|v| {
         serde_json::from_value(v).map_err(|e| format!("not a kneeform shard.json: {e}"))
     })?;
     if record.format != FORMAT {
-        return Err(format!("shard format {}", record.format));
+        return Err(format!(
+            "shard format {}, this kneeform reads {FORMAT}",
+            record.format
+        ));
     }
+    // The summary is bounded as a run's is; then the indices by it.
     let summary_text = serde_json::to_string(&record.summary).unwrap_or_default();
     Summary::from_json(&summary_text).map_err(|e| e.to_string())?;
     let angles = record.summary.angles_deg.len();
-    if record.shard.count > crate::limits::MAX_ANGLES
-        || !record.shard.holds(angles, &record.angle_indices)
-    {
-        return Err("its shard does not hold its angles".into());
+    let shard = record.shard;
+    if shard.count > crate::limits::MAX_ANGLES || !shard.holds(angles, &record.angle_indices) {
+        return Err(format!(
+            "shard {}/{} of {angles} angles does not hold angles {:?}",
+            shard.index, shard.count, record.angle_indices
+        ));
     }
     Ok(record)
 }
@@ -687,28 +694,7 @@ fn read_shard(dir: &Path) -> Result<ShardFiles, ShardError> {
         path: json_path.clone(),
         reason,
     };
-    let record: ShardRecord = unsealed_json(&text)
-        .and_then(|v| {
-            serde_json::from_value(v).map_err(|e| format!("not a kneeform shard.json: {e}"))
-        })
-        .map_err(corrupt)?;
-    if record.format != FORMAT {
-        return Err(corrupt(format!(
-            "shard format {}, this kneeform reads {FORMAT}",
-            record.format
-        )));
-    }
-    // The summary is bounded as a run's is; then the indices by it.
-    let summary_text = serde_json::to_string(&record.summary).unwrap_or_default();
-    Summary::from_json(&summary_text).map_err(|e| corrupt(e.to_string()))?;
-    let angles = record.summary.angles_deg.len();
-    let shard = record.shard;
-    if shard.count > crate::limits::MAX_ANGLES || !shard.holds(angles, &record.angle_indices) {
-        return Err(corrupt(format!(
-            "shard {}/{} of {angles} angles does not hold angles {:?}",
-            shard.index, shard.count, record.angle_indices
-        )));
-    }
+    let record = check_record(&text).map_err(corrupt)?;
     let bin_path = dir.join("shard.bin");
     let header = {
         let mut head = [0u8; HEADER_LEN];
