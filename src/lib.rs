@@ -51,6 +51,7 @@ pub mod grid;
 pub mod harness;
 pub mod kneeform;
 pub mod limits;
+pub mod manifest;
 pub mod memory;
 pub mod mesh;
 pub mod output;

@@ -152,6 +152,16 @@ fn seeds(target: &str) -> Vec<Vec<u8>> {
         .map(|t| t.as_bytes().to_vec())
         .collect(),
         "shard_json" => vec![shard_json()],
+        "study_shard" => study_shards(),
+        "manifest" => [
+            "[defaults]\npitch = 2\nargs = [\"--report\"]\n\n[[item]]\npart = \"a.stl\"\nout = \"a\"\n\n\
+             [[item]]\npart = [\"b.stl\", \"c.stl\"]\nout = \"bc\"\nangles = \"-30:30:10\"\n\
+             side = \"right\"\nargs = [\"--frame\", \"@m.txt\"]\n",
+            "[[item]]\npart = \"console.stl\"\nout = \"./dd/x\"\npitch = 0.5\n",
+        ]
+        .iter()
+        .map(|t| t.as_bytes().to_vec())
+        .collect(),
         _ => unreachable!("no target {target}"),
     };
     seeds.extend(regressions(target));
@@ -208,6 +218,43 @@ fn shard_json() -> Vec<u8> {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     read(&out.join("shard.json"))
+}
+
+/// Study shards as `entry::study_shard` reads them (`shard.json`, a NUL
+/// byte, `shard.bin`): shard 1 of 2 of a small verification (bump.toml,
+/// 8 mm, three angles, 4 starts) and of a small convergence study
+/// (step.toml, 8 and 4 mm, one angle, 3 starts).
+fn study_shards() -> Vec<Vec<u8>> {
+    let dir = scratch_dir("fuzz-study-seed");
+    let runs: [(&str, &str, &[&str]); 2] = [
+        (
+            "verify",
+            "bump",
+            &["--pitch", "8", "--angles=-30,0,30", "--starts", "4"],
+        ),
+        (
+            "converge",
+            "step",
+            &["--pitches", "8,4", "--angles=0", "--starts", "3"],
+        ),
+    ];
+    runs.iter()
+        .map(|(command, part, extra)| {
+            let out = dir.join(command);
+            let part = repo().join(format!("scenarios/{part}.toml"));
+            let mut args = vec![*command, part.to_str().unwrap()];
+            args.extend_from_slice(extra);
+            args.extend(["--shard", "1/2", "--out", out.to_str().unwrap()]);
+            let o = crate::cli::kneeform(&args);
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            let mut input = read(&out.join("shard.json"));
+            input.push(entry::STUDY_SHARD_SEPARATOR);
+            input.extend(read(&out.join("shard.bin")));
+            // Unmutated, the seed is a shard merge accepts.
+            assert!(entry::study_shard(&input), "{command}'s shard is refused");
+            input
+        })
+        .collect()
 }
 
 /// A small random number below `n` (`n > 0`).
@@ -351,6 +398,16 @@ fn frame_mutants_do_not_panic() {
 #[test]
 fn shard_json_mutants_do_not_panic() {
     mutation_loop("shard_json", &seeds("shard_json"), entry::shard_json);
+}
+
+#[test]
+fn study_shard_mutants_do_not_panic() {
+    mutation_loop("study_shard", &seeds("study_shard"), entry::study_shard);
+}
+
+#[test]
+fn manifest_mutants_do_not_panic() {
+    mutation_loop("manifest", &seeds("manifest"), entry::manifest);
 }
 
 /// Every committed reproducer, as it was found (unmutated), through the

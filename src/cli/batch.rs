@@ -19,68 +19,6 @@ use sha2::{Digest, Sha256};
 
 use super::args::BatchArgs;
 
-/// The manifest file.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Manifest {
-    /// Flags of every item: its own `pitch`, `angles` and `side` replace
-    /// these, its `args` follow these.
-    #[serde(default)]
-    defaults: Flags,
-    /// The analyses, in order.
-    #[serde(default, rename = "item")]
-    items: Vec<Item>,
-}
-
-/// `analyze` flags: a few by name, any others as written.
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Flags {
-    pitch: Option<f64>,
-    angles: Option<String>,
-    side: Option<String>,
-    #[serde(default)]
-    args: Vec<String>,
-}
-
-/// One analysis.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Item {
-    /// Its part file(s): one path, or several (an assembly).
-    part: PartPaths,
-    /// Its output directory.
-    out: PathBuf,
-    #[serde(flatten)]
-    flags: Flags,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(untagged)]
-enum PartPaths {
-    One(PathBuf),
-    Many(Vec<PathBuf>),
-}
-
-impl Flags {
-    /// Appends the flags of `item` over `defaults`: its `pitch`, `angles`
-    /// and `side` replace the defaults', its `args` follow theirs.
-    fn push_onto(defaults: &Flags, item: &Flags, argv: &mut Vec<String>) {
-        // `--flag=value`: a value such as -1 is the flag's, not another
-        // flag (clap printed its usage for `pitch = -1`).
-        if let Some(p) = item.pitch.or(defaults.pitch) {
-            argv.push(format!("--pitch={p}"));
-        }
-        if let Some(a) = item.angles.as_ref().or(defaults.angles.as_ref()) {
-            argv.push(format!("--angles={a}"));
-        }
-        if let Some(s) = item.side.as_ref().or(defaults.side.as_ref()) {
-            argv.push(format!("--side={s}"));
-        }
-        argv.extend(defaults.args.iter().chain(&item.args).cloned());
-    }
-}
-
 /// The item's run in progress (its process id): a batch ended by a
 /// signal ends it first ([`end_running_child`]), so that a resumed batch
 /// does not find its lock held.
@@ -132,54 +70,21 @@ const FINGERPRINT_FILE: &str = "batch-item.json";
 pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
     let text = kneeform::limits::read_text_bounded(&args.manifest)
         .with_context(|| format!("cannot read the manifest {}", args.manifest.display()))?;
-    let manifest: Manifest = toml::from_str(&text)
-        .map_err(|e| anyhow::anyhow!("{}", e.message()))
-        .with_context(|| format!("manifest {}", args.manifest.display()))?;
-    ensure!(
-        !manifest.items.is_empty(),
-        "manifest {}: no [[item]]: each is one analysis (part, out, flags)",
-        args.manifest.display()
-    );
     // Relative paths in the manifest are relative to its directory: the
     // items run there.
     let base = match args.manifest.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    // Outputs compared as the directories they are (`dd/x`, `./dd/x` and
-    // `dd/../dd/x` are one): two items on one directory would replace
-    // each other's result and both run again on every resume.
-    let mut outs = std::collections::BTreeMap::new();
-    for (k, item) in manifest.items.iter().enumerate() {
-        if let Some(earlier) = outs.insert(resolved(&base.join(&item.out)), k + 1) {
-            bail!(
-                "manifest {}: item {} writes to {}, the directory item {earlier} writes to",
-                args.manifest.display(),
-                k + 1,
-                item.out.display()
-            );
-        }
-    }
+    let items = kneeform::manifest::plan(&text, &base)
+        .map_err(|e| anyhow::anyhow!("manifest {}: {e}", args.manifest.display()))?;
     let exe = std::env::current_exe().context("cannot find this kneeform binary")?;
-    let total = manifest.items.len();
+    let total = items.len();
     let (mut ran, mut skipped) = (0, 0);
-    for (k, item) in manifest.items.iter().enumerate() {
-        let parts = match &item.part {
-            PartPaths::One(p) => vec![p.clone()],
-            PartPaths::Many(p) => p.clone(),
-        };
-        ensure!(
-            !parts.is_empty(),
-            "manifest {}: item {} has no part (part = [])",
-            args.manifest.display(),
-            k + 1
-        );
-        let mut argv = vec!["analyze".to_string()];
-        argv.extend(parts.iter().map(|p| p.display().to_string()));
-        argv.extend(["--out".into(), item.out.display().to_string()]);
-        Flags::push_onto(&manifest.defaults, &item.flags, &mut argv);
+    for (k, item) in items.iter().enumerate() {
+        let (parts, argv) = (&item.parts, &item.argv);
         let what = format!("batch item {}/{total}, {}", k + 1, item.out.display());
-        let fingerprint = fingerprint(&base, &parts, &argv).with_context(|| what.clone())?;
+        let fingerprint = fingerprint(&base, parts, argv).with_context(|| what.clone())?;
         let out = base.join(&item.out);
         if is_done(&out, &fingerprint) {
             eprintln!("kneeform: {what}: skipped, its run is complete (same fingerprint)");
@@ -190,7 +95,7 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
         // --force: an earlier run of another fingerprint is replaced whole
         // (never a directory of other files: analyze refuses those).
         let mut child = Command::new(&exe)
-            .args(&argv)
+            .args(argv)
             .arg("--force")
             .current_dir(&base)
             .spawn()
@@ -211,7 +116,7 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
         }
         let record = Fingerprint {
             fingerprint: fingerprint.clone(),
-            args: argv,
+            args: argv.clone(),
         };
         let text = serde_json::to_string_pretty(&record)? + "\n";
         kneeform::output::write_file_atomically(&out.join(FINGERPRINT_FILE), |w| {
@@ -233,38 +138,6 @@ fn is_done(out: &Path, fingerprint: &str) -> bool {
         .and_then(|t| serde_json::from_str::<Fingerprint>(&t).ok());
     let complete = out.join("summary.json").is_file() || out.join("shard.json").is_file();
     complete && recorded.is_some_and(|r| r.fingerprint == fingerprint)
-}
-
-/// `path` made absolute and normal: `.` and `..` resolved, and the part
-/// of it that exists followed through links (the rest kept as written).
-fn resolved(path: &Path) -> PathBuf {
-    use std::path::Component;
-    let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
-    let mut normal = PathBuf::new();
-    for c in absolute.components() {
-        match c {
-            Component::CurDir => {}
-            Component::ParentDir => {
-                normal.pop();
-            }
-            c => normal.push(c),
-        }
-    }
-    // The longest existing ancestor, canonical, with the rest after it.
-    let mut rest = Vec::new();
-    let mut head = normal.as_path();
-    loop {
-        if let Ok(real) = head.canonicalize() {
-            return rest.iter().rev().fold(real, |p, c| p.join(c));
-        }
-        match (head.file_name(), head.parent()) {
-            (Some(name), Some(parent)) => {
-                rest.push(name.to_os_string());
-                head = parent;
-            }
-            _ => return normal,
-        }
-    }
 }
 
 /// SHA-256 over this kneeform's version, `argv` and the SHA-256 of every

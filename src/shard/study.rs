@@ -394,43 +394,55 @@ fn read_study(dir: &Path) -> Result<StudyFiles, ShardError> {
     };
     let text = crate::limits::read_bounded(&json_path, crate::limits::MAX_RUN_JSON_BYTES)
         .map_err(io(&json_path))?;
-    let corrupt = |reason: String| ShardError::Corrupt {
+    let record = check_study_record(&text).map_err(|reason| ShardError::Corrupt {
         path: json_path.clone(),
         reason,
-    };
-    let record = from_json(&text).map_err(|e| corrupt(format!("a study shard.json: {e}")))?;
-    if record.format != FORMAT {
-        return Err(corrupt(format!(
-            "study shard format {}, this kneeform reads {FORMAT}",
-            record.format
-        )));
-    }
-    let shard = record.shard;
-    if record.starts > crate::limits::MAX_GRID_NODES
-        || !shard.holds(record.starts, &record.start_indices)
-    {
-        return Err(corrupt(format!(
-            "shard {}/{} of {} starts does not hold starts {:?}",
-            shard.index, shard.count, record.starts, record.start_indices
-        )));
-    }
+    })?;
     let bin_path = dir.join("shard.bin");
     let bin = crate::limits::read_bounded(&bin_path, MAX_BIN_BYTES).map_err(io(&bin_path))?;
-    let bad_bin = |reason: String| ShardError::Corrupt {
+    let part = check_study_bin(&bin, &record).map_err(|reason| ShardError::Corrupt {
         path: bin_path.clone(),
         reason,
-    };
-    if hex_sha256(&bin) != record.data_sha256 {
-        return Err(bad_bin(
-            "its SHA-256 is not the one shard.json records".into(),
-        ));
-    }
-    let part = decode(&bin, &record).map_err(bad_bin)?;
+    })?;
     Ok(StudyFiles {
         dir: dir.to_path_buf(),
         record,
         part,
     })
+}
+
+/// A study shard's `shard.json` checked as [`merge_study`] checks it
+/// before it reads `shard.bin` (its own digest, its fields, its format,
+/// its start count and indices, bounded before they size anything); the
+/// reason when it fails. [`merge_study`] and the fuzz targets call it.
+pub fn check_study_record(text: &[u8]) -> Result<StudyRecord, String> {
+    let record = from_json(text).map_err(|e| format!("a study shard.json: {e}"))?;
+    if record.format != FORMAT {
+        return Err(format!(
+            "study shard format {}, this kneeform reads {FORMAT}",
+            record.format
+        ));
+    }
+    let shard = record.shard;
+    if record.starts > crate::limits::MAX_GRID_NODES
+        || !shard.holds(record.starts, &record.start_indices)
+    {
+        return Err(format!(
+            "shard {}/{} of {} starts does not hold starts {:?}",
+            shard.index, shard.count, record.starts, record.start_indices
+        ));
+    }
+    Ok(record)
+}
+
+/// A study shard's `shard.bin` checked against its checked `record`
+/// (its SHA-256, then every value it holds) and decoded; the reason when
+/// it fails. [`merge_study`] and the fuzz targets call it.
+pub fn check_study_bin(bin: &[u8], record: &StudyRecord) -> Result<StudyPart, String> {
+    if hex_sha256(bin) != record.data_sha256 {
+        return Err("its SHA-256 is not the one shard.json records".into());
+    }
+    decode(bin, record)
 }
 
 /// The study part `bin` holds, checked against its `record`.

@@ -116,3 +116,52 @@ pub fn shard_json(data: &[u8]) -> bool {
     };
     kneeform::shard::check_record(&sealed).is_ok()
 }
+
+/// `data` read as a `kneeform batch` manifest, its items planned as
+/// `batch` plans them (against a directory that does not exist, so that
+/// nothing is read or written); whether it was accepted. An accepted
+/// manifest's every item has a part and runs `analyze`.
+pub fn manifest(data: &[u8]) -> bool {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return false;
+    };
+    let Ok(items) = kneeform::manifest::plan(text, Path::new("/nonexistent-kneeform-fuzz")) else {
+        return false;
+    };
+    assert!(
+        items
+            .iter()
+            .all(|i| !i.parts.is_empty() && i.argv.first().is_some_and(|a| a == "analyze")),
+        "an accepted manifest plans an item without a part"
+    );
+    true
+}
+
+/// The byte that separates a study shard input's `shard.json` from its
+/// `shard.bin` (no JSON text holds a raw NUL).
+pub const STUDY_SHARD_SEPARATOR: u8 = 0;
+
+/// `data` read as a study shard (`verify` or `converge --shard`): its
+/// `shard.json`, a NUL byte, its `shard.bin`. The record's digest of
+/// `shard.bin` and its own digest are made the content's again, so that
+/// the checks past them are reached, then both files are checked and
+/// decoded as `merge` does; whether the shard was accepted.
+pub fn study_shard(data: &[u8]) -> bool {
+    let (json, bin) = match data.iter().position(|&b| b == STUDY_SHARD_SEPARATOR) {
+        Some(k) => (&data[..k], &data[k + 1..]),
+        None => (data, &[][..]),
+    };
+    let Ok(mut value) = serde_json::from_slice::<serde_json::Value>(json) else {
+        return false;
+    };
+    if let Some(map) = value.as_object_mut() {
+        map.insert("data_sha256".into(), kneeform::mesh::sha256_hex(bin).into());
+    }
+    let Some(sealed) = kneeform::shard::reseal(value.to_string().as_bytes()) else {
+        return false;
+    };
+    let Ok(record) = kneeform::shard::study::check_study_record(&sealed) else {
+        return false;
+    };
+    kneeform::shard::study::check_study_bin(bin, &record).is_ok()
+}
