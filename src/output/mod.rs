@@ -582,6 +582,93 @@ mod tests {
         std::fs::remove_dir_all(root).unwrap();
     }
 
+    /// The interrupt handler's account of what was left, in a process of
+    /// its own (the staged and committed directories are the process's):
+    /// this test binary run again on [`interrupt_child`] with
+    /// `KNEEFORM_INTERRUPT_CHILD` naming a scratch directory.
+    fn interrupt_account(root: &Path, step: &str) -> String {
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
+            .args(["--exact", "output::tests::interrupt_child", "--nocapture"])
+            .env("KNEEFORM_INTERRUPT_CHILD", root)
+            .env("KNEEFORM_INTERRUPT_STEP", step)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        text.lines()
+            .find_map(|l| l.strip_prefix("account: "))
+            .unwrap_or_else(|| panic!("no account in {text}"))
+            .to_string()
+    }
+
+    /// Issue 25, item 16: SIGTERM during merge's final commit exited
+    /// saying "partial results removed" while the result was whole. What
+    /// [`remove_staged`] reports after each step of a run: nothing yet, a
+    /// staged directory, its commit (before the process could exit).
+    #[test]
+    fn an_interrupt_reports_what_is_true() {
+        let root = temp_dir("interrupt");
+        for (step, expected) in [
+            ("none", Interrupted::BeforeAnyResult),
+            ("staged", Interrupted::PartialRemoved),
+            ("committed", Interrupted::AfterCommit),
+        ] {
+            let dir = root.join(step);
+            std::fs::create_dir(&dir).unwrap();
+            assert_eq!(
+                interrupt_account(&dir, step),
+                format!("{expected:?}"),
+                "{step}"
+            );
+            let run = dir.join("run");
+            match expected {
+                Interrupted::AfterCommit => {
+                    assert!(run.join("a.csv").is_file(), "the committed run is whole");
+                }
+                _ => assert!(!run.exists(), "{step}: a result directory"),
+            }
+            assert_eq!(
+                entries(&dir),
+                if expected == Interrupted::AfterCommit {
+                    vec!["run".to_string()]
+                } else {
+                    vec![]
+                },
+                "{step}: what is left"
+            );
+        }
+        std::fs::remove_dir_all(root).unwrap();
+    }
+
+    /// The child of [`an_interrupt_reports_what_is_true`]; nothing when
+    /// run by the test harness itself.
+    #[test]
+    fn interrupt_child() {
+        let (Some(root), Ok(step)) = (
+            std::env::var_os("KNEEFORM_INTERRUPT_CHILD"),
+            std::env::var("KNEEFORM_INTERRUPT_STEP"),
+        ) else {
+            return;
+        };
+        let final_dir = Path::new(&root).join("run");
+        if step != "none" {
+            let out = OutputDir::stage(&final_dir).unwrap();
+            std::fs::write(out.path("a.csv"), "angle_deg\n").unwrap();
+            if step == "committed" {
+                // The lock is held until the process ends, as a merge's
+                // is while it writes its report.
+                std::mem::forget(out.commit().unwrap());
+            } else {
+                std::mem::forget(out);
+            }
+        }
+        println!("account: {:?}", remove_staged());
+    }
+
     #[test]
     fn commit_replaces_files_of_an_earlier_run() {
         let root = temp_dir("replace");
