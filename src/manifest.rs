@@ -51,22 +51,82 @@ enum PartPaths {
     Many(Vec<PathBuf>),
 }
 
+/// One flag of an argument list and its value, as written (`--pitch=2`,
+/// or `--pitch` and `2`), or a lone argument (a part path), whose name
+/// is empty.
+struct Group<'a> {
+    name: &'a str,
+    tokens: &'a [String],
+}
+
+/// `args` cut into flags with their values. `is_switch` says which flags
+/// take no value; any other `--flag` takes the next argument unless that
+/// is a flag itself (`--x=v` carries its own).
+fn groups<'a>(args: &'a [String], is_switch: &dyn Fn(&str) -> bool) -> Vec<Group<'a>> {
+    let mut out = Vec::new();
+    let mut k = 0;
+    while k < args.len() {
+        let a = args[k].as_str();
+        let (name, len) = match a.strip_prefix("--") {
+            Some(_) if a.contains('=') => (a.split_once('=').map_or(a, |(n, _)| n), 1),
+            Some(_) if is_switch(a) => (a, 1),
+            Some(_) => {
+                let has_value = args.get(k + 1).is_some_and(|v| !v.starts_with("--"));
+                (a, 1 + usize::from(has_value))
+            }
+            None => ("", 1),
+        };
+        out.push(Group {
+            name,
+            tokens: &args[k..k + len],
+        });
+        k += len;
+    }
+    out
+}
+
 impl Flags {
-    /// Appends the flags of `item` over `defaults`: its `pitch`, `angles`
-    /// and `side` replace the defaults', its `args` follow theirs.
-    fn push_onto(defaults: &Flags, item: &Flags, argv: &mut Vec<String>) {
+    /// Appends the flags of `item` over `defaults`: a flag the item sets,
+    /// by name (`pitch`, `angles`, `side`) or in its `args`, replaces the
+    /// defaults' (a flag given twice failed the item); the defaults'
+    /// `args` come before the item's.
+    fn push_onto(
+        defaults: &Flags,
+        item: &Flags,
+        is_switch: &dyn Fn(&str) -> bool,
+        argv: &mut Vec<String>,
+    ) {
+        let own = groups(&item.args, is_switch);
+        let set_by_item = |name: &str| own.iter().any(|g| g.name == name);
         // `--flag=value`: a value such as -1 is the flag's, not another
         // flag (clap printed its usage for `pitch = -1`).
-        if let Some(p) = item.pitch.or(defaults.pitch) {
-            argv.push(format!("--pitch={p}"));
+        let named = |flag: &str, mine: Option<String>, theirs: Option<String>| {
+            mine.or(theirs.filter(|_| !set_by_item(flag)))
+                .map(|v| format!("{flag}={v}"))
+        };
+        argv.extend(named(
+            "--pitch",
+            item.pitch.map(|p| p.to_string()),
+            defaults.pitch.map(|p| p.to_string()),
+        ));
+        argv.extend(named(
+            "--angles",
+            item.angles.clone(),
+            defaults.angles.clone(),
+        ));
+        argv.extend(named("--side", item.side.clone(), defaults.side.clone()));
+        let item_named = |name: &str| match name {
+            "--pitch" => item.pitch.is_some(),
+            "--angles" => item.angles.is_some(),
+            "--side" => item.side.is_some(),
+            _ => false,
+        };
+        for g in groups(&defaults.args, is_switch) {
+            if g.name.is_empty() || !(set_by_item(g.name) || item_named(g.name)) {
+                argv.extend(g.tokens.iter().cloned());
+            }
         }
-        if let Some(a) = item.angles.as_ref().or(defaults.angles.as_ref()) {
-            argv.push(format!("--angles={a}"));
-        }
-        if let Some(s) = item.side.as_ref().or(defaults.side.as_ref()) {
-            argv.push(format!("--side={s}"));
-        }
-        argv.extend(defaults.args.iter().chain(&item.args).cloned());
+        argv.extend(item.args.iter().cloned());
     }
 }
 
@@ -89,7 +149,14 @@ pub struct BatchItem {
 /// manifest's keys, no item, an item without a part, two items on one
 /// output directory (`dd/x` and `./dd/x` are one: they would replace
 /// each other's result and both run again on every resume).
-pub fn plan(text: &str, base: &Path) -> Result<Vec<BatchItem>, String> {
+///
+/// `is_switch` says which `analyze` flags take no value (`--report`), so
+/// that a flag the item sets replaces the defaults' with its value.
+pub fn plan(
+    text: &str,
+    base: &Path,
+    is_switch: &dyn Fn(&str) -> bool,
+) -> Result<Vec<BatchItem>, String> {
     let manifest: Manifest = toml::from_str(text).map_err(|e| e.message().to_string())?;
     if manifest.items.is_empty() {
         return Err("no [[item]]: each is one analysis (part, out, flags)".into());
@@ -114,7 +181,7 @@ pub fn plan(text: &str, base: &Path) -> Result<Vec<BatchItem>, String> {
         let mut argv = vec!["analyze".to_string()];
         argv.extend(parts.iter().map(|p| p.display().to_string()));
         argv.extend(["--out".into(), item.out.display().to_string()]);
-        Flags::push_onto(&manifest.defaults, &item.flags, &mut argv);
+        Flags::push_onto(&manifest.defaults, &item.flags, is_switch, &mut argv);
         items.push(BatchItem {
             parts,
             out: item.out.clone(),
@@ -159,12 +226,16 @@ fn resolved(path: &Path) -> PathBuf {
 mod tests {
     use super::*;
 
+    fn switch(flag: &str) -> bool {
+        matches!(flag, "--report" | "--force" | "--points-csv")
+    }
+
     #[test]
     fn items_take_their_own_flags_over_the_defaults() {
         let text = "[defaults]\npitch = 2\nargs = [\"--report\"]\n\n\
                     [[item]]\npart = \"a.stl\"\nout = \"a\"\n\n\
                     [[item]]\npart = [\"b.stl\", \"c.stl\"]\nout = \"bc\"\npitch = -1\nargs = [\"--side\", \"right\"]\n";
-        let items = plan(text, Path::new("/nonexistent")).unwrap();
+        let items = plan(text, Path::new("/nonexistent"), &switch).unwrap();
         assert_eq!(
             items[0].argv,
             ["analyze", "a.stl", "--out", "a", "--pitch=2", "--report"]
@@ -186,23 +257,73 @@ mod tests {
         );
     }
 
+    /// Issue 24, item 12: `[defaults] args` were appended to an item's
+    /// own, so a flag in both failed the item. The item's value wins,
+    /// whichever way either gives it.
+    #[test]
+    fn an_item_s_own_flag_replaces_the_defaults() {
+        let text = "[defaults]\npitch = 2\nargs = [\"--deflection\", \"0.5\", \"--report\", \"--window=4\", \"--angles\", \"0\", \"extra.stl\"]\n\n\
+                    [[item]]\npart = \"a.stl\"\nout = \"a\"\nangles = \"-30:30:10\"\nargs = [\"--deflection\", \"3\", \"--window\", \"2\", \"--pitch=1\"]\n\n\
+                    [[item]]\npart = \"b.stl\"\nout = \"b\"\nargs = [\"--report\"]\n";
+        let items = plan(text, Path::new("/nonexistent"), &switch).unwrap();
+        assert_eq!(
+            items[0].argv,
+            [
+                "analyze",
+                "a.stl",
+                "--out",
+                "a",
+                "--angles=-30:30:10",
+                "--report",
+                "extra.stl",
+                "--deflection",
+                "3",
+                "--window",
+                "2",
+                "--pitch=1"
+            ]
+        );
+        assert_eq!(
+            items[1].argv,
+            [
+                "analyze",
+                "b.stl",
+                "--out",
+                "b",
+                "--pitch=2",
+                "--deflection",
+                "0.5",
+                "--window=4",
+                "--angles",
+                "0",
+                "extra.stl",
+                "--report"
+            ]
+        );
+    }
+
     #[test]
     fn one_output_directory_two_ways_is_refused() {
         let text = "[[item]]\npart = \"a.stl\"\nout = \"dd/x\"\n\n\
                     [[item]]\npart = \"b.stl\"\nout = \"./dd/y/../x\"\n";
-        let e = plan(text, Path::new("/nonexistent")).unwrap_err();
+        let e = plan(text, Path::new("/nonexistent"), &switch).unwrap_err();
         assert!(e.contains("item 2 writes to ./dd/y/../x"), "{e}");
     }
 
     #[test]
     fn empty_manifests_and_parts_are_refused() {
         assert!(
-            plan("", Path::new("."))
+            plan("", Path::new("."), &switch)
                 .unwrap_err()
                 .contains("no [[item]]")
         );
-        let e = plan("[[item]]\npart = []\nout = \"x\"\n", Path::new(".")).unwrap_err();
+        let e = plan(
+            "[[item]]\npart = []\nout = \"x\"\n",
+            Path::new("."),
+            &switch,
+        )
+        .unwrap_err();
         assert!(e.contains("no part"), "{e}");
-        assert!(plan("[[item]]\nout = 1\n", Path::new(".")).is_err());
+        assert!(plan("[[item]]\nout = 1\n", Path::new("."), &switch).is_err());
     }
 }

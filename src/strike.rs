@@ -138,9 +138,16 @@ impl StrikeRule {
         StrikeRule { window, ..self }
     }
 
-    /// The deflection threshold `delta` (degrees).
+    /// The deflection threshold `delta` (degrees): the shortest decimal
+    /// whose tangent is this rule's `sigma`, so that a threshold given as
+    /// 3 degrees reads back as 3, not as the round trip's
+    /// 3.0000000000000004.
     pub fn deflection_deg(&self) -> f64 {
-        self.sigma.atan().to_degrees()
+        let delta = self.sigma.atan().to_degrees();
+        (1..=17)
+            .filter_map(|digits| format!("{delta:.*e}", digits - 1).parse::<f64>().ok())
+            .find(|d| d.to_radians().tan() == self.sigma)
+            .unwrap_or(delta)
     }
 
     /// The window in mm as recorded (`window_mm`): the window rule's `W`,
@@ -303,6 +310,11 @@ mod tests {
         assert!(rule.strikes(met(0.0, 0.0, 1e-5, 1e-5, 1.0)));
         assert!(!rule.strikes(met(0.0, 0.0, 1e-7, 1.0, 1.0)));
         assert!((StrikeRule::default().deflection_deg() - 0.5).abs() < 1e-12);
+        // Issue 24, item 5: no float noise in what is recorded.
+        for given in [0.0, 0.5, 3.0, 0.1, 44.9, 1.0 / 3.0] {
+            let rule = StrikeRule::new(given, 1e-6);
+            assert_eq!(rule.deflection_deg(), given, "{given}");
+        }
     }
 
     #[test]

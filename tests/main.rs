@@ -13,5 +13,6 @@ mod hostile;
 mod oracle;
 mod report;
 mod resolution;
+mod second_hour;
 mod shard;
 mod util;

@@ -76,7 +76,7 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let items = kneeform::manifest::plan(&text, &base)
+    let items = kneeform::manifest::plan(&text, &base, &analyze_switch)
         .map_err(|e| anyhow::anyhow!("manifest {}: {e}", args.manifest.display()))?;
     let exe = std::env::current_exe().context("cannot find this kneeform binary")?;
     let total = items.len();
@@ -128,6 +128,21 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
     }
     eprintln!("kneeform: batch done: {ran} items run, {skipped} skipped (complete)");
     Ok(ExitCode::SUCCESS)
+}
+
+/// Whether `flag` (`--report`) is an `analyze` flag that takes no value,
+/// as the command line defines it.
+fn analyze_switch(flag: &str) -> bool {
+    use clap::CommandFactory;
+    let cli = super::args::Cli::command();
+    let Some(analyze) = cli.find_subcommand("analyze") else {
+        return false;
+    };
+    let name = flag.trim_start_matches('-');
+    analyze
+        .get_arguments()
+        .find(|a| a.get_long() == Some(name))
+        .is_some_and(|a| !a.get_action().takes_values())
 }
 
 /// Whether `out` holds a complete run (or shard: `--shard` in the item's

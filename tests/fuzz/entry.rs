@@ -125,7 +125,11 @@ pub fn manifest(data: &[u8]) -> bool {
     let Ok(text) = std::str::from_utf8(data) else {
         return false;
     };
-    let Ok(items) = kneeform::manifest::plan(text, Path::new("/nonexistent-kneeform-fuzz")) else {
+    let Ok(items) =
+        kneeform::manifest::plan(text, Path::new("/nonexistent-kneeform-fuzz"), &|flag| {
+            flag == "--report"
+        })
+    else {
         return false;
     };
     assert!(
