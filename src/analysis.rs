@@ -597,7 +597,15 @@ impl Analysis {
         progress: &dyn Progress,
         mut warnings: Vec<Warning>,
     ) -> Result<Analysis, AnalysisError> {
-        let part_warnings = sanity::part_warnings(&input.part, input.side, &setup.knee);
+        let mut part_warnings = sanity::part_warnings(&input.part, input.side, &setup.knee);
+        // The slide pushes the knee along y; the direct approach meets the
+        // part along x, where its own frame is checked.
+        if setup.approach == Approach::Slide {
+            part_warnings.extend(sanity::facing_axis_warning(
+                &input.part,
+                !input.frame.is_none(),
+            ));
+        }
         for w in &part_warnings {
             progress.warn(w);
         }

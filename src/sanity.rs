@@ -39,12 +39,19 @@ pub const LARGE_FACTOR: f64 = 30.0;
 /// open surface exported for the analysis is nearly all one way.
 pub const FACING_RATIO: f64 = 3.0;
 
+/// The part is "edge-on" when the area its triangles present along x or
+/// along z (area-weighted normals) is more than this times the area they
+/// present along y, the push axis: a plate lying flat, a panel modelled
+/// facing sideways. A console side or a closed solid presents about as
+/// much or more along y and is not flagged.
+pub const EDGE_ON_RATIO: f64 = 2.0;
+
 /// One finding, as one line of text.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Warning {
     /// The part is much smaller than the knee-form.
     #[error(
-        "the part is {extent_mm:.3} mm across, much smaller than the {knee_mm:.0} mm knee-form: if its file is in metres, pass --scale 1000 (in cm, --scale 10)"
+        "the part is {extent_mm:.3} mm across, much smaller than the {knee_mm:.0} mm knee-form: if its file is in metres, pass --scale 1000 (in cm, --scale 10; in inches, --scale 25.4)"
     )]
     TooSmall {
         /// The part's larger extent in x and z (mm, after `--scale`).
@@ -79,6 +86,22 @@ pub enum Warning {
         faces: &'static str,
         /// The share of the surface facing that way (%).
         percent: f64,
+    },
+    /// Most of the surface faces along x or z, not towards the knee.
+    #[error(
+        "the part's surface faces mostly along {axis} ({percent:.0}% of its area, {y_percent:.0}% along y, the axis the knee is pushed on): the knee-form meets it edge-on; {advice}"
+    )]
+    EdgeOn {
+        /// The axis most of the surface faces along (`x` or `z`, in the
+        /// frame the part is analysed in).
+        axis: &'static str,
+        /// The share of the area facing along it (%).
+        percent: f64,
+        /// The share facing along y (%).
+        y_percent: f64,
+        /// What to do, in words: the `--frame` that turns that face
+        /// towards the knee.
+        advice: String,
     },
     /// Some angles are beyond the regulation's range.
     #[error(
@@ -187,6 +210,64 @@ pub fn part_warnings(part: &Part, side: Side, knee: &KneeForm) -> Vec<Warning> {
         });
     }
     warnings
+}
+
+/// The areas of the part's surface facing along x, y and z (mm^2): each
+/// triangle's area times the absolute component of its unit normal, and
+/// the signed sums along x and z (which way most of it faces).
+fn axis_areas(part: &Part) -> ([f64; 3], [f64; 3]) {
+    let (mut unsigned, mut signed) = ([0.0; 3], [0.0; 3]);
+    for t in &part.triangles {
+        let (a, b, c) = (t[0], t[1], t[2]);
+        let u = nalgebra::Vector3::new(b[0] - a[0], b[1] - a[1], b[2] - a[2]);
+        let v = nalgebra::Vector3::new(c[0] - a[0], c[1] - a[1], c[2] - a[2]);
+        let n = 0.5 * u.cross(&v);
+        for k in 0..3 {
+            unsigned[k] += n[k].abs();
+            signed[k] += n[k];
+        }
+    }
+    (unsigned, signed)
+}
+
+/// The check of a part analysed by the slide (the knee pushed along y)
+/// for a surface met edge-on ([`EDGE_ON_RATIO`]), with the `--frame` that
+/// would face it, as the part's own axes, where `framed` is false (no
+/// `--frame` given); with one, the advice is to check it.
+pub fn facing_axis_warning(part: &Part, framed: bool) -> Option<Warning> {
+    let (area, signed) = axis_areas(part);
+    let total: f64 = area.iter().sum();
+    let (k, along) = if area[0] >= area[2] {
+        (0, area[0])
+    } else {
+        (2, area[2])
+    };
+    if total.is_nan() || total <= 0.0 || along <= EDGE_ON_RATIO * area[1] {
+        return None;
+    }
+    // The rotation whose vehicle y is the part's axis k, signed so that
+    // the side facing +k (the larger share) faces the knee of the left
+    // side, at -y.
+    let plus = signed[k] >= 0.0;
+    let (axis, frame) = match (k, plus) {
+        (0, true) => ("x", "y,-x,z"),
+        (0, false) => ("x", "-y,x,z"),
+        (_, true) => ("z", "x,-z,y"),
+        (_, false) => ("z", "x,z,-y"),
+    };
+    let advice = if framed {
+        "check --frame: it should turn the face the knee meets towards y".to_string()
+    } else {
+        format!(
+            "if its large faces are the ones the knee meets, pass --frame {frame} (the part's axes as the vehicle's x, y, z), or model it facing y"
+        )
+    };
+    Some(Warning::EdgeOn {
+        axis,
+        percent: 100.0 * along / total,
+        y_percent: 100.0 * area[1] / total,
+        advice,
+    })
 }
 
 /// The angles (degrees) beyond the regulation's range, as one warning.
@@ -385,6 +466,68 @@ mod tests {
         assert!(part_warnings(&p, Side::Left, &knee).iter().any(wrong));
         let p = part(sheet(400.0, false, 1.0), Side::Left);
         assert!(part_warnings(&p, Side::Left, &knee).is_empty());
+    }
+
+    /// Issue 24, item 8: a plate facing z (and one facing x) was analysed
+    /// edge-on with no hint. Each is flagged with the frame that faces it,
+    /// and that frame, applied, silences the warning; a surface facing y
+    /// and a closed box of even sides are not flagged.
+    #[test]
+    fn a_part_facing_away_from_the_push_axis_is_flagged_with_its_frame() {
+        use crate::frame::Frame;
+        // A 200 x 200 mm square in the plane y = 0, turned to face each
+        // axis by a frame's inverse.
+        let square = sheet(200.0, true, 0.0);
+        for (faces, frame) in [
+            ("x,-z,y", "x,-z,y"),
+            ("y,-x,z", "y,-x,z"),
+            ("x,z,-y", "x,z,-y"),
+            ("-y,x,z", "-y,x,z"),
+        ] {
+            let f = Frame::parse(faces).unwrap();
+            // The plate as modelled: the vehicle-facing square mapped back.
+            let modelled: Vec<Triangle> = square.iter().map(|t| t.map(|v| f.to_part(v))).collect();
+            let p = part(modelled.clone(), Side::Left);
+            let w = facing_axis_warning(&p, false).expect("edge-on");
+            assert!(
+                w.to_string().contains(&format!("--frame {frame}")),
+                "{faces}: {w}"
+            );
+            assert!(
+                facing_axis_warning(&p, true)
+                    .unwrap()
+                    .to_string()
+                    .contains("check --frame")
+            );
+            // Placed by the suggested frame, it faces y: no warning.
+            let placed: Vec<Triangle> = modelled
+                .iter()
+                .map(|t| t.map(|v| f.to_vehicle(v)))
+                .collect();
+            assert_eq!(
+                facing_axis_warning(&part(placed, Side::Left), false),
+                None,
+                "{faces}"
+            );
+        }
+        assert_eq!(facing_axis_warning(&part(square, Side::Left), false), None);
+        // A closed cube: a third of its area along each axis (the
+        // winding does not matter to how much faces along an axis).
+        let mut cube = Vec::new();
+        for k in 0..3 {
+            for offset in [0.0, 100.0] {
+                let at = |u: f64, v: f64| {
+                    let mut p = [0.0; 3];
+                    p[k] = offset;
+                    p[(k + 1) % 3] = u;
+                    p[(k + 2) % 3] = v;
+                    p
+                };
+                cube.push([at(0.0, 0.0), at(100.0, 0.0), at(0.0, 100.0)]);
+                cube.push([at(100.0, 0.0), at(100.0, 100.0), at(0.0, 100.0)]);
+            }
+        }
+        assert_eq!(facing_axis_warning(&part(cube, Side::Left), false), None);
     }
 
     #[test]

@@ -56,3 +56,156 @@ out = "runs/defaults"
     assert_eq!(defaults["deflection_deg"], 0.5, "{defaults}");
     assert_eq!(defaults["pitch_mm"], 8.0, "{defaults}");
 }
+
+/// An ASCII STL of the square `[0, s]^2` in the plane `axis = 0` of the
+/// part's own axes (x, y or z), as two triangles wound to face +axis.
+fn square_stl(axis: usize, s: f64) -> String {
+    let at = |u: f64, v: f64| {
+        let mut p = [0.0; 3];
+        p[(axis + 1) % 3] = u;
+        p[(axis + 2) % 3] = v;
+        format!("vertex {} {} {}", p[0], p[1], p[2])
+    };
+    let mut text = String::from("solid plate\n");
+    for [a, b, c] in [
+        [(0.0, 0.0), (s, 0.0), (0.0, s)],
+        [(s, 0.0), (s, s), (0.0, s)],
+    ] {
+        text += &format!(
+            "facet normal 0 0 0\nouter loop\n{}\n{}\n{}\nendloop\nendfacet\n",
+            at(a.0, a.1),
+            at(b.0, b.1),
+            at(c.0, c.1)
+        );
+    }
+    text + "endsolid plate\n"
+}
+
+/// Runs `analyze` on `part` with `extra` flags into a fresh directory:
+/// its stderr and summary.json.
+fn analyze(dir: &Path, part: &Path, extra: &[&str]) -> (String, serde_json::Value) {
+    let out = dir.join("run");
+    let mut args = vec![
+        "analyze",
+        part.to_str().unwrap(),
+        "--angles=0",
+        "--pitch",
+        "8",
+        "--force",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let o = kneeform(&args);
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(o.status.success(), "{err}");
+    (err, summary(&out))
+}
+
+/// Item 8: a plate facing z (a part lying flat) was analysed edge-on with
+/// no hint. It is warned of, naming the `--frame` that faces it; with
+/// that frame the warning is gone. The units hint names inches.
+#[test]
+fn a_plate_facing_z_is_warned_of_with_the_frame_that_faces_it() {
+    let dir = scratch_dir("second-hour-plate");
+    let plate = dir.join("plate.stl");
+    std::fs::write(&plate, square_stl(2, 400.0)).unwrap();
+    let (err, s) = analyze(&dir, &plate, &[]);
+    let line = err
+        .lines()
+        .find(|l| l.contains("edge-on"))
+        .unwrap_or_else(|| panic!("no edge-on warning: {err}"));
+    assert!(
+        line.contains("along z") && line.contains("--frame x,-z,y"),
+        "{line}"
+    );
+    let recorded = s["warnings"].to_string();
+    assert!(recorded.contains("edge-on"), "summary.json: {recorded}");
+    let (err, _) = analyze(&dir, &plate, &["--frame", "x,-z,y"]);
+    assert!(!err.contains("meets it edge-on"), "{err}");
+    // A 12 mm part, a 0.5 inch one read as mm.
+    let small = dir.join("small.stl");
+    std::fs::write(&small, square_stl(1, 12.0)).unwrap();
+    let (err, _) = analyze(&dir, &small, &[]);
+    assert!(err.contains("--scale 25.4"), "{err}");
+}
+
+/// Item 10: `verify`'s default tolerance (1 mm) was below the default
+/// pitch (1.24 mm), so a correct grid failed by construction. It is now
+/// sqrt 2 pitches, the grid's own sampling error (rounded up to the
+/// micrometre), recorded as such; `--help` says why; a tolerance given
+/// is kept.
+#[test]
+fn verify_s_default_tolerance_is_the_pitch_s_sampling_error() {
+    let dir = scratch_dir("second-hour-tolerance");
+    let run = |extra: &[&str]| {
+        let out = dir.join("verify");
+        let _ = std::fs::remove_dir_all(&out);
+        let mut args = vec![
+            "verify".to_string(),
+            scenario("ramp"),
+            "--pitch".into(),
+            "4".into(),
+            "--angles=0".into(),
+            "--starts".into(),
+            "3".into(),
+            "--out".into(),
+            out.display().to_string(),
+        ];
+        args.extend(extra.iter().map(|s| s.to_string()));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = kneeform(&args);
+        assert!(
+            matches!(o.status.code(), Some(0 | 1)),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let text = std::fs::read_to_string(out.join("verify.json")).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["tolerance_mm"].as_f64().unwrap()
+    };
+    assert_eq!(run(&[]), 5.656855, "sqrt 2 x 4 mm, rounded up to 1 um");
+    assert_eq!(run(&["--tolerance", "1"]), 1.0);
+    let help = kneeform(&["verify", "--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    assert!(help.contains("sqrt 2 pitches"), "{help}");
+}
+
+/// Item 9: `verify` ran for minutes with nothing on stderr when stderr was
+/// not a terminal (a scheduler's log, CI). Off a terminal a progress line
+/// comes at most every 10 s (`KNEEFORM_PROGRESS_EVERY` seconds here, so
+/// that the test need not wait), saying done/total, elapsed and left.
+#[test]
+fn off_a_terminal_progress_comes_as_lines() {
+    let dir = scratch_dir("second-hour-progress");
+    let out = dir.join("verify");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_kneeform"))
+        .args([
+            "verify",
+            &scenario("bump"),
+            "--pitch",
+            "4",
+            "--angles=-30,0,30",
+            "--starts",
+            "12",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .env("KNEEFORM_PROGRESS_EVERY", "0.05")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    let progress: Vec<&str> = err.lines().filter(|l| l.contains(" elapsed")).collect();
+    assert!(!progress.is_empty(), "no progress line: {err}");
+    assert!(
+        progress
+            .iter()
+            .any(|l| l.contains('/') && l.contains(" left")),
+        "no done/total line: {progress:?}"
+    );
+    assert!(
+        progress.iter().all(|l| l.starts_with("kneeform: exact oracle")),
+        "{progress:?}"
+    );
+}

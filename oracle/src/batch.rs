@@ -20,6 +20,18 @@ pub fn evaluate(
     angles_deg: &[f64],
     options: &OracleOptions,
 ) -> Result<Vec<StartTrace>, OracleError> {
+    evaluate_reporting(part, starts, angles_deg, options, &|| {})
+}
+
+/// [`evaluate`], calling `traced` once as each start-angle pair's trace
+/// is done (from whichever thread traced it): a caller's progress.
+pub fn evaluate_reporting(
+    part: &Part,
+    starts: &[[f64; 2]],
+    angles_deg: &[f64],
+    options: &OracleOptions,
+    traced: &(dyn Fn() + Sync),
+) -> Result<Vec<StartTrace>, OracleError> {
     options.validate()?;
     if let Some(bad) = angles_deg.iter().find(|a| !a.is_finite()) {
         return Err(OracleError::InvalidOptions(format!(
@@ -41,6 +53,10 @@ pub fn evaluate(
     let n = starts.len();
     Ok((0..knees.len() * n)
         .into_par_iter()
-        .map(|k| trace_validated(part, &knees[k / n], starts[k % n], options))
+        .map(|k| {
+            let trace = trace_validated(part, &knees[k / n], starts[k % n], options);
+            traced();
+            trace
+        })
         .collect())
 }

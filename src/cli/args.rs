@@ -418,9 +418,14 @@ pub struct VerifyArgs {
     pub study: StudyArgs,
     /// Largest error allowed for every decided metric (mm): push, first
     /// contact, miss, false alarm and the area distance, over decided
-    /// strikes.
-    #[arg(long, default_value_t = 1.0, value_name = "MM")]
-    pub tolerance: f64,
+    /// strikes. Default: sqrt 2 pitches (1.753624 mm at the default
+    /// 1.24 mm), the grid's own sampling error: a nearest node lies up to
+    /// that far from a point of the part, so a correct grid cannot do
+    /// better, and a fixed 1 mm below the pitch would fail every correct
+    /// run. Give your own (say 1) to ask whether this pitch is fine enough
+    /// for it; a failing figure then names the pitch that would be.
+    #[arg(long, value_name = "MM")]
+    pub tolerance: Option<f64>,
     /// Output directory for verify.csv and verify.json.
     #[arg(long, default_value = "kneeform-verify", value_name = "DIR")]
     pub out: PathBuf,

@@ -119,7 +119,7 @@ pub fn print_verification(result: &Verification, out: &Path) -> ExitCode {
         };
         eprintln!(
             "kneeform: PASS at tolerance {} mm{explained}; results in {}",
-            s.tolerance_mm,
+            kneeform::limits::short(s.tolerance_mm),
             out.display()
         );
         ExitCode::SUCCESS
@@ -155,7 +155,7 @@ pub fn print_verification(result: &Verification, out: &Path) -> ExitCode {
         });
         eprintln!(
             "kneeform: FAIL at tolerance {} mm ({}){worst}; results in {}",
-            s.tolerance_mm,
+            kneeform::limits::short(s.tolerance_mm),
             s.failures
                 .iter()
                 .filter(|f| f.fails_verdict)
@@ -250,7 +250,7 @@ pub fn print_direct_verification(result: &DirectVerification, out: &Path) -> Exi
     let verdict = if s.pass { "PASS" } else { "FAIL" };
     eprintln!(
         "kneeform: {verdict} (direct approach) at tolerance {} mm; results in {}",
-        s.tolerance_mm,
+        kneeform::limits::short(s.tolerance_mm),
         out.display()
     );
     if s.pass {

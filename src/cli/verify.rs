@@ -15,7 +15,9 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
     let options = VerifyOptions {
         selection: args.study.starts.validate()?,
         tie_band_per_mm: args.study.starts.tie_band,
-        tolerance: args.tolerance,
+        tolerance: args
+            .tolerance
+            .unwrap_or_else(|| sampling_tolerance(&args.study)),
     };
     let shard = super::study_shard(&args.study)?;
     let (input, setup) = super::study_inputs(&args.study, options.validate())?;
@@ -37,6 +39,19 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
         .map_err(super::harness_error)?;
     output::write_verification(&args.out, &result)?;
     Ok(super::study::print_verification(&result, &args.out))
+}
+
+/// `verify`'s default tolerance: sqrt 2 pitches (mm), rounded up to the
+/// micrometre, the grid's sampling error at the pitch under test (a
+/// point of the part lies up to that far from its nearest node). Under
+/// `--pitch auto`, refused later, 1 mm.
+fn sampling_tolerance(study: &super::args::StudyArgs) -> f64 {
+    match study.setup.pitch {
+        super::args::PitchArg::Mm(p) if p.is_finite() && p > 0.0 => {
+            (std::f64::consts::SQRT_2 * p * 1e6).ceil() / 1e6
+        }
+        _ => 1.0,
+    }
 }
 
 /// `verify --approach direct`: the grid's first contacts against the exact

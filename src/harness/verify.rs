@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use super::HarnessError;
 use super::compare::{
     AreaDistance, CompareOptions, Comparison, Counts, StartSelection, compare_grid_with,
-    exact_traces, select_starts,
+    exact_traces_reporting, select_starts,
 };
 use super::metrics::{Stats, TieBand};
 use super::trace::Fault;
@@ -143,10 +143,10 @@ pub(super) fn run_oracle(
             starts.len(),
             angles.len()
         ),
-        None,
+        Some((starts.len() * angles.len()) as u64),
     );
     let t = Instant::now();
-    let traces = exact_traces(triangles, starts, angles, options);
+    let traces = exact_traces_reporting(triangles, starts, angles, options, &|| progress.step());
     progress.end();
     Ok((traces?, t.elapsed().as_secs_f64()))
 }
