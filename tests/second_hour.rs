@@ -205,7 +205,61 @@ fn off_a_terminal_progress_comes_as_lines() {
         "no done/total line: {progress:?}"
     );
     assert!(
-        progress.iter().all(|l| l.starts_with("kneeform: exact oracle")),
+        progress
+            .iter()
+            .all(|l| l.starts_with("kneeform: exact oracle")),
         "{progress:?}"
     );
+}
+
+/// `kneeform` run in the directory `dir`.
+fn kneeform_in(dir: &Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_kneeform"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+/// Item 13: `report` could not find a scenario part named relatively when
+/// made from another directory, and without `--out` it silently replaced
+/// `./report.html`. The part is found from the run directory's ancestors
+/// (its SHA-256 decides); an existing report is replaced only with
+/// `--force`.
+#[test]
+fn report_finds_a_relative_part_from_elsewhere_and_keeps_an_existing_file() {
+    let dir = scratch_dir("second-hour-report");
+    std::fs::create_dir_all(dir.join("parts")).unwrap();
+    std::fs::copy(scenario("step"), dir.join("parts/step.toml")).unwrap();
+    let o = kneeform_in(
+        &dir,
+        &[
+            "analyze",
+            "parts/step.toml",
+            "--pitch",
+            "8",
+            "--angles=0",
+            "--out",
+            "runs/step",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // From runs/step itself: the run directory is `.`.
+    let report = |args: &[&str]| kneeform_in(&dir.join("runs/step"), args);
+    let o = report(&["report", "."]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // Again: refused, the file untouched.
+    std::fs::write(dir.join("runs/step/report.html"), b"my notes").unwrap();
+    let o = report(&["report", "."]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("--force"), "{err}");
+    assert_eq!(
+        std::fs::read(dir.join("runs/step/report.html")).unwrap(),
+        b"my notes"
+    );
+    let o = report(&["report", ".", "--force"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let html = std::fs::read_to_string(dir.join("runs/step/report.html")).unwrap();
+    assert!(html.contains("<html"), "replaced by a report");
 }

@@ -319,9 +319,14 @@ pub struct ReportArgs {
     /// Output directories of `kneeform verify` or `kneeform converge`.
     #[arg(value_name = "VERIFY_DIR")]
     pub verify_dirs: Vec<PathBuf>,
-    /// The HTML file to write.
+    /// The HTML file to write. An existing file is refused unless
+    /// --force is given.
     #[arg(long, default_value = "report.html", value_name = "FILE")]
     pub out: PathBuf,
+    /// Replace an existing --out report (an .html file only: never a part
+    /// or a run's file).
+    #[arg(long)]
+    pub force: bool,
     /// The analysed part, when it is no longer at the path the run names
     /// (its SHA-256 must still be the run's).
     #[arg(long, value_name = "FILE")]

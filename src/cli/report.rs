@@ -17,6 +17,13 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
         "--out {} exists and is not an .html file: it will not be overwritten; name the report something.html",
         args.out.display()
     );
+    // An earlier report (another run's, perhaps) is replaced only when
+    // asked, as `analyze` replaces a run directory.
+    anyhow::ensure!(
+        args.force || !args.out.exists(),
+        "--out {} exists: pass --force to replace it, or name another file",
+        args.out.display()
+    );
     let options = ReportOptions {
         verify_dirs: args.verify_dirs.clone(),
         part: args.part.clone(),

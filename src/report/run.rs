@@ -684,10 +684,16 @@ fn find_part(
         Some(p) => vec![p.to_path_buf()],
         None => {
             let mut c = vec![named.clone()];
-            if named.is_relative()
-                && let Some(parent) = dir.parent()
-            {
-                c.push(parent.join(&named));
+            if named.is_relative() {
+                if let Some(parent) = dir.parent() {
+                    c.push(parent.join(&named));
+                }
+                // A report made from another directory: the part named
+                // relative to where the run was made, which is most often
+                // an ancestor of the run directory (the SHA-256 decides).
+                if let Ok(real) = dir.canonicalize() {
+                    c.extend(real.ancestors().skip(1).take(8).map(|a| a.join(&named)));
+                }
             }
             c
         }
