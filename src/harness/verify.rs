@@ -182,6 +182,11 @@ pub(crate) fn verify_with(
         oracle_s,
         ..
     } = &traced;
+    // The grid's slides and their comparison: minutes on a large part.
+    progress.begin(
+        &format!("grid against exact: {} start-angle pairs", traces.len()),
+        None,
+    );
     let comparison = compare_grid_with(
         &input.part.triangles,
         grid,
@@ -190,7 +195,9 @@ pub(crate) fn verify_with(
         traces,
         compare,
         fault,
-    )?;
+    );
+    progress.end();
+    let comparison = comparison?;
     let summary = VerifySummary::new(
         input,
         setup,
