@@ -20,6 +20,16 @@ pub(crate) fn kneeform(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
+/// [`kneeform`] run in the directory `dir`.
+pub(crate) fn kneeform_in(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_kneeform"))
+        .current_dir(dir)
+        .args(args)
+        .env_remove("RUST_BACKTRACE")
+        .output()
+        .expect("the binary runs")
+}
+
 fn shared_meshes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes")
 }

@@ -3,11 +3,10 @@
 //! approaches"; `src/direct.rs`), and on the pocket behind a ridge, the
 //! area it cannot reach and push-and-slide strikes.
 
-use std::path::Path;
-
 use kneeform::direct::{DirectFootprint, contact_levels, direct_mask};
 use kneeform::{Analysis, Approach, HeightGrid, KneeForm, Setup, Side};
 
+use crate::cli::kneeform_in as kneeform_cli;
 use crate::util::{SEEDS, ok, random_grid_quantised, row_start, scenario_file, triangle};
 
 /// The definition, per position and per footprint node, with the test's
@@ -181,14 +180,6 @@ fn the_direct_approach_cannot_reach_the_pocket_behind_the_ridge() {
         let front = points.iter().filter(|p| on_front_flank(p)).count();
         assert!(front >= rows, "{name}: {front} nodes on the front flank");
     }
-}
-
-fn kneeform_cli(dir: &Path, args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_kneeform"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("the binary runs")
 }
 
 #[test]

@@ -11,18 +11,11 @@ use std::process::{Command, Output, Stdio};
 use kneeform::summary::Summary;
 use serde_json::Value;
 
+use crate::cli::kneeform_in as kneeform;
 use crate::util::{Image, Rng, SEEDS, scratch_dir};
 
 fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn kneeform(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kneeform"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("the binary runs")
 }
 
 fn stderr(out: &Output) -> String {

@@ -6,10 +6,10 @@
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use serde_json::Value;
 
+use crate::cli::kneeform_in as kneeform;
 use crate::util::{Image, ok, scratch_dir};
 
 /// Angles of the test runs: the paper's Figure 12 angles and two between.
@@ -17,14 +17,6 @@ const ANGLES: &str = "--angles=-30,-15,0,15,30";
 /// The step scenario strikes exactly the node column x = -2 mm at this
 /// pitch (the step's front edge), at every angle.
 const PITCH: &str = "2";
-
-fn kneeform(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kneeform"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
 
 /// A scratch directory holding `part.stl` (the step scenario, mirrored in
 /// y for the right side) and its analysis in `run/`.

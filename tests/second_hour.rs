@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use crate::cli::kneeform;
+use crate::cli::{kneeform, kneeform_in};
 use crate::util::{scenario, scratch_dir};
 
 /// Runs `kneeform batch` on `manifest`, asserting that it succeeds.
@@ -211,15 +211,6 @@ fn off_a_terminal_progress_comes_as_lines() {
                 || l.starts_with("kneeform: grid against exact")),
         "{progress:?}"
     );
-}
-
-/// `kneeform` run in the directory `dir`.
-fn kneeform_in(dir: &Path, args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_kneeform"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("the binary runs")
 }
 
 /// Item 13: `report` could not find a scenario part named relatively when
