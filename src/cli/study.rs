@@ -195,9 +195,15 @@ pub fn print_convergence(study: &Convergence, out: &Path) {
         if !DECIDED_METRICS.contains(&m.as_str()) {
             continue;
         }
+        let exact = results
+            .iter()
+            .all(|r| r.comparison.stat(m).max <= kneeform::harness::ROUNDING_MM);
         match f {
             Some(f) => eprintln!("{m:>22}: error ~ {:.3} p^{:.2}", f.c, f.alpha),
-            None => eprintln!("{m:>22}: no fit (zero or too few errors)"),
+            None if exact => eprintln!("{m:>22}: exact at every pitch (at most rounding, 1e-9 mm)"),
+            None => {
+                eprintln!("{m:>22}: no fit (an error above rounding at fewer than two pitches)")
+            }
         }
     }
     match (study.summary.tolerance_mm, study.recommended()) {

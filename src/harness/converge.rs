@@ -49,13 +49,19 @@ pub struct Fit {
     pub points: usize,
 }
 
-/// Fits `y ~ c x^alpha` through the points with `x, y > 0`; `None` with
-/// fewer than two such points (an error that is zero at every pitch has no
-/// order).
+/// Errors at or below this (mm) are rounding, not error: a push error of
+/// 1e-15 mm at every pitch is exact there, and fitting it gave orders
+/// such as "alpha = -0.50" that mean nothing.
+pub const ROUNDING_MM: f64 = 1e-9;
+
+/// Fits `y ~ c x^alpha` through the points with `x > 0` and `y` above
+/// rounding ([`ROUNDING_MM`]); `None` with fewer than two such points (an
+/// error that is zero, or rounding, at every pitch has no order: it is
+/// exact there).
 pub fn fit_power_law(points: &[(f64, f64)]) -> Option<Fit> {
     let logs: Vec<(f64, f64)> = points
         .iter()
-        .filter(|(x, y)| *x > 0.0 && *y > 0.0 && y.is_finite())
+        .filter(|(x, y)| *x > 0.0 && *y > ROUNDING_MM && y.is_finite())
         .map(|(x, y)| (x.ln(), y.ln()))
         .collect();
     if logs.len() < 2 {
@@ -607,5 +613,7 @@ mod tests {
         assert_eq!(fit.points, 4);
         // Zero errors carry no order.
         assert!(fit_power_law(&[(8.0, 0.0), (4.0, 0.0), (2.0, 1.0)]).is_none());
+        // Issue 24, item 5: rounding-level errors are exact, not an order.
+        assert!(fit_power_law(&[(8.0, 2e-15), (4.0, 3e-15), (2.0, 4e-15)]).is_none());
     }
 }

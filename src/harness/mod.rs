@@ -45,7 +45,9 @@ pub use compare::{
     AreaDistance, CompareOptions, Comparison, Counts, PairResult, StartSelection, VerifyRow,
     assemble, compare_grid, exact_traces, select_starts,
 };
-pub use converge::{ConvergeOptions, ConvergeSummary, Convergence, PitchResult, converge};
+pub use converge::{
+    ConvergeOptions, ConvergeSummary, Convergence, PitchResult, ROUNDING_MM, converge,
+};
 pub use direct::{
     DIRECT_METRICS, DIRECT_STATUSES, DirectComparison, DirectConvergeSummary, DirectConvergence,
     DirectCounts, DirectPair, DirectRow, DirectStats, DirectVerification, DirectVerifySummary,

@@ -873,8 +873,14 @@ fn converge_block(k: usize, json: &Value) -> Markup {
                         td {
                             "error " (ASYMP) " C " (MIDDOT) " pitch" sup { "alpha" } ": " (name)
                         }
-                        td class="num" { (c(&format!("{base}/alpha"))) }
-                        td class="num" { (c(&format!("{base}/c"))) }
+                        @if fits.get(name).is_some_and(Value::is_null) {
+                            td colspan="2" {
+                                "no order: exact (at most rounding, 1e-9 mm) at every pitch, or above it at fewer than two"
+                            }
+                        } @else {
+                            td class="num" { (c(&format!("{base}/alpha"))) }
+                            td class="num" { (c(&format!("{base}/c"))) }
+                        }
                     }
                     "\n"
                 }
