@@ -255,3 +255,33 @@ fn report_finds_a_relative_part_from_elsewhere_and_keeps_an_existing_file() {
     let html = std::fs::read_to_string(dir.join("runs/step/report.html")).unwrap();
     assert!(html.contains("<html"), "replaced by a report");
 }
+
+/// Item 5: an IoU of 1.000 was printed beside an area distance of
+/// 1.021 mm with nothing to say why both hold. `verify` and the report
+/// say what the IoU can see (exact strikes snapped to nodes) and which
+/// figure to read.
+#[test]
+fn the_area_iou_says_what_it_cannot_see() {
+    let dir = scratch_dir("second-hour-iou");
+    let common = ["--pitch", "4", "--angles=0"];
+    let o = kneeform_in(
+        &dir,
+        &[&["analyze", &scenario("ramp"), "--out", "run"][..], &common].concat(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = kneeform_in(
+        &dir,
+        &[
+            &["verify", &scenario("ramp"), "--starts", "3", "--out", "v"][..],
+            &common,
+        ]
+        .concat(),
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    assert!(err.contains("snapped to their nearest nodes"), "{err}");
+    let o = kneeform_in(&dir, &["report", "run", "v", "--out", "r.html"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let html = std::fs::read_to_string(dir.join("r.html")).unwrap();
+    assert!(html.contains("cannot see a difference under half a pitch"));
+}

@@ -60,7 +60,7 @@ pub fn print_verification(result: &Verification, out: &Path) -> ExitCode {
         .map(|(why, n)| format!("{n}: {why}"))
         .collect();
     eprintln!(
-        "{:>29}: {:.3}; {} start-angle pairs compared, {} oracle failures{}",
+        "{:>29}: {:.3} (exact strikes snapped to their nearest nodes: blind to differences under half a pitch; the area distance measures them); {} start-angle pairs compared, {} oracle failures{}",
         "area IoU",
         s.area_iou,
         c.compared,

@@ -796,6 +796,11 @@ fn verify_block(k: usize, json: &Value, verdict: Verdict) -> Markup {
                 " exact contacts undecided (rate within the tie band: " (c("/tie_band_rule")) ")."
             }
             "\n"
+            p {
+                "The area IoU below (" (c("/area_iou"))
+                ") compares the exact strikes snapped to their nearest nodes with the grid's colliding nodes: it cannot see a difference under half a pitch, so an IoU of 1 beside an area distance near the pitch is no contradiction; the area distance is the figure to read."
+            }
+            "\n"
         }
         @if let Some(Value::Object(metrics)) = json.get("metrics") {
             table class="metrics" {
