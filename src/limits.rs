@@ -160,6 +160,16 @@ pub struct OutOfMemory {
     pub bytes: usize,
 }
 
+/// `seconds` as a clock reading: `1h02m03s`, `2m03s` or `3s`.
+pub fn duration_words(seconds: f64) -> String {
+    let s = seconds.max(0.0).round() as u64;
+    match (s / 3600, s / 60 % 60, s % 60) {
+        (0, 0, s) => format!("{s}s"),
+        (0, m, s) => format!("{m}m{s:02}s"),
+        (h, m, s) => format!("{h}h{m:02}m{s:02}s"),
+    }
+}
+
 /// A number for a message: short, whatever its size (`1e-300`, not three
 /// hundred digits; `0.25`, not `2.5e-1`).
 pub fn short(value: f64) -> String {

@@ -48,6 +48,7 @@ fn compare_by(
         selection,
         tie_band_per_mm: TieBand::DEFAULT_PER_MM,
         tolerance: 1.0,
+        budget_s: None,
     };
     let mut setup = setup(pitch, angles);
     setup.rule = setup.rule.with_rate(rate);

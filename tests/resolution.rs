@@ -123,6 +123,7 @@ fn the_pitch_chosen_for_a_tolerance_passes_verify_there() {
             selection: StartSelection::Sample { count: 60, seed: 2 },
             tie_band_per_mm: TieBand::DEFAULT_PER_MM,
             tolerance: 1.0,
+            budget_s: None,
         };
         let at_choice = Setup {
             pitch: choice.pitch_mm,

@@ -285,3 +285,45 @@ fn the_area_iou_says_what_it_cannot_see() {
     let html = std::fs::read_to_string(dir.join("r.html")).unwrap();
     assert!(html.contains("cannot see a difference under half a pitch"));
 }
+
+/// Issue 26, item 4: `verify` printed nothing about how long its oracle
+/// would take. One start in twenty is traced first, at every angle; its
+/// time predicts the rest (printed), and a prediction beyond `--budget-s`
+/// is refused before the rest is traced, naming the `--shard` count that
+/// would fit. The sample's traces are kept: a run with a generous budget
+/// writes what one without a budget writes.
+#[test]
+fn verify_predicts_its_oracle_time_and_keeps_within_a_budget() {
+    let dir = scratch_dir("second-hour-budget");
+    let common = [
+        "verify",
+        &scenario("bump"),
+        "--pitch",
+        "4",
+        "--angles=-30,0,30",
+        "--starts",
+        "40",
+    ];
+    let run = |out: &str, extra: &[&str]| {
+        kneeform_in(&dir, &[&common[..], &["--out", out], extra].concat())
+    };
+    let o = run("refused", &["--budget-s", "0.000001"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--budget-s") && err.contains("--shard K/"),
+        "{err}"
+    );
+    assert!(!dir.join("refused").exists(), "a refused run wrote nothing");
+    let o = run("free", &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    assert!(
+        err.contains("predicted from 2 of the 40 starts at every angle"),
+        "{err}"
+    );
+    let o = run("budget", &["--budget-s", "100000"]);
+    assert!(matches!(o.status.code(), Some(0 | 1)));
+    let csv = |d: &str| std::fs::read_to_string(dir.join(d).join("verify.csv")).unwrap();
+    assert_eq!(csv("free"), csv("budget"), "the same rows either way");
+}

@@ -431,6 +431,13 @@ pub struct VerifyArgs {
     /// for it; a failing figure then names the pitch that would be.
     #[arg(long, value_name = "MM")]
     pub tolerance: Option<f64>,
+    /// The longest the exact oracle may take (seconds). One start in
+    /// twenty is traced first, at every angle; its time predicts the rest
+    /// (always printed), and a prediction beyond this is refused (exit 2)
+    /// naming the --shard count that would fit, before the rest is traced.
+    /// Default: no limit.
+    #[arg(long, value_name = "S")]
+    pub budget_s: Option<f64>,
     /// Output directory for verify.csv and verify.json.
     #[arg(long, default_value = "kneeform-verify", value_name = "DIR")]
     pub out: PathBuf,

@@ -60,27 +60,21 @@ impl Logged {
                     "kneeform: {}: {}/{total}, {} elapsed, about {} left",
                     self.what,
                     self.done,
-                    clock(elapsed),
-                    clock(left)
+                    kneeform::limits::duration_words(elapsed),
+                    kneeform::limits::duration_words(left)
                 )
             }
             Some(total) => format!(
                 "kneeform: {}: 0/{total}, {} elapsed",
                 self.what,
-                clock(elapsed)
+                kneeform::limits::duration_words(elapsed)
             ),
-            None => format!("kneeform: {}: {} elapsed", self.what, clock(elapsed)),
+            None => format!(
+                "kneeform: {}: {} elapsed",
+                self.what,
+                kneeform::limits::duration_words(elapsed)
+            ),
         })
-    }
-}
-
-/// `seconds` as `1h02m03s`, `2m03s` or `3s`.
-fn clock(seconds: f64) -> String {
-    let s = seconds.max(0.0).round() as u64;
-    match (s / 3600, s / 60 % 60, s % 60) {
-        (0, 0, s) => format!("{s}s"),
-        (0, m, s) => format!("{m}m{s:02}s"),
-        (h, m, s) => format!("{h}h{m:02}m{s:02}s"),
     }
 }
 
@@ -229,6 +223,6 @@ mod tests {
         );
         // At most one line every LOG_EVERY.
         assert_eq!(log.due_line(), None);
-        assert_eq!(clock(3725.0), "1h02m05s");
+        assert_eq!(kneeform::limits::duration_words(3725.0), "1h02m05s");
     }
 }

@@ -18,6 +18,7 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
         tolerance: args
             .tolerance
             .unwrap_or_else(|| sampling_tolerance(&args.study)),
+        budget_s: args.budget_s,
     };
     let shard = super::study_shard(&args.study)?;
     let (input, setup) = super::study_inputs(&args.study, options.validate())?;

@@ -287,7 +287,7 @@ impl<'a> Ladder<'a> {
         let starts = super::sharded::share(&all_starts, shard)?;
         let oracle = oracle_options(&setup.knee, finest, coarse.x(0));
         let (traces, oracle_s) = match oracle_budget_s {
-            None => run_oracle(triangles, &starts, &setup.angles, &oracle, progress)?,
+            None => run_oracle(triangles, &starts, &setup.angles, &oracle, None, progress)?,
             Some(budget_s) => traces_within(
                 triangles,
                 &starts,

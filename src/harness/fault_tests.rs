@@ -29,6 +29,7 @@ fn compare(
         selection,
         tie_band_per_mm: TieBand::DEFAULT_PER_MM,
         tolerance: 1.0,
+        budget_s: None,
     };
     verify_with(
         &PartFile::in_memory("test", part),

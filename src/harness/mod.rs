@@ -160,6 +160,20 @@ pub enum HarnessError {
         /// The study so far, in words.
         studied: String,
     },
+    /// A verification's exact traces would take longer than its budget.
+    #[error(
+        "the exact oracle would take about {predicted_s:.0} s for {pairs} start-angle pairs (predicted from a sample), beyond --budget-s {budget_s}: fan it out with --shard K/{shards} (K = 1..{shards}, then `kneeform merge`), or trace fewer starts (--starts)"
+    )]
+    VerifyBudget {
+        /// The predicted oracle time (s).
+        predicted_s: f64,
+        /// Start-angle pairs to trace.
+        pairs: usize,
+        /// The budget (s).
+        budget_s: f64,
+        /// Shards that would each fit the budget.
+        shards: usize,
+    },
     /// The exact traces of a pitch study would take longer than its
     /// budget.
     #[error(

@@ -28,6 +28,10 @@ pub struct VerifyOptions {
     pub tie_band_per_mm: f64,
     /// The largest error allowed for every decided metric (mm).
     pub tolerance: f64,
+    /// The longest the exact oracle may take (s): predicted from a sample
+    /// of the starts traced first, beyond it the verification is refused
+    /// naming the `--shard` count that would fit. Unbounded when `None`.
+    pub budget_s: Option<f64>,
 }
 
 impl VerifyOptions {
@@ -35,7 +39,11 @@ impl VerifyOptions {
     pub fn validate(&self) -> Result<(), HarnessError> {
         check_selection(&self.selection)?;
         check_tie_band(self.tie_band_per_mm)?;
-        check_tolerance(self.tolerance)
+        check_tolerance(self.tolerance)?;
+        match self.budget_s {
+            Some(b) if !(b.is_finite() && b > 0.0) => Err(HarnessError::Budget(b)),
+            _ => Ok(()),
+        }
     }
 }
 
@@ -129,26 +137,78 @@ pub(super) fn start_positions(
     Ok(starts)
 }
 
-/// The oracle's traces of `starts` at `angles`, reported as one stage.
+/// The share of the starts traced first, at every angle, to predict the
+/// oracle's time: one in twenty (at least one start).
+const SAMPLE_EVERY: usize = 20;
+
+/// The oracle's traces of `starts` at `angles`, reported as one stage,
+/// angle-major. A sample of the starts is traced first, at every angle:
+/// its time predicts the whole (said as a note), and a prediction beyond
+/// `budget_s` is refused before the rest is traced.
 pub(super) fn run_oracle(
     triangles: &[Triangle],
     starts: &[[f64; 2]],
     angles: &[f64],
     options: &OracleOptions,
+    budget_s: Option<f64>,
     progress: &dyn Progress,
 ) -> Result<(Vec<StartTrace>, f64), HarnessError> {
+    let pairs = starts.len() * angles.len();
     progress.begin(
         &format!(
             "exact oracle: {} starts x {} angles",
             starts.len(),
             angles.len()
         ),
-        Some((starts.len() * angles.len()) as u64),
+        Some(pairs as u64),
     );
     let t = Instant::now();
-    let traces = exact_traces_reporting(triangles, starts, angles, options, &|| progress.step());
+    let traced = || progress.step();
+    let sampled = starts.len().div_ceil(SAMPLE_EVERY).min(starts.len());
+    let (first, rest) = starts.split_at(sampled);
+    let sample = exact_traces_reporting(triangles, first, angles, options, &traced);
+    let sample = match sample {
+        Ok(s) => s,
+        Err(e) => {
+            progress.end();
+            return Err(e);
+        }
+    };
+    let sample_s = t.elapsed().as_secs_f64();
+    let predicted_s = sample_s * starts.len() as f64 / sampled.max(1) as f64;
+    if !rest.is_empty() {
+        progress.note(&format!(
+            "exact oracle: about {} for {pairs} start-angle pairs (predicted from {} of the {} starts at every angle, {:.1} s)",
+            crate::limits::duration_words(predicted_s),
+            sampled,
+            starts.len(),
+            sample_s
+        ));
+    }
+    if let Some(budget_s) = budget_s
+        && predicted_s > budget_s
+    {
+        progress.end();
+        return Err(HarnessError::VerifyBudget {
+            predicted_s,
+            pairs,
+            budget_s,
+            shards: ((predicted_s / budget_s).ceil() as usize).clamp(2, starts.len().max(2)),
+        });
+    }
+    let rest = exact_traces_reporting(triangles, rest, angles, options, &traced);
     progress.end();
-    Ok((traces?, t.elapsed().as_secs_f64()))
+    let rest = rest?;
+    // Angle-major over every start: each angle's sampled starts, then the
+    // rest of them.
+    let (m, r) = (sampled, starts.len() - sampled);
+    let mut traces = Vec::with_capacity(pairs);
+    let (mut sample, mut rest) = (sample.into_iter(), rest.into_iter());
+    for _ in angles {
+        traces.extend(sample.by_ref().take(m));
+        traces.extend(rest.by_ref().take(r));
+    }
+    Ok((traces, t.elapsed().as_secs_f64()))
 }
 
 /// Verifies the grid against the exact oracle at `setup`'s pitch, on the
@@ -256,7 +316,14 @@ impl Traced {
         let all = start_positions(&grid, &footprints, &options.selection)?;
         let starts = super::sharded::share(&all, shard)?;
         let oracle = oracle_options(&setup.knee, setup.pitch, spec.x(0));
-        let (traces, oracle_s) = run_oracle(triangles, &starts, &setup.angles, &oracle, progress)?;
+        let (traces, oracle_s) = run_oracle(
+            triangles,
+            &starts,
+            &setup.angles,
+            &oracle,
+            options.budget_s,
+            progress,
+        )?;
         Ok(Traced {
             spec,
             grid,
