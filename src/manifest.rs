@@ -67,14 +67,14 @@ fn groups<'a>(args: &'a [String], is_switch: &dyn Fn(&str) -> bool) -> Vec<Group
     let mut k = 0;
     while k < args.len() {
         let a = args[k].as_str();
-        let (name, len) = match a.strip_prefix("--") {
-            Some(_) if a.contains('=') => (a.split_once('=').map_or(a, |(n, _)| n), 1),
-            Some(_) if is_switch(a) => (a, 1),
-            Some(_) => {
+        let (name, len) = match a.split_once('=') {
+            _ if !a.starts_with("--") => ("", 1),
+            Some((name, _)) => (name, 1),
+            None if is_switch(a) => (a, 1),
+            None => {
                 let has_value = args.get(k + 1).is_some_and(|v| !v.starts_with("--"));
                 (a, 1 + usize::from(has_value))
             }
-            None => ("", 1),
         };
         out.push(Group {
             name,
@@ -97,7 +97,16 @@ impl Flags {
         argv: &mut Vec<String>,
     ) {
         let own = groups(&item.args, is_switch);
-        let set_by_item = |name: &str| own.iter().any(|g| g.name == name);
+        // Whether the item sets `name`, by name or in its `args`.
+        let set_by_item = |name: &str| {
+            own.iter().any(|g| g.name == name)
+                || match name {
+                    "--pitch" => item.pitch.is_some(),
+                    "--angles" => item.angles.is_some(),
+                    "--side" => item.side.is_some(),
+                    _ => false,
+                }
+        };
         // `--flag=value`: a value such as -1 is the flag's, not another
         // flag (clap printed its usage for `pitch = -1`).
         let named = |flag: &str, mine: Option<String>, theirs: Option<String>| {
@@ -115,14 +124,8 @@ impl Flags {
             defaults.angles.clone(),
         ));
         argv.extend(named("--side", item.side.clone(), defaults.side.clone()));
-        let item_named = |name: &str| match name {
-            "--pitch" => item.pitch.is_some(),
-            "--angles" => item.angles.is_some(),
-            "--side" => item.side.is_some(),
-            _ => false,
-        };
         for g in groups(&defaults.args, is_switch) {
-            if g.name.is_empty() || !(set_by_item(g.name) || item_named(g.name)) {
+            if g.name.is_empty() || !set_by_item(g.name) {
                 argv.extend(g.tokens.iter().cloned());
             }
         }

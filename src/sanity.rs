@@ -157,22 +157,27 @@ pub fn knee_extent(knee: &KneeForm) -> f64 {
 /// mirrors it, so the y component of the winding normal is the same in the
 /// analysis frame as in the part's: the sums read the part as it is.
 pub fn facing_areas(part: &Part) -> (f64, f64) {
-    let (mut plus, mut minus) = (0.0, 0.0);
+    axis_facing_areas(part)[1]
+}
+
+/// The areas of the part's surface facing +axis and -axis, for the axes
+/// x, y and z (mm^2): each triangle's area times each component of its
+/// unit normal by winding, summed by sign ([`facing_areas`] for y).
+fn axis_facing_areas(part: &Part) -> [(f64, f64); 3] {
+    let mut areas = [(0.0, 0.0); 3];
     for t in &part.triangles {
-        let (a, b, c) = (t[0], t[1], t[2]);
-        let (u, v) = (
-            [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
-            [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
-        );
-        // Half the y component of u x v: the projected area, signed.
-        let ny = 0.5 * (u[2] * v[0] - u[0] * v[2]);
-        if ny > 0.0 {
-            plus += ny;
-        } else {
-            minus -= ny;
+        let [a, b, c] = t.map(nalgebra::Vector3::from);
+        // Half of (b - a) x (c - a): the projected areas, signed.
+        let n = 0.5 * (b - a).cross(&(c - a));
+        for (k, area) in areas.iter_mut().enumerate() {
+            if n[k] > 0.0 {
+                area.0 += n[k];
+            } else {
+                area.1 -= n[k];
+            }
         }
     }
-    (plus, minus)
+    areas
 }
 
 /// The checks of a part read for `side` against `knee`: its size and its
@@ -212,30 +217,13 @@ pub fn part_warnings(part: &Part, side: Side, knee: &KneeForm) -> Vec<Warning> {
     warnings
 }
 
-/// The areas of the part's surface facing along x, y and z (mm^2): each
-/// triangle's area times the absolute component of its unit normal, and
-/// the signed sums along x and z (which way most of it faces).
-fn axis_areas(part: &Part) -> ([f64; 3], [f64; 3]) {
-    let (mut unsigned, mut signed) = ([0.0; 3], [0.0; 3]);
-    for t in &part.triangles {
-        let (a, b, c) = (t[0], t[1], t[2]);
-        let u = nalgebra::Vector3::new(b[0] - a[0], b[1] - a[1], b[2] - a[2]);
-        let v = nalgebra::Vector3::new(c[0] - a[0], c[1] - a[1], c[2] - a[2]);
-        let n = 0.5 * u.cross(&v);
-        for k in 0..3 {
-            unsigned[k] += n[k].abs();
-            signed[k] += n[k];
-        }
-    }
-    (unsigned, signed)
-}
-
 /// The check of a part analysed by the slide (the knee pushed along y)
 /// for a surface met edge-on ([`EDGE_ON_RATIO`]), with the `--frame` that
 /// would face it, as the part's own axes, where `framed` is false (no
 /// `--frame` given); with one, the advice is to check it.
 pub fn facing_axis_warning(part: &Part, framed: bool) -> Option<Warning> {
-    let (area, signed) = axis_areas(part);
+    let facing = axis_facing_areas(part);
+    let area = facing.map(|(plus, minus)| plus + minus);
     let total: f64 = area.iter().sum();
     let (k, along) = if area[0] >= area[2] {
         (0, area[0])
@@ -248,7 +236,7 @@ pub fn facing_axis_warning(part: &Part, framed: bool) -> Option<Warning> {
     // The rotation whose vehicle y is the part's axis k, signed so that
     // the side facing +k (the larger share) faces the knee of the left
     // side, at -y.
-    let plus = signed[k] >= 0.0;
+    let plus = facing[k].0 >= facing[k].1;
     let (axis, frame) = match (k, plus) {
         (0, true) => ("x", "y,-x,z"),
         (0, false) => ("x", "-y,x,z"),

@@ -76,7 +76,8 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let items = kneeform::manifest::plan(&text, &base, &analyze_switch)
+    let switches = analyze_switches();
+    let items = kneeform::manifest::plan(&text, &base, &|flag| switches.iter().any(|s| s == flag))
         .map_err(|e| anyhow::anyhow!("manifest {}: {e}", args.manifest.display()))?;
     let exe = std::env::current_exe().context("cannot find this kneeform binary")?;
     let total = items.len();
@@ -130,19 +131,17 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Whether `flag` (`--report`) is an `analyze` flag that takes no value,
-/// as the command line defines it.
-fn analyze_switch(flag: &str) -> bool {
+/// The `analyze` flags that take no value (`--report`), as the command
+/// line defines them.
+fn analyze_switches() -> Vec<String> {
     use clap::CommandFactory;
     let cli = super::args::Cli::command();
-    let Some(analyze) = cli.find_subcommand("analyze") else {
-        return false;
-    };
-    let name = flag.trim_start_matches('-');
-    analyze
-        .get_arguments()
-        .find(|a| a.get_long() == Some(name))
-        .is_some_and(|a| !a.get_action().takes_values())
+    cli.find_subcommand("analyze")
+        .into_iter()
+        .flat_map(|analyze| analyze.get_arguments())
+        .filter(|a| !a.get_action().takes_values())
+        .filter_map(|a| a.get_long().map(|long| format!("--{long}")))
+        .collect()
 }
 
 /// Whether `out` holds a complete run (or shard: `--shard` in the item's

@@ -153,21 +153,8 @@ pub fn exact_traces(
     angles: &[f64],
     options: &OracleOptions,
 ) -> Result<Vec<StartTrace>, HarnessError> {
-    exact_traces_reporting(triangles, starts, angles, options, &|| {})
-}
-
-/// [`exact_traces`], calling `traced` as each start-angle pair is done.
-pub(super) fn exact_traces_reporting(
-    triangles: &[Triangle],
-    starts: &[[f64; 2]],
-    angles: &[f64],
-    options: &OracleOptions,
-    traced: &(dyn Fn() + Sync),
-) -> Result<Vec<StartTrace>, HarnessError> {
     let part = kneeform_oracle::Part::from_triangles(triangles)?;
-    Ok(kneeform_oracle::evaluate_reporting(
-        &part, starts, angles, options, traced,
-    )?)
+    Ok(kneeform_oracle::evaluate(&part, starts, angles, options)?)
 }
 
 /// One row of `verify.csv`.

@@ -221,3 +221,23 @@ pub enum HarnessError {
     #[error("a strip of starts needs finite z bounds Z0 <= Z1 (mm), got {0:?}")]
     Strip([f64; 2]),
 }
+
+/// `work` reported to `progress` as one stage, `what` with `total` steps
+/// (a spinner when `None`): the stage ends however `work` returns.
+pub(crate) fn in_stage<T>(
+    progress: &dyn crate::Progress,
+    what: &str,
+    total: Option<u64>,
+    work: impl FnOnce() -> T,
+) -> T {
+    progress.begin(what, total);
+    let done = work();
+    progress.end();
+    done
+}
+
+/// The stage in which a study's grid slides are compared with the exact
+/// traces of `pairs` start-angle pairs: minutes on a large part.
+fn comparing(pairs: usize) -> String {
+    format!("grid against exact: {pairs} start-angle pairs")
+}

@@ -207,21 +207,17 @@ pub fn verify_shard(
         oracle_s,
     } = Traced::new(input, setup, options, Some(shard), progress)?;
     let t = Instant::now();
-    progress.begin(
-        &format!("grid against exact: {} start-angle pairs", traces.len()),
-        None,
-    );
-    let pairs = pair_results(
-        &input.part.triangles,
-        &grid,
-        &footprints,
-        &starts,
-        &traces,
-        &compare,
-        None,
-    );
-    progress.end();
-    let pairs = pairs?;
+    let pairs = super::in_stage(progress, &super::comparing(traces.len()), None, || {
+        pair_results(
+            &input.part.triangles,
+            &grid,
+            &footprints,
+            &starts,
+            &traces,
+            &compare,
+            None,
+        )
+    })?;
     let grid_s = t.elapsed().as_secs_f64();
     let band = TieBand::new(setup.rule.sigma, spec.pitch, options.tie_band_per_mm);
     // The study's identity and settings; its statistics are the merge's

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use super::HarnessError;
 use super::compare::{
     AreaDistance, CompareOptions, Comparison, Counts, StartSelection, compare_grid_with,
-    exact_traces_reporting, select_starts,
+    select_starts,
 };
 use super::metrics::{Stats, TieBand};
 use super::trace::Fault;
@@ -154,61 +154,53 @@ pub(super) fn run_oracle(
     progress: &dyn Progress,
 ) -> Result<(Vec<StartTrace>, f64), HarnessError> {
     let pairs = starts.len() * angles.len();
-    progress.begin(
-        &format!(
-            "exact oracle: {} starts x {} angles",
-            starts.len(),
-            angles.len()
-        ),
-        Some(pairs as u64),
+    let what = format!(
+        "exact oracle: {} starts x {} angles",
+        starts.len(),
+        angles.len()
     );
-    let t = Instant::now();
-    let traced = || progress.step();
-    let sampled = starts.len().div_ceil(SAMPLE_EVERY).min(starts.len());
-    let (first, rest) = starts.split_at(sampled);
-    let sample = exact_traces_reporting(triangles, first, angles, options, &traced);
-    let sample = match sample {
-        Ok(s) => s,
-        Err(e) => {
-            progress.end();
-            return Err(e);
+    super::in_stage(progress, &what, Some(pairs as u64), || {
+        let t = Instant::now();
+        let part = kneeform_oracle::Part::from_triangles(triangles)?;
+        let trace = |starts: &[[f64; 2]]| {
+            kneeform_oracle::evaluate_reporting(&part, starts, angles, options, &|| progress.step())
+        };
+        let sampled = starts.len().div_ceil(SAMPLE_EVERY);
+        let (first, rest) = starts.split_at(sampled);
+        let sample = trace(first)?;
+        let sample_s = t.elapsed().as_secs_f64();
+        let predicted_s = sample_s * starts.len() as f64 / sampled.max(1) as f64;
+        if !rest.is_empty() {
+            progress.note(&format!(
+                "exact oracle: about {} for {pairs} start-angle pairs (predicted from {} of the {} starts at every angle, {:.1} s)",
+                crate::limits::duration_words(predicted_s),
+                sampled,
+                starts.len(),
+                sample_s
+            ));
         }
-    };
-    let sample_s = t.elapsed().as_secs_f64();
-    let predicted_s = sample_s * starts.len() as f64 / sampled.max(1) as f64;
-    if !rest.is_empty() {
-        progress.note(&format!(
-            "exact oracle: about {} for {pairs} start-angle pairs (predicted from {} of the {} starts at every angle, {:.1} s)",
-            crate::limits::duration_words(predicted_s),
-            sampled,
-            starts.len(),
-            sample_s
-        ));
-    }
-    if let Some(budget_s) = budget_s
-        && predicted_s > budget_s
-    {
-        progress.end();
-        return Err(HarnessError::VerifyBudget {
-            predicted_s,
-            pairs,
-            budget_s,
-            shards: ((predicted_s / budget_s).ceil() as usize).clamp(2, starts.len().max(2)),
-        });
-    }
-    let rest = exact_traces_reporting(triangles, rest, angles, options, &traced);
-    progress.end();
-    let rest = rest?;
-    // Angle-major over every start: each angle's sampled starts, then the
-    // rest of them.
-    let (m, r) = (sampled, starts.len() - sampled);
-    let mut traces = Vec::with_capacity(pairs);
-    let (mut sample, mut rest) = (sample.into_iter(), rest.into_iter());
-    for _ in angles {
-        traces.extend(sample.by_ref().take(m));
-        traces.extend(rest.by_ref().take(r));
-    }
-    Ok((traces, t.elapsed().as_secs_f64()))
+        if let Some(budget_s) = budget_s
+            && predicted_s > budget_s
+        {
+            return Err(HarnessError::VerifyBudget {
+                predicted_s,
+                pairs,
+                budget_s,
+                shards: ((predicted_s / budget_s).ceil() as usize).clamp(2, starts.len().max(2)),
+            });
+        }
+        let rest = trace(rest)?;
+        // Angle-major over every start: each angle's sampled starts, then
+        // the rest of them.
+        let (m, r) = (sampled, starts.len() - sampled);
+        let mut traces = Vec::with_capacity(pairs);
+        let (mut sample, mut rest) = (sample.into_iter(), rest.into_iter());
+        for _ in angles {
+            traces.extend(sample.by_ref().take(m));
+            traces.extend(rest.by_ref().take(r));
+        }
+        Ok((traces, t.elapsed().as_secs_f64()))
+    })
 }
 
 /// Verifies the grid against the exact oracle at `setup`'s pitch, on the
@@ -243,21 +235,17 @@ pub(crate) fn verify_with(
         ..
     } = &traced;
     // The grid's slides and their comparison: minutes on a large part.
-    progress.begin(
-        &format!("grid against exact: {} start-angle pairs", traces.len()),
-        None,
-    );
-    let comparison = compare_grid_with(
-        &input.part.triangles,
-        grid,
-        footprints,
-        starts,
-        traces,
-        compare,
-        fault,
-    );
-    progress.end();
-    let comparison = comparison?;
+    let comparison = super::in_stage(progress, &super::comparing(traces.len()), None, || {
+        compare_grid_with(
+            &input.part.triangles,
+            grid,
+            footprints,
+            starts,
+            traces,
+            compare,
+            fault,
+        )
+    })?;
     let summary = VerifySummary::new(
         input,
         setup,
