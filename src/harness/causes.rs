@@ -27,8 +27,13 @@
 //!   mm from the touched point met 1.3 mm of travel later, the one 0.11 mm
 //!   away 3 mm later). It fails the verdict.
 //! * **Sampling.** An unexplained residual within `sqrt 2` pitches: the
-//!   grid's first-order error at this pitch. It fails the verdict (the
-//!   pitch is too coarse for the tolerance).
+//!   grid's first-order error at this pitch; or a start's miss inside the
+//!   footprint beyond that which, slid again with the grid sampled at half
+//!   the pitch against the same exact trace, falls to at most half
+//!   (shown by refinement: on trimesh's teapot and the console, exact
+//!   strikes along a crease of the mesh between two node rows, which the
+//!   grid's strikes meet later); or a brief strike. It fails the verdict
+//!   (the pitch is too coarse for the tolerance).
 //! * **Unexplained.** None of the above: a real disagreement.
 
 use serde::{Deserialize, Serialize};
@@ -248,8 +253,11 @@ pub enum Mechanism {
     Rim,
     /// A residual no mechanism above explains, within `sqrt 2` pitches:
     /// the size of error the grid makes at this pitch, which a finer pitch
-    /// shrinks where the figure converges (`results/`). It fails the
-    /// verdict: the pitch is too coarse for the tolerance.
+    /// shrinks where the figure converges (`results/`); beyond it, a
+    /// start's miss that halves at half the pitch against the same exact
+    /// trace ([`super::metrics::StartComparison::halves`]) or a brief
+    /// strike. It fails the verdict: the pitch is too coarse for the
+    /// tolerance.
     Sampling,
     /// A real disagreement.
     Unexplained,

@@ -340,6 +340,12 @@ pub struct StartComparison {
     /// the knee-form): shorter than the travel the grid needs to meet a
     /// node there, a sampling error in travel.
     pub miss_brief: Vec<bool>,
+    /// Where the largest decided miss inside the footprint (neither in
+    /// the rim nor brief, [`StartComparison::inside_miss`]) exceeds `sqrt
+    /// 2` pitches: the same figure with the grid sampled at half the pitch,
+    /// against the same exact trace (mm; `+inf` where the finer grid
+    /// strikes nothing in the start). See [`StartComparison::halves`].
+    pub miss_half_pitch: Option<f64>,
     /// The same for each exact strike downstream of one, decided or not
     /// (blind is a category beside decided and undecided).
     pub miss_blind: Vec<f64>,
@@ -411,6 +417,9 @@ pub struct StartPoints {
     /// The decided exact strikes away from blind spots that lie inside the
     /// grid's footprint at their travel (not in the knee-form's rim).
     pub decided_inside: Vec<[f64; 2]>,
+    /// Those of them in a start whose inside miss halves at half the pitch
+    /// ([`StartComparison::halves`]): moved here from `decided_inside`.
+    pub decided_refined: Vec<[f64; 2]>,
     /// The exact contacts that are not decided non-strikes.
     pub possible: Vec<[f64; 2]>,
     /// The exact push contact, when placed: a point of the exact curve for
@@ -427,7 +436,7 @@ impl StartPoints {
     }
 
     /// Every set, in a fixed order (what a shard's file holds).
-    pub fn sets(&self) -> [&Vec<[f64; 2]>; 10] {
+    pub fn sets(&self) -> [&Vec<[f64; 2]>; 11] {
         [
             &self.grid,
             &self.grid_decided,
@@ -437,13 +446,14 @@ impl StartPoints {
             &self.decided,
             &self.blind,
             &self.decided_inside,
+            &self.decided_refined,
             &self.possible,
             &self.push,
         ]
     }
 
     /// Every set, mutable, in the order of [`StartPoints::sets`].
-    pub fn sets_mut(&mut self) -> [&mut Vec<[f64; 2]>; 10] {
+    pub fn sets_mut(&mut self) -> [&mut Vec<[f64; 2]>; 11] {
         [
             &mut self.grid,
             &mut self.grid_decided,
@@ -453,6 +463,7 @@ impl StartPoints {
             &mut self.decided,
             &mut self.blind,
             &mut self.decided_inside,
+            &mut self.decided_refined,
             &mut self.possible,
             &mut self.push,
         ]
@@ -466,6 +477,32 @@ impl StartPoints {
 }
 
 impl StartComparison {
+    /// The largest decided miss inside the grid's footprint: over the
+    /// decided exact strikes away from blind spots that are neither in the
+    /// rim nor brief (mm; `+inf` where the grid strikes nothing in the
+    /// start); `None` where there is none.
+    pub fn inside_miss(&self) -> Option<f64> {
+        self.miss_decided
+            .iter()
+            .zip(self.miss_rim.iter().zip(&self.miss_brief))
+            .filter(|(_, (rim, brief))| !**rim && !**brief)
+            .map(|(d, _)| *d)
+            .reduce(f64::max)
+    }
+
+    /// Whether this start's inside miss is the grid's sampling error,
+    /// shown by refinement: with the grid sampled at half the pitch it
+    /// falls to at most half its value (first order or better), against
+    /// the same exact trace. A crease of the mesh between two node rows,
+    /// struck along by the exact knee-form, is such a miss: the grid's
+    /// strike along it starts later, by less at a finer pitch.
+    pub fn halves(&self) -> bool {
+        match (self.inside_miss(), self.miss_half_pitch) {
+            (Some(d), Some(h)) => d.is_finite() && h <= 0.5 * d + LEVEL_TOL,
+            _ => false,
+        }
+    }
+
     /// Where the worst decided disagreement of this start lies (xz, mm)
     /// and how large it is: the decided exact strike furthest from the
     /// grid's strikes or the grid strike furthest from every possible exact
@@ -799,6 +836,7 @@ pub fn compare(
             .filter(|(_, (rim, brief))| !**rim && !**brief)
             .map(|((_, c), _)| xz(c.contact.witness))
             .collect(),
+        decided_refined: Vec::new(),
         possible: points(&|c| c.decision != Decision::NoStrike),
         push,
     };
@@ -894,6 +932,7 @@ pub fn compare(
         miss_decided: miss_of(&pts.decided),
         miss_rim,
         miss_brief,
+        miss_half_pitch: None,
         miss_blind: miss_of(&pts.blind),
         false_alarm: false_alarm_of(grid_points, &strikes_or_push),
         false_alarm_decided: false_alarm_of(&pts.grid_decided, &possible_or_push),

@@ -69,6 +69,7 @@ pub(super) fn put_pair(out: &mut Vec<u8>, pair: &PairResult) {
         c.first_contact_error_decided,
         c.first_contact_error_blind,
         c.first_contact_late_inside,
+        c.miss_half_pitch,
     ] {
         put_opt(out, v);
     }
@@ -291,6 +292,7 @@ impl<'a> Reader<'a> {
             (self.opt()?, self.opt()?, self.opt()?);
         let first_contact_error_blind = self.opt()?;
         let first_contact_late_inside = self.opt()?;
+        let miss_half_pitch = self.opt()?;
         let flags = self.u8()?;
         if flags >> 4 != 0 {
             return Err(format!("pair flags {flags}"));
@@ -327,6 +329,7 @@ impl<'a> Reader<'a> {
             false_alarm_explained: self.bools()?,
             miss_rim: self.bools()?,
             miss_brief: self.bools()?,
+            miss_half_pitch,
             oracle_failure,
             exact_strikes: self.len()?,
             undecided: self.len()?,
@@ -364,6 +367,7 @@ mod tests {
             miss_decided: vec![f64::INFINITY],
             miss_rim: vec![true],
             miss_brief: vec![false],
+            miss_half_pitch: Some(0.25),
             miss_blind: vec![0.5],
             false_alarm: vec![0.1 + 0.2, 7.0],
             false_alarm_decided: vec![0.3],
@@ -389,6 +393,7 @@ mod tests {
                 decided: vec![[5.0, 6.0]],
                 blind: vec![[3.0, 4.0]],
                 decided_inside: Vec::new(),
+                decided_refined: vec![[0.5, 1.5]],
                 possible: Vec::new(),
                 push: vec![[-7.5, 8.25]],
             },

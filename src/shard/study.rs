@@ -47,8 +47,8 @@ use crate::output::{OutputDir, WriteError};
 /// `shard.json` of a study's shard.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StudyRecord {
-    /// The format of the shard's files (2: pairs carry the blind and
-    /// level-error facts).
+    /// The format of the shard's files ([`FORMAT`]; 4: pairs carry their
+    /// miss at half the pitch and the points it sets apart).
     pub format: u32,
     /// Which shard of how many.
     pub shard: Shard,
@@ -75,9 +75,9 @@ pub struct StudyRecord {
 }
 
 /// The format [`write_study_shard`] writes and [`merge_study`] reads.
-pub const FORMAT: u32 = 3;
+pub const FORMAT: u32 = 4;
 
-const MAGIC: &[u8; 16] = b"kneeform study 3";
+const MAGIC: &[u8; 16] = b"kneeform study 4";
 
 /// The largest `shard.bin` read (bytes): far beyond a study's (a few
 /// hundred bytes per start and angle), short of exhausting memory.
