@@ -15,373 +15,15 @@ use std::time::Instant;
 use crate::assembly::{PartSource, colliding_nodes_per_file};
 use crate::blind::{BlindSpot, blind_spots};
 use crate::direct::{DirectFootprint, direct_masks};
-use crate::engine::{Algorithm, AngleMask, EngineOptions, Probe, colliding_masks, composite};
-use crate::grid::{GridError, GridSpec, HeightGrid};
-use crate::kneeform::{Footprint, GridFootprint, KneeForm};
-use crate::limits::{self, short};
+use crate::engine::{AngleMask, EngineOptions, Probe, colliding_masks, composite};
+use crate::frame::Approach;
+use crate::grid::{GridError, HeightGrid};
+use crate::input::{MeshError, PartFile};
+use crate::kneeform::{GridFootprint, KneeForm};
 use crate::memory::MemoryEstimate;
-use crate::mesh::{Bbox, MeshError, Part, PartFile};
 use crate::sanity::{self, Warning};
-use crate::strike::StrikeRule;
+use crate::setup::{GIB, Limit, Setup, SetupError, check_estimate};
 use crate::summary::{AngleSummary, FileSummary, Summary, Timings};
-
-/// Where the grid lies.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum GridPlacement {
-    /// SPEC's default extent: every node whose footprint, at any angle or
-    /// its mirror, can reach the part's xz bounding box.
-    AroundPart,
-    /// An explicit origin (mm, snapped to multiples of the pitch) and
-    /// size (nodes).
-    Explicit {
-        /// Origin x, z (mm).
-        origin: [f64; 2],
-        /// Nodes along x, z.
-        size: [usize; 2],
-    },
-}
-
-/// Which knee motion an analysis follows. See README's "Two approaches".
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "snake_case")]
-pub enum Approach {
-    /// SPEC's push-and-slide (the paper's method): the knee-form pushed in
-    /// +y against a surface facing -y, then slid in -x; strikes by the
-    /// deflection threshold.
-    #[default]
-    Slide,
-    /// The direct approach (its predecessor, [`crate::direct`]): the
-    /// knee-form moved in -x until it first touches the part; the
-    /// first-contact points are the area. The deflection threshold and
-    /// rate rule are recorded but not used.
-    Direct,
-}
-
-impl Approach {
-    /// The name as the flag and `summary.json` write it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Approach::Slide => "slide",
-            Approach::Direct => "direct",
-        }
-    }
-}
-
-/// What an analysis computes: the knee-form, the grid, the angles and the
-/// strike rule. Lengths in mm, angles in degrees. [`Setup::validate`]
-/// checks it; [`Analysis::run`] does so before any work.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Setup {
-    /// Grid pitch (mm).
-    pub pitch: f64,
-    /// The knee-form.
-    pub knee: KneeForm,
-    /// Knee-form angles (degrees, positive raises its back), distinct.
-    pub angles: Vec<f64>,
-    /// SPEC's strike rule.
-    pub rule: StrikeRule,
-    /// Where the grid lies.
-    pub grid: GridPlacement,
-    /// Which implementation of push and slide runs (both give the same
-    /// masks).
-    pub algorithm: Algorithm,
-    /// The largest estimated working memory allowed (bytes).
-    pub max_memory_bytes: f64,
-    /// How far the part must stick out between nodes (mm) for a grid cell
-    /// to be a blind spot ([`crate::blind`]).
-    pub blind_depth: f64,
-    /// Push-and-slide (the default) or the direct approach.
-    pub approach: Approach,
-}
-
-impl Default for Setup {
-    /// The paper's setup: 1.24 mm pitch, the default knee-form, every
-    /// whole degree from -30 to 30, SPEC's default strike rule, the default
-    /// extent, the fast engine, 16 GiB.
-    fn default() -> Self {
-        Setup {
-            pitch: 1.24,
-            knee: KneeForm::default(),
-            angles: (-30..=30).map(f64::from).collect(),
-            rule: StrikeRule::default(),
-            grid: GridPlacement::AroundPart,
-            algorithm: Algorithm::Fast,
-            max_memory_bytes: 16.0 * f64::from(1u32 << 30),
-            blind_depth: Setup::DEFAULT_BLIND_DEPTH,
-            approach: Approach::Slide,
-        }
-    }
-}
-
-/// A setup that cannot be run. Each names the field at fault
-/// ([`SetupError::field`]), so that a front end can name its own flag.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SetupError {
-    /// A length or limit that must be a finite positive number is not.
-    #[error("the {field} must be a finite number > 0, got {}", short(*value))]
-    NotPositive {
-        /// The field (`max_memory`).
-        field: &'static str,
-        /// The value given.
-        value: f64,
-    },
-    /// A number is outside the bounds of [`crate::limits`].
-    #[error("the {field} must be a number from {} to {}, got {}", short(*min), short(*max), short(*value))]
-    OutOfRange {
-        /// The field (`pitch`, `triangle_side`, `radius`, `thickness`,
-        /// `blind_depth`, `scale`, `window`).
-        field: &'static str,
-        /// The value given.
-        value: f64,
-        /// The smallest allowed.
-        min: f64,
-        /// The largest allowed.
-        max: f64,
-    },
-    /// More angles than [`crate::limits::MAX_ANGLES`].
-    #[error("{0} angles given, at most {max} are analysed in one run", max = crate::limits::MAX_ANGLES)]
-    TooManyAngles(usize),
-    /// The angle list is empty.
-    #[error("no angle given")]
-    NoAngles,
-    /// An angle is not finite or beyond +-90 degrees.
-    #[error("angle {} is outside -90..90 degrees", short(*.0))]
-    AngleOutOfRange(f64),
-    /// An angle is given twice.
-    #[error("angle {} is given twice", short(*.0))]
-    RepeatedAngle(f64),
-    /// The deflection threshold is outside [0, 45) degrees.
-    #[error("the deflection threshold must be a number of degrees in [0, 45), got {}", short(*.0))]
-    Deflection(f64),
-    /// The rounding tolerance is outside [0, 0.01] mm.
-    #[error("e0 must be a number of mm in [0, 0.01] (it only absorbs rounding), got {}", short(*.0))]
-    E0(f64),
-    /// The explicit grid's origin is not finite, or beyond
-    /// [`crate::limits::MAX_COORD_MM`].
-    #[error("the grid origin must be two numbers of mm within +-{}, got {},{}", short(crate::limits::MAX_COORD_MM), short(.0[0]), short(.0[1]))]
-    GridOrigin([f64; 2]),
-    /// The explicit grid has no node, or more than
-    /// [`crate::limits::MAX_GRID_NODES`].
-    #[error("the grid size must be from 1,1 to {} nodes in all, got {},{}", crate::limits::MAX_GRID_NODES, .0[0], .0[1])]
-    GridSize([usize; 2]),
-}
-
-impl SetupError {
-    /// The [`Setup`] field at fault, snake_case (`pitch`, `angles`,
-    /// `deflection`, `e0`, `grid_origin`, ...).
-    pub fn field(&self) -> &'static str {
-        match self {
-            SetupError::NotPositive { field, .. } | SetupError::OutOfRange { field, .. } => field,
-            SetupError::NoAngles
-            | SetupError::TooManyAngles(_)
-            | SetupError::AngleOutOfRange(_)
-            | SetupError::RepeatedAngle(_) => "angles",
-            SetupError::Deflection(_) => "deflection",
-            SetupError::E0(_) => "e0",
-            SetupError::GridOrigin(_) => "grid_origin",
-            SetupError::GridSize(_) => "grid_size",
-        }
-    }
-}
-
-impl Setup {
-    /// The default depth of a blind spot (mm): well above the sag of a
-    /// smooth part between nodes (0.06 mm for the 8 mm waves at a 4 mm
-    /// pitch), half the 1 mm tolerance the evidence is held to.
-    pub const DEFAULT_BLIND_DEPTH: f64 = 0.5;
-
-    /// Checks every field, before any work.
-    pub fn validate(&self) -> Result<(), SetupError> {
-        let within = |field: &'static str, value: f64, min: f64, max: f64| {
-            if value.is_finite() && (min..=max).contains(&value) {
-                Ok(())
-            } else {
-                Err(SetupError::OutOfRange {
-                    field,
-                    value,
-                    min,
-                    max,
-                })
-            }
-        };
-        within(
-            "pitch",
-            self.pitch,
-            limits::MIN_PITCH_MM,
-            limits::MAX_PITCH_MM,
-        )?;
-        let length =
-            |field, value| within(field, value, limits::MIN_PITCH_MM, limits::MAX_LENGTH_MM);
-        length("triangle_side", self.knee.triangle_side)?;
-        length("radius", self.knee.radius)?;
-        length("thickness", self.knee.thickness)?;
-        length("blind_depth", self.blind_depth)?;
-        if !(self.max_memory_bytes.is_finite() && self.max_memory_bytes > 0.0) {
-            return Err(SetupError::NotPositive {
-                field: "max_memory",
-                value: self.max_memory_bytes,
-            });
-        }
-        if self.angles.is_empty() {
-            return Err(SetupError::NoAngles);
-        }
-        if self.angles.len() > limits::MAX_ANGLES {
-            return Err(SetupError::TooManyAngles(self.angles.len()));
-        }
-        if let Some(&a) = self
-            .angles
-            .iter()
-            .find(|a| !(a.is_finite() && a.abs() <= 90.0))
-        {
-            return Err(SetupError::AngleOutOfRange(a));
-        }
-        let mut sorted = self.angles.clone();
-        sorted.sort_by(f64::total_cmp);
-        if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
-            return Err(SetupError::RepeatedAngle(w[0]));
-        }
-        let deflection = self.rule.deflection_deg();
-        if !(deflection.is_finite() && (0.0..45.0).contains(&deflection)) {
-            return Err(SetupError::Deflection(deflection));
-        }
-        if !(self.rule.e0.is_finite() && (0.0..=0.01).contains(&self.rule.e0)) {
-            return Err(SetupError::E0(self.rule.e0));
-        }
-        if self.rule.window_mm().is_some() {
-            let longest = limits::MAX_WINDOW_MM.min(limits::MAX_WINDOW_PITCHES * self.pitch);
-            within("window", self.rule.window, limits::MIN_PITCH_MM, longest)?;
-        }
-        if let GridPlacement::Explicit { origin, size } = self.grid {
-            if !origin
-                .iter()
-                .all(|c| c.is_finite() && c.abs() <= limits::MAX_COORD_MM)
-            {
-                return Err(SetupError::GridOrigin(origin));
-            }
-            let nodes = size[0].checked_mul(size[1]);
-            if !nodes.is_some_and(|n| (1..=limits::MAX_GRID_NODES).contains(&n)) {
-                return Err(SetupError::GridSize(size));
-            }
-        }
-        Ok(())
-    }
-
-    /// The grid for `part` (analysis frame; the direct frame for
-    /// [`Approach::Direct`]), at this setup's pitch: SPEC's
-    /// default extent covers every requested angle and its mirror, so that
-    /// a part mirrored in z gets the mirrored grid. Checked to have a
-    /// bounded number of nodes and the analysis on it to fit the memory
-    /// allowed ([`Setup::check_memory`]).
-    pub fn grid_spec(&self, part: &Part) -> Result<GridSpec, GridError> {
-        let spec = self.grid_placed(&part.bbox())?;
-        self.check_memory(&spec, part.triangles.len())?;
-        Ok(spec)
-    }
-
-    /// The grid alone, its node count checked, not its memory. For the
-    /// direct approach `bbox` is the part's in the direct frame.
-    fn grid_placed(&self, bbox: &Bbox) -> Result<GridSpec, GridError> {
-        let spec = match self.grid {
-            GridPlacement::AroundPart if self.approach == Approach::Direct => {
-                crate::direct::grid_around(bbox, &self.knee, &self.angles, self.pitch)
-            }
-            GridPlacement::AroundPart => {
-                let extents: Vec<Footprint> = self
-                    .angles
-                    .iter()
-                    .flat_map(|&a| {
-                        [
-                            Footprint::new(&self.knee, a),
-                            Footprint::new(&self.knee, -a),
-                        ]
-                    })
-                    .collect();
-                GridSpec::around(bbox, &extents, self.pitch)
-            }
-            GridPlacement::Explicit { origin, size } => {
-                GridSpec::explicit(origin[0], origin[1], size[0], size[1], self.pitch)
-            }
-        };
-        spec.check_nodes()?;
-        Ok(spec)
-    }
-
-    /// The working memory of analysing a part of `triangles` triangles on
-    /// `spec` with this setup, on the current thread pool.
-    pub fn memory_estimate(&self, spec: &GridSpec, triangles: usize) -> MemoryEstimate {
-        MemoryEstimate::analysis(
-            spec,
-            &self.footprints(spec),
-            &self.rule,
-            triangles,
-            rayon::current_num_threads(),
-        )
-    }
-
-    /// The estimate of [`Setup::memory_estimate`], checked against the
-    /// memory allowed and the machine's physical memory before anything is
-    /// allocated.
-    pub fn check_memory(
-        &self,
-        spec: &GridSpec,
-        triangles: usize,
-    ) -> Result<MemoryEstimate, GridError> {
-        spec.check_nodes()?;
-        let estimate = self.memory_estimate(spec, triangles);
-        check_estimate(&estimate, self.max_memory_bytes).map_err(|limit| {
-            let (nx, nz, angles) = (spec.nx, spec.nz, self.angles.len());
-            let need_gib = estimate.bytes() / GIB;
-            match limit {
-                Limit::Allowed(limit) => GridError::TooLarge {
-                    nx,
-                    nz,
-                    angles,
-                    need_gib,
-                    limit_gib: limit / GIB,
-                },
-                Limit::Machine(machine, what) => GridError::BeyondMachine {
-                    nx,
-                    nz,
-                    angles,
-                    need_gib,
-                    machine_gib: machine / GIB,
-                    what,
-                },
-            }
-        })?;
-        Ok(estimate)
-    }
-
-    /// The knee-form's footprint at every angle, laid on `spec`.
-    pub fn footprints(&self, spec: &GridSpec) -> Vec<GridFootprint> {
-        self.angles
-            .iter()
-            .map(|&a| GridFootprint::new(&self.knee, a, spec))
-            .collect()
-    }
-}
-
-const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
-
-/// Which limit an estimate broke (bytes).
-enum Limit {
-    Allowed(f64),
-    /// The system's limit, and which one ([`crate::memory::limit_bytes`]).
-    Machine(f64, &'static str),
-}
-
-/// Whether `estimate` fits `allowed` bytes and the machine's memory.
-fn check_estimate(estimate: &MemoryEstimate, allowed: f64) -> Result<(), Limit> {
-    let need = estimate.bytes();
-    if need > allowed {
-        return Err(Limit::Allowed(allowed));
-    }
-    match crate::memory::limit_bytes() {
-        Some((machine, what)) if need > machine => Err(Limit::Machine(machine, what)),
-        _ => Ok(()),
-    }
-}
 
 /// Estimates above this (bytes) are said before the run: 256 MiB.
 const NOTE_MEMORY_BYTES: f64 = 256.0 * 1024.0 * 1024.0;
@@ -480,7 +122,7 @@ pub struct Analysis {
     pub warnings: Vec<Warning>,
     /// The pitch study that chose `setup.pitch`, when one did (set by the
     /// caller: [`crate::harness::choose_pitch`]).
-    pub pitch_choice: Option<crate::harness::PitchChoice>,
+    pub pitch_choice: Option<crate::summary::PitchChoice>,
     /// The working memory estimated before the run.
     pub memory: MemoryEstimate,
     /// Seconds per stage (`write_s` and `total_s` are the writer's).
@@ -492,7 +134,7 @@ impl Analysis {
     pub fn of_file(
         path: &std::path::Path,
         scale: f64,
-        side: crate::mesh::Side,
+        side: crate::frame::Side,
         setup: &Setup,
         progress: &dyn Progress,
     ) -> Result<Analysis, AnalysisError> {
@@ -522,7 +164,7 @@ impl Analysis {
         progress: &dyn Progress,
     ) -> Result<Analysis, AnalysisError> {
         setup.validate()?;
-        crate::mesh::check_scale(source.scale)?;
+        crate::input::check_scale(source.scale)?;
         let angle_warnings = sanity::angle_warnings(&setup.angles);
         for w in &angle_warnings {
             progress.warn(w);
@@ -530,7 +172,7 @@ impl Analysis {
         // Every file is sized up before any is read.
         let (mut file_bytes, mut triangles, mut known) = (0u64, 0u64, true);
         for path in source.files.iter().chain(&source.ignored) {
-            let size = crate::mesh::part_size(path)?;
+            let size = crate::input::part_size(path)?;
             file_bytes = file_bytes.saturating_add(size.file_bytes);
             triangles = triangles.saturating_add(size.triangles);
             known &= size.known;
@@ -564,7 +206,7 @@ impl Analysis {
         let read_bytes = if known {
             file_bytes
         } else {
-            crate::mesh::binary_stl_len(n)
+            crate::input::binary_stl_len(n)
         };
         let read = MemoryEstimate::reading(read_bytes, n);
         let mut analysis = Analysis::run_checked(input, setup, only, progress, angle_warnings)?;
@@ -615,7 +257,7 @@ impl Analysis {
         // frame, where SPEC's z-buffer from -y is its depth grid along x.
         if setup.approach == Approach::Direct {
             for v in input.part.triangles.iter_mut().flatten() {
-                *v = crate::direct::to_direct(*v);
+                *v = crate::frame::to_direct(*v);
             }
         }
         let t = Instant::now();
@@ -661,52 +303,50 @@ impl Analysis {
                 y: b.y,
             })
             .collect();
-        let computed = only.map_or(setup.angles.len(), <[usize]>::len);
+        // A shard computes its own angles (`only`); the others are empty.
+        let all: Vec<usize> = (0..setup.angles.len()).collect();
+        let chosen = only.unwrap_or(&all);
         let step = || progress.step();
-        let masks = match setup.approach {
+        let found = match setup.approach {
             Approach::Slide => {
-                progress.begin("push and slide", Some(computed as u64));
+                progress.begin("push and slide", Some(chosen.len() as u64));
                 let options = EngineOptions {
                     rule: setup.rule,
                     algorithm: setup.algorithm,
                     start_rows: None,
                     probes,
                 };
-                match only {
-                    None => colliding_masks(&grid, &footprints, &options, &step),
-                    Some(only) => crate::shard::masks_at(&grid, &footprints, &options, only, &step),
-                }
+                let footprints: Vec<GridFootprint> =
+                    chosen.iter().map(|&a| footprints[a].clone()).collect();
+                colliding_masks(&grid, &footprints, &options, &step)
             }
             Approach::Direct => {
-                progress.begin("direct approach", Some(computed as u64));
-                let all: Vec<usize> = (0..setup.angles.len()).collect();
-                let chosen = only.unwrap_or(&all);
+                progress.begin("direct approach", Some(chosen.len() as u64));
                 let fronts: Vec<DirectFootprint> = chosen
                     .iter()
                     .map(|&a| DirectFootprint::new(&setup.knee, setup.angles[a], spec.pitch))
                     .collect();
-                let found = direct_masks(&grid, &fronts, setup.rule.e0, &probes, &step);
-                if only.is_none() {
-                    found
-                } else {
-                    // A shard's other angles: nothing computed, nothing struck.
-                    let mut masks: Vec<AngleMask> = setup
-                        .angles
-                        .iter()
-                        .map(|&angle_deg| AngleMask {
-                            angle_deg,
-                            mask: vec![0; spec.len()],
-                            placed: 0,
-                            colliding: 0,
-                            probes_met: vec![false; probes.len()],
-                        })
-                        .collect();
-                    for (&a, m) in chosen.iter().zip(found) {
-                        masks[a] = m;
-                    }
-                    masks
-                }
+                direct_masks(&grid, &fronts, setup.rule.e0, &probes, &step)
             }
+        };
+        let masks = if only.is_none() {
+            found
+        } else {
+            let mut masks: Vec<AngleMask> = setup
+                .angles
+                .iter()
+                .map(|&angle_deg| AngleMask {
+                    angle_deg,
+                    mask: vec![0; spec.len()],
+                    placed: 0,
+                    colliding: 0,
+                    probes_met: vec![false; blind_count],
+                })
+                .collect();
+            for (&a, m) in chosen.iter().zip(found) {
+                masks[a] = m;
+            }
+            masks
         };
         progress.end();
         let push_slide_s = t.elapsed().as_secs_f64();

@@ -17,35 +17,9 @@
 use std::path::{Path, PathBuf};
 
 use crate::frame::Placement;
-use crate::mesh::{MeshError, Part, PartFile, read_part_placed};
 
-/// One file of an assembly.
-#[derive(Debug, Clone, PartialEq)]
-pub struct AssemblyFile {
-    /// The file as given.
-    pub path: PathBuf,
-    /// SHA-256 of its bytes (lowercase hex).
-    pub sha256: String,
-    /// Triangles in the file.
-    pub triangles: usize,
-    /// Of those, skipped for zero area.
-    pub degenerate: usize,
-    /// Bodies read from it ([`crate::mesh::Part::bodies`]).
-    pub bodies: usize,
-    /// Disregarded by the regulation (`--ignore`): not in the height grid.
-    pub ignored: bool,
-}
-
-/// The files of a part read from several, and where each triangle came
-/// from.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Assembly {
-    /// Every file, in the order given: the analysed files, then the
-    /// `--ignore` files not among them.
-    pub files: Vec<AssemblyFile>,
-    /// Per triangle of the merged part, the index of its file in `files`.
-    pub file_of: Vec<u32>,
-}
+use crate::input::{Assembly, AssemblyError, AssemblyFile, MeshError, PartFile, read_part_placed};
+use crate::mesh::Part;
 
 /// What to read: the files of a part, the ones to disregard, and how
 /// their coordinates map into the analysis frame.
@@ -60,23 +34,6 @@ pub struct PartSource {
     pub scale: f64,
     /// The frame and side of every file.
     pub placement: Placement,
-}
-
-/// Why the files of an assembly cannot be read as one part.
-#[derive(Debug, thiserror::Error)]
-pub enum AssemblyError {
-    /// No file to analyse.
-    #[error("no part file to analyse (every file given is --ignore'd)")]
-    NothingToAnalyse,
-    /// A file is given twice.
-    #[error("{} is given twice", path.display())]
-    Repeated {
-        /// The file.
-        path: PathBuf,
-    },
-    /// An assembly holds more files than a node's attribution can name.
-    #[error("{0} files: at most {max} can be analysed as one part", max = u32::MAX)]
-    TooMany(usize),
 }
 
 impl PartSource {

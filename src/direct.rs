@@ -9,13 +9,13 @@
 //! In SPEC's analysis frame (the part placed by `--frame` and `--side`)
 //! the knee moves in -x and the analysed surface faces +x. The part is
 //! turned into the **direct frame** by the proper rotation
-//! `D: (x, y, z) -> (x', y', z') = (y, -x, z)` ([`to_direct`]), where the
+//! `D: (x, y, z) -> (x', y', z') = (y, -x, z)` ([`crate::frame::to_direct`]), where the
 //! knee moves in +y' and the surface faces -y', so that SPEC's height grid
 //! ([`crate::grid::HeightGrid`], the z-buffer from -y) sampled on the
 //! turned part is the depth grid of the direct approach:
 //! `h(x', z') = min y' = -(max x)` over the line, the first surface the
 //! knee meets. Results go back by `D^-1: (x', y', z') -> (-y', x', z')`
-//! ([`from_direct`], exact: only a sign and a swap), then by
+//! ([`crate::frame::from_direct`], exact: only a sign and a swap), then by
 //! [`crate::frame::Placement::to_part`].
 //!
 //! # The definition
@@ -62,21 +62,10 @@
 use rayon::prelude::*;
 
 use crate::engine::{AngleMask, Probe};
+use crate::grid::NODE_TOL;
 use crate::grid::{GridSpec, HeightGrid};
-use crate::kneeform::{Footprint, KneeForm, NODE_TOL};
+use crate::kneeform::{Footprint, KneeForm};
 use crate::mesh::Bbox;
-
-/// A point of SPEC's analysis frame (mm) in the direct frame: `D(x, y, z)
-/// = (y, -x, z)`, a proper rotation.
-pub fn to_direct([x, y, z]: [f64; 3]) -> [f64; 3] {
-    [y, -x, z]
-}
-
-/// A point of the direct frame (mm) in SPEC's analysis frame: `D^-1(x',
-/// y', z') = (-y', x', z')`, the exact inverse of [`to_direct`].
-pub fn from_direct([x, y, z]: [f64; 3]) -> [f64; 3] {
-    [-y, x, z]
-}
 
 /// The knee-form's front at one angle, laid on a grid of pitch `pitch`:
 /// the half width in nodes and, per footprint row, its offset `a`.
@@ -126,7 +115,7 @@ impl DirectFootprint {
 /// direct frame is `bbox`: every position whose footprint, at any of
 /// `angles` or its mirror, can reach the box. The box grown by `W/2` in x'
 /// and by the knee-form's z-extent in z, snapped outwards to multiples of
-/// the pitch (as [`GridSpec::around`] does for the slide).
+/// the pitch (as [`crate::kneeform::Footprint::grid_around`] does for the slide).
 pub fn grid_around(bbox: &Bbox, knee: &KneeForm, angles: &[f64], pitch: f64) -> GridSpec {
     let (mut zl, mut zh) = (0.0f64, 0.0f64);
     for &a in angles {
@@ -309,6 +298,7 @@ pub fn direct_masks(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::frame::{from_direct, to_direct};
 
     #[test]
     fn the_rotation_and_its_inverse_are_exact() {

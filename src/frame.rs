@@ -27,8 +27,67 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Matrix3, Point3, Rotation3, Translation3};
 
-use crate::analysis::Approach;
-use crate::mesh::Side;
+/// Which side of the vehicle the analysed surface is on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "snake_case")]
+pub enum Side {
+    /// The analysed surface faces -y (SPEC's canonical frame).
+    Left,
+    /// The analysed surface faces +y: mirrored y -> -y on input and back on
+    /// output.
+    Right,
+}
+
+impl Side {
+    /// Maps a y coordinate between the part's frame and the analysis frame
+    /// (the mapping is its own inverse).
+    pub fn to_part(self, y: f64) -> f64 {
+        match self {
+            Side::Left => y,
+            Side::Right => -y,
+        }
+    }
+}
+
+/// Which knee motion an analysis follows. See README's "Two approaches".
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "snake_case")]
+pub enum Approach {
+    /// SPEC's push-and-slide (the paper's method): the knee-form pushed in
+    /// +y against a surface facing -y, then slid in -x; strikes by the
+    /// deflection threshold.
+    #[default]
+    Slide,
+    /// The direct approach (its predecessor, [`crate::direct`]): the
+    /// knee-form moved in -x until it first touches the part; the
+    /// first-contact points are the area. The deflection threshold and
+    /// rate rule are recorded but not used.
+    Direct,
+}
+
+impl Approach {
+    /// The name as the flag and `summary.json` write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Approach::Slide => "slide",
+            Approach::Direct => "direct",
+        }
+    }
+}
+
+/// A point of SPEC's analysis frame (mm) in the direct frame: `D(x, y, z)
+/// = (y, -x, z)`, a proper rotation.
+pub fn to_direct([x, y, z]: [f64; 3]) -> [f64; 3] {
+    [y, -x, z]
+}
+
+/// A point of the direct frame (mm) in SPEC's analysis frame: `D^-1(x',
+/// y', z') = (-y', x', z')`, the exact inverse of [`to_direct`].
+pub fn from_direct([x, y, z]: [f64; 3]) -> [f64; 3] {
+    [-y, x, z]
+}
 
 /// How far from orthonormal with determinant +1 a frame's 3 x 3 part may
 /// be (entrywise, and the determinant from 1): a matrix written with 16
@@ -308,7 +367,7 @@ pub struct Placement {
     /// Where the part sits in the vehicle.
     pub frame: Frame,
     /// For [`Approach::Direct`], the analysis frame is turned into the
-    /// direct frame last ([`crate::direct::to_direct`]); the slide's is
+    /// direct frame last ([`crate::frame::to_direct`]); the slide's is
     /// SPEC's.
     pub approach: Approach,
 }
@@ -332,7 +391,7 @@ impl Placement {
         let a = [x, self.side.to_part(y), z];
         match self.approach {
             Approach::Slide => a,
-            Approach::Direct => crate::direct::to_direct(a),
+            Approach::Direct => to_direct(a),
         }
     }
 
@@ -342,7 +401,7 @@ impl Placement {
     pub fn to_part(&self, a: [f64; 3]) -> [f64; 3] {
         let [x, y, z] = match self.approach {
             Approach::Slide => a,
-            Approach::Direct => crate::direct::from_direct(a),
+            Approach::Direct => from_direct(a),
         };
         self.frame.to_part([x, self.side.to_part(y), z])
     }

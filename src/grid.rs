@@ -7,9 +7,14 @@
 //! nothing. Stored row-major by z: `h[j * nx + i]`, so the slide (along -x)
 //! reads contiguous memory.
 
-use crate::kneeform::{Footprint, NODE_TOL};
 use crate::mesh::{Bbox, Triangle};
 use crate::zbuffer::{Lattice, Weighting, zbuffer};
+
+/// Distance (mm) within which a node counts as inside the closed footprint
+/// (SPEC, "push"), and within which two slide distances form one tie group
+/// (SPEC, "slide"). It only has to absorb floating-point rounding of
+/// coordinates of order 1e3 mm (about 1e-13 mm), so it is far below any pitch.
+pub const NODE_TOL: f64 = 1e-9;
 
 /// Where the grid's nodes are (mm, analysis frame).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -86,27 +91,10 @@ pub enum GridError {
 }
 
 impl GridSpec {
-    /// The default extent of SPEC: every node whose footprint, at any of
-    /// `footprints`, can reach the part's xz bounding box. That is the box
-    /// grown by the footprints' extent on every side, snapped outwards to
-    /// multiples of the pitch.
-    pub fn around(bbox: &Bbox, footprints: &[Footprint], pitch: f64) -> GridSpec {
-        let (mut fx_lo, mut fx_hi, mut fz_lo, mut fz_hi) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-        for fp in footprints {
-            let (xl, xh) = fp.x_range();
-            let (zl, zh) = fp.z_range();
-            fx_lo = fx_lo.min(xl);
-            fx_hi = fx_hi.max(xh);
-            fz_lo = fz_lo.min(zl);
-            fz_hi = fz_hi.max(zh);
-        }
-        GridSpec::reaching(bbox, (fx_lo, fx_hi), (fz_lo, fz_hi), pitch)
-    }
-
     /// Every node from which a shape spanning `x` and `z` (mm, relative to
     /// the node) can reach `bbox`'s xz extent, snapped outwards to
     /// multiples of the pitch.
-    pub(crate) fn reaching(bbox: &Bbox, x: (f64, f64), z: (f64, f64), pitch: f64) -> GridSpec {
+    pub fn reaching(bbox: &Bbox, x: (f64, f64), z: (f64, f64), pitch: f64) -> GridSpec {
         let i_lo = ((bbox.min[0] - x.1) / pitch).floor() as i64;
         let i_hi = ((bbox.max[0] - x.0) / pitch).ceil() as i64;
         let j_lo = ((bbox.min[2] - z.1) / pitch).floor() as i64;
@@ -274,6 +262,7 @@ fn nodes_within(pitch: f64, origin: i64, n: usize, lo: f64, hi: f64) -> Option<(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kneeform::Footprint;
 
     fn spec(nx: usize, nz: usize, pitch: f64) -> GridSpec {
         GridSpec {
@@ -345,8 +334,8 @@ mod tests {
             max: [30.0, 1.0, 7.0],
         };
         let fp = [Footprint::new(&crate::KneeForm::default(), 0.0)];
-        let coarse = GridSpec::around(&bbox, &fp, 4.0);
-        let fine = GridSpec::around(&bbox, &fp, 2.0);
+        let coarse = Footprint::grid_around(&bbox, &fp, 4.0);
+        let fine = Footprint::grid_around(&bbox, &fp, 2.0);
         // Every coarse node is a fine node.
         assert_eq!(coarse.x(0), fine.x((coarse.x(0) - fine.x(0)) as usize / 2));
         assert!(coarse.x(0) <= -10.0 - fp[0].x_range().1);

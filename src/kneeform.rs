@@ -6,13 +6,8 @@
 //! (front is -x, z up). The reference point is the triangle vertex `v0`, the
 //! centre of the rounded front corner, at the origin of the footprint.
 
-use crate::grid::GridSpec;
-
-/// Distance (mm) within which a node counts as inside the closed footprint
-/// (SPEC, "push"), and within which two slide distances form one tie group
-/// (SPEC, "slide"). It only has to absorb floating-point rounding of
-/// coordinates of order 1e3 mm (about 1e-13 mm), so it is far below any pitch.
-pub const NODE_TOL: f64 = 1e-9;
+use crate::grid::{GridSpec, NODE_TOL};
+use crate::mesh::Bbox;
 
 /// The knee-form's dimensions (mm).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -48,6 +43,23 @@ pub struct Footprint {
 }
 
 impl Footprint {
+    /// The default extent of SPEC: every node whose footprint, at any of
+    /// `footprints`, can reach the part's xz bounding box. That is the box
+    /// grown by the footprints' extent on every side, snapped outwards to
+    /// multiples of the pitch.
+    pub fn grid_around(bbox: &Bbox, footprints: &[Footprint], pitch: f64) -> GridSpec {
+        let (mut fx_lo, mut fx_hi, mut fz_lo, mut fz_hi) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        for fp in footprints {
+            let (xl, xh) = fp.x_range();
+            let (zl, zh) = fp.z_range();
+            fx_lo = fx_lo.min(xl);
+            fx_hi = fx_hi.max(xh);
+            fz_lo = fz_lo.min(zl);
+            fz_hi = fz_hi.max(zh);
+        }
+        GridSpec::reaching(bbox, (fx_lo, fx_hi), (fz_lo, fz_hi), pitch)
+    }
+
     /// The footprint of `knee` at `angle_deg` (positive raises the back).
     pub fn new(knee: &KneeForm, angle_deg: f64) -> Footprint {
         let (sin, cos) = angle_deg.to_radians().sin_cos();

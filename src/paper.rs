@@ -20,7 +20,8 @@
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-use crate::kneeform::{GridFootprint, NODE_TOL};
+use crate::grid::NODE_TOL;
+use crate::kneeform::GridFootprint;
 use crate::padded::{PaddedGrid, fmin};
 use crate::push::push_start_literal;
 use crate::strike::{LevelHistory, Meeting, RateEstimate, StrikeRule};

@@ -14,8 +14,9 @@
 //! **Invariant:** the checks read the inputs and the result; they change
 //! neither.
 
+use crate::frame::Side;
 use crate::kneeform::{Footprint, KneeForm};
-use crate::mesh::{Part, Side};
+use crate::mesh::Part;
 
 /// The regulation's knee-form angles: -30..+30 degrees (SPEC, "The
 /// knee-form").

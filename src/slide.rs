@@ -24,7 +24,8 @@
 //! Heights and levels are taken as their ranks ([`crate::ranked`]), and
 //! the rule as each node's threshold rank: the same comparisons, exactly.
 
-use crate::kneeform::{GridFootprint, NODE_TOL};
+use crate::grid::NODE_TOL;
+use crate::kneeform::GridFootprint;
 use crate::padded::PaddedGrid;
 use crate::push::WindowOf;
 use crate::ranked::{NEVER, OFF, Rank};

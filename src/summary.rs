@@ -148,7 +148,7 @@ pub struct Summary {
     /// are recorded but not used). Absent in runs of earlier versions
     /// (slide).
     #[serde(default)]
-    pub approach: crate::analysis::Approach,
+    pub approach: crate::frame::Approach,
     /// Worker threads.
     pub threads: usize,
     /// Per angle, in the order of `angles_deg`.
@@ -172,7 +172,7 @@ pub struct Summary {
     /// With `--pitch auto`: the pitch study, its tolerance and why it
     /// chose `pitch_mm`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub pitch_study: Option<crate::harness::PitchChoice>,
+    pub pitch_study: Option<PitchChoice>,
     /// The working memory estimated before the run (MiB,
     /// [`crate::memory::MemoryEstimate`]). Absent in runs of earlier
     /// versions.
@@ -333,6 +333,54 @@ impl Summary {
         }
         Ok(())
     }
+}
+
+// The pitch study of `--pitch auto` ([`crate::harness::choose_pitch`]),
+// as `summary.json` records it.
+
+/// One pitch of the study (`summary.json`'s `pitch_study`).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PitchStudyRow {
+    /// The pitch (mm).
+    pub pitch_mm: f64,
+    /// The area distance judged against the exact oracle on the sample
+    /// (mm; `null` where one side strikes nothing): from the decided exact
+    /// strikes not downstream of a flagged blind spot to the grid's, and
+    /// from the grid's strikes the level error does not explain to the
+    /// exact ones (what `verify` fails on).
+    pub exact_area_distance_mm: Option<f64>,
+    /// The false-alarm side over every decided grid strike, the level
+    /// error's included (mm; shown, not judged: the grid's level error
+    /// strikes more, on the safe side, at half order).
+    #[serde(default)]
+    pub level_error_area_mm: Option<f64>,
+    /// Area distance to the previous, coarser pitch's colliding area over
+    /// the whole part (mm; `null` for the first pitch or where one side
+    /// strikes nothing).
+    pub grid_change_mm: Option<f64>,
+    /// Predicted time of the full analysis at this pitch (s).
+    pub predicted_s: f64,
+    /// Estimated working memory (GiB).
+    pub memory_gib: f64,
+    /// Whether this pitch meets the tolerance.
+    pub meets: bool,
+}
+
+/// The study and its choice.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PitchChoice {
+    /// The chosen pitch (mm).
+    pub pitch_mm: f64,
+    /// The tolerance (mm).
+    pub tolerance_mm: f64,
+    /// The study, coarsest first.
+    pub study: Vec<PitchStudyRow>,
+    /// The predicted time of the analysis at the chosen pitch (s).
+    pub predicted_s: f64,
+    /// Seconds the study took.
+    pub study_s: f64,
+    /// Why this pitch, in one sentence.
+    pub reason: String,
 }
 
 #[cfg(test)]

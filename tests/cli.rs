@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use kneeform::mesh::Triangle;
-use kneeform::scenario::{Extent, ScenarioFile, builtin, write_stl};
+use kneeform::output::write_stl;
+use kneeform::scenario::{Extent, ScenarioFile, builtin};
 
 use crate::util::scratch_dir;
 

@@ -376,7 +376,7 @@ fn a_part_in_metres_is_warned_of_and_its_empty_result_too() {
         kneeform::Side::Left,
     )
     .unwrap();
-    kneeform::scenario::write_stl(&dir.join("console_m.stl"), &mm.part.triangles).unwrap();
+    kneeform::output::write_stl(&dir.join("console_m.stl"), &mm.part.triangles).unwrap();
     let out = ok(
         kneeform(&dir, &["analyze", "console_m.stl", "--out", "run"]),
         "a part in metres",
@@ -427,7 +427,7 @@ fn a_surface_facing_plus_y_is_warned_of_unless_side_right() {
         .iter()
         .map(|&[a, b, c]| [a, c, b])
         .collect();
-    kneeform::scenario::write_stl(&dir.join("right.stl"), &rewound).unwrap();
+    kneeform::output::write_stl(&dir.join("right.stl"), &rewound).unwrap();
     let out = ok(kneeform(&dir, &quick("right.stl", "as-left", &[])), "left");
     let w = warnings(&out);
     // Its back face, seen from -y, is a flat plate: nothing struck either.

@@ -7,8 +7,9 @@
 
 use std::path::Path;
 
-use kneeform::mesh::{Triangle, sha256_hex};
-use kneeform::scenario::write_stl;
+use kneeform::input::sha256_hex;
+use kneeform::mesh::Triangle;
+use kneeform::output::write_stl;
 use kneeform::summary::Summary;
 use kneeform::{HeightGrid, Side};
 

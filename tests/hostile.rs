@@ -445,7 +445,7 @@ fn the_memory_estimate_bounds_the_measured_peak() {
     // layer meets a corner of its cell (their sorted lists once peaked at
     // eight times the estimate).
     let rough = scratch.join("rough.stl");
-    kneeform::scenario::write_stl(&rough, &rough_ground()).unwrap();
+    kneeform::output::write_stl(&rough, &rough_ground()).unwrap();
     let rough = rough.to_str().unwrap().to_string();
     let rough_runs: [(&str, String, &[&str]); 1] = [(
         "rough ground, 7 angles, 16 threads",

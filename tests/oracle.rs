@@ -3,7 +3,7 @@
 //! the footprint, so the grid's push level is never below the exact one.
 
 use kneeform::mesh::Triangle;
-use kneeform::{Footprint, GridFootprint, GridSpec, HeightGrid, KneeForm, push_levels};
+use kneeform::{Footprint, GridFootprint, HeightGrid, KneeForm, push_levels};
 use kneeform_oracle::{KneeFormDims, OracleOptions, StartStatus, evaluate};
 
 use crate::util::{Rng, SEEDS, lattice_part};
@@ -65,7 +65,7 @@ fn grid_push_level_is_never_below_the_exact_one() {
         let extent: Vec<Footprint> = angles.iter().map(|&a| Footprint::new(&knee, a)).collect();
         let grid = HeightGrid::sample(
             &part.triangles,
-            GridSpec::around(&part.bbox(), &extent, pitch),
+            Footprint::grid_around(&part.bbox(), &extent, pitch),
         );
         let exact = kneeform_oracle::Part::from_triangles(&tris).unwrap();
         // A seeded sample of starts over the whole grid, placed or not.
@@ -116,7 +116,7 @@ fn grid_push_level_is_never_below_the_exact_one() {
 /// the cast is now decided by distances, and the start is traced.
 #[test]
 fn the_wave_s_unconfirmed_misses_are_decided_by_distance() {
-    let input = kneeform::mesh::read_part(
+    let input = kneeform::input::read_part(
         std::path::Path::new("scenarios/wave.toml"),
         1.0,
         kneeform::Side::Left,

@@ -30,7 +30,7 @@ fn step_run(name: &str, side: &str) -> PathBuf {
         // The same part on the vehicle's right: its surface faces +y.
         let part = kneeform::read_part(&dir.join("step.stl"), 1.0, kneeform::Side::Right)
             .expect("the scenario reads");
-        kneeform::scenario::write_stl(&dir.join("part.stl"), &part.part.triangles).unwrap();
+        kneeform::output::write_stl(&dir.join("part.stl"), &part.part.triangles).unwrap();
     } else {
         std::fs::rename(dir.join("step.stl"), dir.join("part.stl")).unwrap();
     }

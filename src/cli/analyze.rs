@@ -8,7 +8,8 @@ use anyhow::{Context, bail, ensure};
 use kneeform::Analysis;
 use kneeform::harness::{self, AutoPitch};
 use kneeform::output;
-use kneeform::shard::{Shard, ShardError};
+use kneeform::partition::Shard;
+use kneeform::shard::ShardError;
 
 use super::args::{AnalyzeArgs, PitchArg};
 use super::progress::Bars;

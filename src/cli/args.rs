@@ -565,7 +565,7 @@ impl PartArgs {
     /// Validates the flags into where the part's files are read from:
     /// `files`, less `ignored`, scaled, framed and sided.
     pub fn validate(&self, files: &[PathBuf], ignored: &[PathBuf]) -> anyhow::Result<PartSource> {
-        kneeform::mesh::check_scale(self.scale).context("--scale")?;
+        kneeform::input::check_scale(self.scale).context("--scale")?;
         let frame = match &self.frame {
             None => Frame::none(),
             Some(value) => Frame::parse(value).context("--frame")?,

@@ -170,7 +170,7 @@ fn fingerprint(base: &Path, parts: &[PathBuf], argv: &[String]) -> anyhow::Resul
     let read = |path: &Path| -> anyhow::Result<String> {
         let bytes = kneeform::limits::read_bounded(path, kneeform::limits::MAX_PART_FILE_BYTES)
             .with_context(|| format!("cannot read {}", path.display()))?;
-        Ok(kneeform::mesh::sha256_hex(&bytes))
+        Ok(kneeform::input::sha256_hex(&bytes))
     };
     for p in parts {
         let path = base.join(p);

@@ -19,8 +19,8 @@ use std::process::ExitCode;
 
 use kneeform::harness::{HarnessError, StudyPart};
 use kneeform::output::OutputDir;
+use kneeform::partition::Shard;
 use kneeform::report::ReportOptions;
-use kneeform::shard::Shard;
 use kneeform::{PartFile, Setup};
 
 use args::StudyArgs;

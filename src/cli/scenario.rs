@@ -37,9 +37,9 @@ pub fn run(args: &ScenarioArgs) -> anyhow::Result<()> {
     let triangles = file.triangulate(args.triangles);
     // What `analyze` would refuse is not written: no triangles (an extent
     // too small for one), non-finite or out-of-range heights.
-    kneeform::mesh::check_triangles(&args.part, &triangles, 1.0)
+    kneeform::input::check_triangles(&args.part, &triangles, 1.0)
         .context("the scenario makes no usable part")?;
-    scenario::write_stl(&args.out, &triangles)
+    kneeform::output::write_stl(&args.out, &triangles)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
     eprintln!(
         "kneeform: wrote {} triangles (step {step:.4} mm) to {}",

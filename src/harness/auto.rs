@@ -30,16 +30,16 @@
 
 use std::time::Instant;
 
-use serde::{Deserialize, Serialize};
-
 use super::compare::StartSelection;
 use super::converge::Ladder;
 use super::nearest::PointSet;
 use super::{HarnessError, TieBand};
-use crate::analysis::{Progress, Setup};
+use crate::analysis::Progress;
 use crate::engine::AngleMask;
 use crate::grid::{GridSpec, HeightGrid};
-use crate::mesh::PartFile;
+use crate::input::PartFile;
+use crate::setup::Setup;
+use crate::summary::{PitchChoice, PitchStudyRow};
 
 /// How to choose the pitch.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -57,51 +57,6 @@ impl AutoPitch {
     pub const DEFAULT_STARTS: usize = 40;
     /// The default time budget (s).
     pub const DEFAULT_BUDGET_S: f64 = 600.0;
-}
-
-/// One pitch of the study (`summary.json`'s `pitch_study`).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct PitchStudyRow {
-    /// The pitch (mm).
-    pub pitch_mm: f64,
-    /// The area distance judged against the exact oracle on the sample
-    /// (mm; `null` where one side strikes nothing): from the decided exact
-    /// strikes not downstream of a flagged blind spot to the grid's, and
-    /// from the grid's strikes the level error does not explain to the
-    /// exact ones (what `verify` fails on).
-    pub exact_area_distance_mm: Option<f64>,
-    /// The false-alarm side over every decided grid strike, the level
-    /// error's included (mm; shown, not judged: the grid's level error
-    /// strikes more, on the safe side, at half order).
-    #[serde(default)]
-    pub level_error_area_mm: Option<f64>,
-    /// Area distance to the previous, coarser pitch's colliding area over
-    /// the whole part (mm; `null` for the first pitch or where one side
-    /// strikes nothing).
-    pub grid_change_mm: Option<f64>,
-    /// Predicted time of the full analysis at this pitch (s).
-    pub predicted_s: f64,
-    /// Estimated working memory (GiB).
-    pub memory_gib: f64,
-    /// Whether this pitch meets the tolerance.
-    pub meets: bool,
-}
-
-/// The study and its choice.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct PitchChoice {
-    /// The chosen pitch (mm).
-    pub pitch_mm: f64,
-    /// The tolerance (mm).
-    pub tolerance_mm: f64,
-    /// The study, coarsest first.
-    pub study: Vec<PitchStudyRow>,
-    /// The predicted time of the analysis at the chosen pitch (s).
-    pub predicted_s: f64,
-    /// Seconds the study took.
-    pub study_s: f64,
-    /// Why this pitch, in one sentence.
-    pub reason: String,
 }
 
 /// How many halvings the study may take from its first pitch.
@@ -123,7 +78,7 @@ pub fn choose_pitch(
     auto: &AutoPitch,
     progress: &dyn Progress,
 ) -> Result<PitchChoice, HarnessError> {
-    if setup.approach == crate::analysis::Approach::Direct {
+    if setup.approach == crate::frame::Approach::Direct {
         return Err(HarnessError::DirectApproach);
     }
     super::verify::check_tolerance(auto.tolerance)?;

@@ -17,11 +17,13 @@ use super::verify::{
     check_selection, check_tie_band, check_tolerance, oracle_options, run_oracle, start_positions,
     tie_band_rule,
 };
-use crate::analysis::{Progress, Setup};
+use crate::analysis::Progress;
 use crate::engine::{AngleMask, EngineOptions, colliding_masks};
 use crate::grid::{GridSpec, HeightGrid};
-use crate::mesh::{PartFile, Triangle};
-use crate::shard::Shard;
+use crate::input::PartFile;
+use crate::mesh::Triangle;
+use crate::partition::Shard;
+use crate::setup::Setup;
 use kneeform_oracle::StartTrace;
 
 /// One pitch of a convergence study.
@@ -488,7 +490,7 @@ pub fn converge(
     options: &ConvergeOptions,
     progress: &dyn Progress,
 ) -> Result<Convergence, HarnessError> {
-    if setup.approach == crate::analysis::Approach::Direct {
+    if setup.approach == crate::frame::Approach::Direct {
         return Err(HarnessError::DirectApproach);
     }
     options.validate()?;

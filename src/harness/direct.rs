@@ -15,7 +15,7 @@
 //! contact level of the position at node `(i0, j0)` is
 //! `Y* = min (h[i][j] + a(z_j - z_j0))` over the nodes with
 //! `|x'_i - x'_i0| <= W/2 + NODE_TOL` and `z_j - z_j0` in the footprint's
-//! z-range (closed, [`crate::kneeform::NODE_TOL`]), and its contacted nodes are those with
+//! z-range (closed, [`crate::grid::NODE_TOL`]), and its contacted nodes are those with
 //! `h + a <= Y* + e0`. A position with no finite `h` there is not placed.
 //! The exact level is `X*`, the reference point's x at first contact, and
 //! `Y* = -X*`.
@@ -47,12 +47,16 @@ use super::metrics::{nearest_rank, sorted_abs};
 use super::sharded::{NO_BAND, Pairs, PitchPart, StudyPart, StudySummary, share, study_settings};
 use super::verify::{check_selection, check_tolerance};
 use super::{ConvergeOptions, VerifyOptions};
-use crate::analysis::{Approach, Progress, Setup};
-use crate::direct::{DirectFootprint, contact_levels, to_direct};
+use crate::analysis::Progress;
+use crate::direct::{DirectFootprint, contact_levels};
+use crate::frame::Approach;
+use crate::frame::to_direct;
 use crate::grid::{GridSpec, HeightGrid};
+use crate::input::PartFile;
 use crate::kneeform::KneeForm;
-use crate::mesh::{Part, PartFile, Triangle};
-use crate::shard::Shard;
+use crate::mesh::{Part, Triangle};
+use crate::partition::Shard;
+use crate::setup::Setup;
 
 /// The metrics of the direct approach, in the order of `converge.csv`.
 pub const DIRECT_METRICS: [&str; 2] = ["level_error", "contact_distance"];

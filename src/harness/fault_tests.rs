@@ -6,9 +6,11 @@
 use super::trace::Fault;
 use super::verify::verify_with;
 use super::{Comparison, StartSelection, TieBand, VerifyOptions};
-use crate::analysis::Setup;
-use crate::mesh::{Part, PartFile, Side, Triangle};
+use crate::frame::Side;
+use crate::input::PartFile;
+use crate::mesh::{Part, Triangle};
 use crate::scenario::{axis, tessellate};
+use crate::setup::Setup;
 
 /// Verifies `tris` at `pitch` and `angles` on the starts of `selection`,
 /// with an optional fault.

@@ -40,7 +40,7 @@ pub mod verify;
 #[cfg(test)]
 mod fault_tests;
 
-pub use auto::{AutoPitch, PitchChoice, PitchStudyRow, choose_pitch};
+pub use auto::{AutoPitch, choose_pitch};
 pub use compare::{
     AreaDistance, CompareOptions, Comparison, Counts, PairResult, StartSelection, VerifyRow,
     assemble, compare_grid, exact_traces, select_starts,
@@ -64,8 +64,8 @@ pub use verify::{
     tie_band_rule, verify,
 };
 
-use crate::analysis::SetupError;
 use crate::grid::GridError;
+use crate::setup::SetupError;
 
 /// Why a verification or convergence study could not run. (A failed
 /// oracle query on one start is no error: it is counted and fails the

@@ -34,10 +34,11 @@ use super::direct::{
 };
 use super::metrics::TieBand;
 use super::verify::{Traced, Verification, VerifyOptions, VerifySummary};
-use crate::analysis::{Progress, Setup};
+use crate::analysis::Progress;
 use crate::grid::GridSpec;
-use crate::mesh::PartFile;
-use crate::shard::Shard;
+use crate::input::PartFile;
+use crate::partition::Shard;
+use crate::setup::Setup;
 
 /// The pairs of one pitch of a share, angle-major over the share's starts.
 #[derive(Debug, Clone, PartialEq)]
@@ -260,7 +261,7 @@ pub fn converge_shard(
     shard: Shard,
     progress: &dyn Progress,
 ) -> Result<StudyPart, HarnessError> {
-    if setup.approach == crate::analysis::Approach::Direct {
+    if setup.approach == crate::frame::Approach::Direct {
         return Err(HarnessError::DirectApproach);
     }
     options.validate()?;

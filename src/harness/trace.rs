@@ -7,7 +7,8 @@
 //! level), with test-only faults that the harness must catch.
 
 use crate::grid::HeightGrid;
-use crate::kneeform::{GridFootprint, NODE_TOL};
+use crate::grid::NODE_TOL;
+use crate::kneeform::GridFootprint;
 use crate::strike::{LevelHistory, Meeting, StrikeRule};
 
 /// A deliberate mistake in the grid side of a comparison, for the tests

@@ -14,10 +14,12 @@ use super::compare::{
 };
 use super::metrics::{Stats, TieBand};
 use super::trace::Fault;
-use crate::analysis::{Progress, Setup};
+use crate::analysis::Progress;
 use crate::grid::{GridSpec, HeightGrid};
+use crate::input::PartFile;
 use crate::kneeform::{GridFootprint, KneeForm};
-use crate::mesh::{PartFile, Triangle};
+use crate::mesh::Triangle;
+use crate::setup::Setup;
 
 /// How to verify, beside the analysis [`Setup`].
 #[derive(Debug, Clone, PartialEq)]
@@ -287,11 +289,11 @@ impl Traced {
         input: &PartFile,
         setup: &Setup,
         options: &VerifyOptions,
-        shard: Option<crate::shard::Shard>,
+        shard: Option<crate::partition::Shard>,
         progress: &dyn Progress,
     ) -> Result<Traced, HarnessError> {
         setup.validate()?;
-        if setup.approach == crate::analysis::Approach::Direct {
+        if setup.approach == crate::frame::Approach::Direct {
             return Err(HarnessError::DirectApproach);
         }
         options.validate()?;

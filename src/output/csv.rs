@@ -292,8 +292,8 @@ impl Row {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::frame::Side;
     use crate::grid::GridSpec;
-    use crate::mesh::Side;
 
     /// A 3 x 2 grid at pitch 0.5 starting at x = -1, z = 2.
     fn grid() -> HeightGrid {
@@ -480,7 +480,7 @@ mod tests {
         let placement = crate::frame::Placement {
             side: Side::Right,
             frame: crate::frame::Frame::parse("z,x,y").unwrap(),
-            approach: crate::analysis::Approach::Slide,
+            approach: crate::frame::Approach::Slide,
         };
         // Node (2, 0): analysis (0, -3, 2), vehicle (0, 3, 2); vehicle
         // (x, y, z) = part (z, x, y), so part (3, 2, 0).

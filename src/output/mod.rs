@@ -16,7 +16,7 @@
 //! **Invariant:** nothing here changes a result; writers only format what
 //! the engine computed, mapping y back to the part with [`Side::to_part`].
 //!
-//! [`Side::to_part`]: crate::mesh::Side::to_part
+//! [`Side::to_part`]: crate::frame::Side::to_part
 
 use std::io;
 use std::path::{Path, PathBuf};
@@ -46,8 +46,7 @@ pub use self::results::{
     write_direct_convergence, write_direct_convergence_files, write_direct_verification,
     write_direct_verification_files, write_results, write_verification, write_verification_files,
 };
-pub(crate) use self::stl::to_stl_triangle;
-pub use self::stl::write_colliding_area;
+pub use self::stl::{write_colliding_area, write_stl};
 
 /// The files kneeform writes into a result directory: a run's, a
 /// verification's, a convergence study's, a shard's, the report, and a

@@ -82,7 +82,7 @@ pub fn write_colliding_area_ply<W: Write>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::Side;
+    use crate::frame::Side;
 
     fn grid() -> HeightGrid {
         crate::output::surface::test_grid(3)

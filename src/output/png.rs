@@ -24,10 +24,10 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
-use crate::analysis::Approach;
+use crate::frame::Approach;
 use crate::frame::Placement;
+use crate::frame::Side;
 use crate::grid::{GridSpec, HeightGrid};
-use crate::mesh::Side;
 
 /// Largest plot area width (pixels); the whole image stays under 1600.
 const MAX_PLOT_W: usize = 1300;

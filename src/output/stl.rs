@@ -10,6 +10,7 @@
 //! agree (right-hand rule) and the normal faces +y, the knee's side there.
 
 use std::io::{self, Write};
+use std::path::Path;
 
 use super::surface::{AreaSurface, to_part, wound};
 use crate::frame::Placement;
@@ -43,6 +44,16 @@ pub fn write_colliding_area<W: Write>(
     Ok(triangles.len())
 }
 
+/// Writes `triangles` (mm) as a binary STL at `path`, through a temporary
+/// file in the same directory renamed into place, so `path` is never a
+/// partial file.
+pub fn write_stl(path: &Path, triangles: &[Triangle]) -> io::Result<()> {
+    super::write_file_atomically(path, |file| {
+        let stl: Vec<stl_io::Triangle> = triangles.iter().map(to_stl_triangle).collect();
+        stl_io::write_stl(file, stl.iter())
+    })
+}
+
 /// An STL triangle with its unit normal from the winding (right-hand rule);
 /// zero for a degenerate triangle.
 pub(crate) fn to_stl_triangle(t: &Triangle) -> stl_io::Triangle {
@@ -69,7 +80,7 @@ pub(crate) fn to_stl_triangle(t: &Triangle) -> stl_io::Triangle {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::Side;
+    use crate::frame::Side;
 
     fn grid() -> HeightGrid {
         crate::output::surface::test_grid(4)

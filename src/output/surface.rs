@@ -12,8 +12,8 @@
 use std::io;
 
 use crate::frame::Placement;
+use crate::frame::Side;
 use crate::grid::HeightGrid;
-use crate::mesh::Side;
 
 /// Side of the square patch drawn on an otherwise unconnected colliding
 /// node, as a fraction of the pitch: small enough not to be mistaken for a

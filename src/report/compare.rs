@@ -13,7 +13,7 @@
 
 use std::collections::HashMap;
 
-use crate::analysis::Approach;
+use crate::frame::Approach;
 
 use super::ReportError;
 use super::render::{Rgb, RgbImage, View, paint, rasterize};

@@ -25,7 +25,7 @@
 
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 
-use crate::analysis::Approach;
+use crate::frame::Approach;
 use serde_json::Value;
 
 use super::compare::{BOTH, Comparison, DIRECT_ONLY, MATCH_PITCHES, SLIDE_ONLY};

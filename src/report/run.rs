@@ -7,10 +7,12 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use crate::analysis::Approach;
+use crate::frame::Approach;
 use crate::frame::Frame;
+use crate::frame::Side;
 use crate::grid::GridSpec;
-use crate::mesh::{Part, Side, read_part_bytes, sha256_hex};
+use crate::input::{read_part_bytes, sha256_hex};
+use crate::mesh::Part;
 use crate::summary::{Summary, SummaryError};
 
 use super::ReportError;
@@ -160,7 +162,7 @@ impl Run {
     /// Reads `dir`. The part is looked for at `part` when given, else at the
     /// run's `input_file` as given (relative to the current directory) and
     /// relative to the run directory's parent; the first file whose SHA-256
-    /// is the run's is used ([`crate::mesh::read_part_bytes`]).
+    /// is the run's is used ([`crate::input::read_part_bytes`]).
     pub fn read(dir: &Path, part: Option<&Path>) -> Result<Run, ReportError> {
         let summary_path = dir.join("summary.json");
         // A run replaced while it is read (`analyze --force` renames a

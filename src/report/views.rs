@@ -16,8 +16,9 @@
 
 use nalgebra::Vector3;
 
-use crate::analysis::Approach;
-use crate::mesh::{Side, Triangle};
+use crate::frame::Approach;
+use crate::frame::Side;
+use crate::mesh::Triangle;
 use crate::output::count_colour;
 
 use super::render::{Camera, Rgb, RgbImage, View, paint, rasterize};

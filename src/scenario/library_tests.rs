@@ -280,7 +280,7 @@ fn a_coarse_grid_misses_the_thin_rib_a_fine_one_does_not() {
 
 #[test]
 fn parts_that_strike_nothing_strike_nothing() {
-    use crate::grid::{GridSpec, HeightGrid};
+    use crate::grid::HeightGrid;
     use crate::{EngineOptions, Footprint, GridFootprint, KneeForm, colliding_masks};
     // The flat wall and the grooved wall: every node's height is at least
     // the face level after any push (the wall's 0), so nothing is more
@@ -294,7 +294,7 @@ fn parts_that_strike_nothing_strike_nothing() {
         let part =
             crate::Part::from_triangles(stem, part(stem).triangulate(None), 1.0, crate::Side::Left)
                 .unwrap();
-        let spec = GridSpec::around(&part.bbox(), &shapes, pitch);
+        let spec = Footprint::grid_around(&part.bbox(), &shapes, pitch);
         let grid = HeightGrid::sample(&part.triangles, spec);
         let footprints: Vec<GridFootprint> = angles
             .iter()

@@ -23,9 +23,10 @@
 //!   lattice cell facing -y; the files use it on a square lattice with
 //!   vertex lines at their creases (so thin features are in the mesh at
 //!   any step), and the tests and the oracle's tests and examples on
-//!   lattices of their own;
-//! * [`write_stl`]: a mesh as a binary STL that the CLI reads like any
-//!   other part.
+//!   lattices of their own.
+//!
+//! A scenario's mesh is written as a binary STL by
+//! [`crate::output::write_stl`], which the CLI reads like any other part.
 
 mod builtin;
 mod console;
@@ -36,11 +37,6 @@ mod primitive;
 #[cfg(test)]
 mod library_tests;
 
-use std::io;
-use std::path::Path;
-
-use crate::mesh::Triangle;
-
 pub use builtin::{PAPER_TRIANGLES, builtin, builtin_names};
 pub use file::{
     Extent, MAX_TRIANGLES, ScenarioError, ScenarioFile, is_scenario_file, load, parse,
@@ -49,22 +45,10 @@ pub use file::{
 pub use lattice::{axis, tessellate};
 pub use primitive::{Boss, Bump, Console, Feature, Groove, Plane, Rib, Ridge, Step, Wave};
 
-/// Writes `triangles` (mm) as a binary STL at `path`, through a temporary
-/// file in the same directory renamed into place, so `path` is never a
-/// partial file.
-pub fn write_stl(path: &Path, triangles: &[Triangle]) -> io::Result<()> {
-    crate::output::write_file_atomically(path, |file| {
-        let stl: Vec<stl_io::Triangle> = triangles
-            .iter()
-            .map(crate::output::to_stl_triangle)
-            .collect();
-        stl_io::write_stl(file, stl.iter())
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::output::write_stl;
 
     #[test]
     fn stl_round_trips() {

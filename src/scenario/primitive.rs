@@ -13,7 +13,7 @@ use serde::Deserialize;
 
 use super::console::console_height;
 use super::lattice::{cos2_bell, plateau, sin_turns};
-use crate::kneeform::NODE_TOL;
+use crate::grid::NODE_TOL;
 
 /// One primitive of a scenario file; the file's surface is the sum of its
 /// primitives' contributions.

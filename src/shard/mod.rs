@@ -39,67 +39,15 @@ use sha2::{Digest, Sha256};
 
 use crate::analysis::Analysis;
 use crate::blind::BlindSpot;
-use crate::engine::{AngleMask, EngineOptions};
+use crate::engine::AngleMask;
 use crate::frame::{Frame, Placement};
 use crate::grid::{GridSpec, HeightGrid};
-use crate::kneeform::GridFootprint;
 use crate::output::{OutputDir, RunResults, WriteError};
+use crate::partition::{Shard, ShardSyntax};
 use crate::summary::{AngleSummary, Summary};
 
 mod codec;
 pub mod study;
-
-/// One shard of a run's angles: the `index`-th (1-based) of `count`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Shard {
-    /// K, from 1 to `count`.
-    pub index: usize,
-    /// N, at least 1.
-    pub count: usize,
-}
-
-impl Shard {
-    /// Parses `K/N` (1 <= K <= N <= [`crate::limits::MAX_ANGLES`]).
-    pub fn parse(s: &str) -> Result<Shard, ShardError> {
-        let bad = || ShardError::Syntax(s.to_string());
-        let (k, n) = s.split_once('/').ok_or_else(bad)?;
-        let index: usize = k.trim().parse().map_err(|_| bad())?;
-        let count: usize = n.trim().parse().map_err(|_| bad())?;
-        if index == 0 || index > count || count > crate::limits::MAX_ANGLES {
-            return Err(bad());
-        }
-        Ok(Shard { index, count })
-    }
-
-    /// The indices, among `angles` angles, of this shard's: `a` with
-    /// `a % count == index - 1`, in increasing order.
-    pub fn angle_indices(&self, angles: usize) -> Vec<usize> {
-        self.indices(angles)
-    }
-
-    /// The indices, among `items` (a run's angles, a study's starts), of
-    /// this shard's: `k` with `k % count == index - 1`, in increasing
-    /// order.
-    pub fn indices(&self, items: usize) -> Vec<usize> {
-        (self.index - 1..items).step_by(self.count).collect()
-    }
-
-    /// Whether `indices` are this shard's among `items` ([`Shard::indices`]),
-    /// checked without building them (a shard.json's numbers are not
-    /// trusted to size anything): `1 <= index <= count <= max(items, 1)`
-    /// and `indices[m] = index - 1 + m * count`.
-    pub fn holds(&self, items: usize, indices: &[usize]) -> bool {
-        let Shard { index, count } = *self;
-        if index == 0 || index > count || count > items.max(1) {
-            return false;
-        }
-        let expected = items.saturating_sub(index - 1).div_ceil(count);
-        indices.len() == expected
-            && indices.iter().enumerate().all(|(m, &k)| {
-                m.checked_mul(count).and_then(|o| o.checked_add(index - 1)) == Some(k)
-            })
-    }
-}
 
 /// The SHA-256 (hex) of a `shard.json`'s content with its
 /// `record_sha256` left out (keys sorted, compact JSON): what
@@ -135,18 +83,12 @@ pub(crate) fn unsealed_json(text: &[u8]) -> Result<serde_json::Value, String> {
     }
 }
 
-impl std::fmt::Display for Shard {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}/{}", self.index, self.count)
-    }
-}
-
 /// Why shards cannot be written or merged.
 #[derive(Debug, thiserror::Error)]
 pub enum ShardError {
     /// Not `K/N`.
-    #[error("expected K/N with 1 <= K <= N (shard K of N), got {0:?}")]
-    Syntax(String),
+    #[error(transparent)]
+    Syntax(#[from] ShardSyntax),
     /// More shards than angles: some shard would have nothing to do.
     #[error("{shards} shards of {angles} angles: at most one shard per angle")]
     TooMany {
@@ -205,37 +147,6 @@ pub struct ShardRecord {
 pub const FORMAT: u32 = 2;
 
 const MAGIC: &[u8; 16] = b"kneeform shard 2";
-
-/// The masks of `footprints` (one per angle of the run) computed at the
-/// angles `only` (indices into `footprints`): the others are empty, with
-/// no placed start and no blind spot met.
-pub(crate) fn masks_at(
-    grid: &HeightGrid,
-    footprints: &[GridFootprint],
-    options: &EngineOptions,
-    only: &[usize],
-    on_angle: &(dyn Fn() + Sync),
-) -> Vec<AngleMask> {
-    let chosen: Vec<GridFootprint> = only
-        .iter()
-        .filter_map(|&a| footprints.get(a).cloned())
-        .collect();
-    let computed = crate::engine::colliding_masks(grid, &chosen, options, on_angle);
-    let mut masks: Vec<AngleMask> = footprints
-        .iter()
-        .map(|fp| AngleMask {
-            angle_deg: fp.angle_deg,
-            mask: vec![0; grid.spec.len()],
-            placed: 0,
-            colliding: 0,
-            probes_met: vec![false; options.probes.len()],
-        })
-        .collect();
-    for (&a, m) in only.iter().zip(computed) {
-        masks[a] = m;
-    }
-    masks
-}
 
 /// Writes `analysis`, computed at `shard`'s angles only
 /// ([`Analysis::of_source_at`]), as that shard: `shard.json` and

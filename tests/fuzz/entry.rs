@@ -10,7 +10,7 @@
 use std::path::Path;
 
 use kneeform::Side;
-use kneeform::mesh::read_part_bytes;
+use kneeform::input::read_part_bytes;
 use kneeform::scenario;
 use kneeform::summary::Summary;
 
@@ -159,7 +159,10 @@ pub fn study_shard(data: &[u8]) -> bool {
         return false;
     };
     if let Some(map) = value.as_object_mut() {
-        map.insert("data_sha256".into(), kneeform::mesh::sha256_hex(bin).into());
+        map.insert(
+            "data_sha256".into(),
+            kneeform::input::sha256_hex(bin).into(),
+        );
     }
     let Some(sealed) = kneeform::shard::reseal(value.to_string().as_bytes()) else {
         return false;
