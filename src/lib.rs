@@ -3,14 +3,16 @@
 //!
 //! The pipeline, each step named as in SPEC.md and the paper:
 //!
-//! * [`mesh`]: STL in, triangles in the analysis frame (mm, knee pushed in
-//!   +y, sliding in -x); [`frame`]: parts in other coordinates
-//!   (`--frame`); [`assembly`]: several files as one part;
+//! * [`input`]: STL in, a [`mesh`] of triangles in the analysis frame (mm,
+//!   knee pushed in +y, sliding in -x); [`frame`]: parts in other
+//!   coordinates (`--frame`); [`assembly`]: several files as one part;
+//! * [`setup`]: what an analysis computes, checked before any work;
 //! * [`grid`]: step 1, the height grid (an orthographic depth buffer);
 //! * [`kneeform`]: the knee-form, its footprint per angle and row intervals;
-//! * [`push`] and [`slide`]: step 2, the fast path; [`paper`]: the
-//!   paper-literal reference;
-//! * [`engine`]: every angle and start, the colliding masks and composite;
+//! * [`engine`]: step 2, push and slide at every angle and start (the fast
+//!   path, and the paper-literal reference), the colliding masks and
+//!   composite; its rooms are private, its surface [`colliding_masks`],
+//!   [`composite`], [`push_levels`] and their options;
 //! * [`direct`]: the direct approach (`--approach direct`), the knee-form
 //!   moved straight in -x until it first touches the part;
 //! * [`analysis`]: the pipeline above as one call, with its typed setup;
@@ -56,18 +58,12 @@ pub mod manifest;
 pub mod memory;
 pub mod mesh;
 pub mod output;
-pub mod padded;
-pub mod paper;
 pub mod partition;
-pub mod push;
-pub mod ranked;
 pub mod report;
 pub mod sanity;
 pub mod scenario;
 pub mod setup;
 pub mod shard;
-mod simd;
-pub mod slide;
 pub mod strike;
 pub mod summary;
 mod zbuffer;

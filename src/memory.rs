@@ -10,8 +10,9 @@
 //! * the part: `72 n` (three f64 vertices per triangle);
 //! * the height grid `8 N`, its padded copy `8 Np`, the ranks and
 //!   thresholds, and the push's tables: the window minima `4 (L - 1) Nr`
-//!   (level 0 is the ranks themselves) and the group bounds
-//!   ([`WindowMin::bytes_for`]);
+//!   (level 0 is the ranks themselves) and the group bounds (these and the
+//!   two items below are the engine's own figures,
+//!   [`crate::engine::working_bytes`]);
 //! * per band task running (at most `T`, and at most the bands there
 //!   are): its reach window, strikes and probe-corner bits (`5.125 Nw`;
 //!   the paper path's band mask `Np` where that is larger);
@@ -25,12 +26,8 @@
 //! The figures were checked against the measured peak (`VmHWM`) on runs
 //! from 40 MiB to 1.3 GiB (`tests/hostile.rs` holds the bound test).
 
-use crate::engine::BAND_ROWS;
 use crate::grid::GridSpec;
 use crate::kneeform::GridFootprint;
-use crate::padded::Padding;
-use crate::push::WindowMin;
-use crate::slide::window_depth;
 use crate::strike::StrikeRule;
 
 /// The program before any part is read: code, the font, the thread pool.
@@ -70,45 +67,19 @@ impl MemoryEstimate {
         threads: usize,
     ) -> MemoryEstimate {
         let n = spec.nx as f64 * spec.nz as f64;
-        let padding = Padding::deep(spec, footprints, window_depth(rule, spec.pitch));
-        let padded = padding.nodes(spec) as f64;
         let angles = footprints.len() as f64;
-        let threads = threads.max(1);
-        let angles_in_flight = threads.min(footprints.len().max(1)) as f64;
-        let span = footprints
-            .iter()
-            .map(|fp| {
-                let (lo, hi) = fp.dj_range();
-                (hi - lo) as usize + 1
-            })
-            .max()
-            .unwrap_or(1);
-        let band = BAND_ROWS.min(spec.nz.max(1));
-        let window = (padding.stride * (band - 1 + span)) as f64;
-        let bands = footprints.len().max(1) * spec.nz.div_ceil(band).max(1);
-        let tasks = threads.min(bands) as f64;
-        let thresholds = if rule.window_mm().is_some() { 2.0 } else { 1.0 };
-        MemoryEstimate {
-            items: vec![
-                ("program", BASE_BYTES),
-                ("part", BYTES_PER_TRIANGLE * triangles as f64),
-                ("height grid", 8.0 * n + 8.0 * padded),
-                // The ranks, the strike thresholds (two under the window
-                // rule) and the distinct heights (at most one per node).
-                ("ranks", 4.0 * padded + 4.0 * thresholds * padded + 8.0 * n),
-                (
-                    "push table",
-                    WindowMin::bytes_for(spec.nz, padding.stride, WindowMin::max_width(footprints))
-                        as f64,
-                ),
-                // A rank of reach, a strike byte and a probe-corner bit
-                // per window node.
-                ("bands running", tasks * (5.125 * window).max(padded)),
-                ("angles in flight", angles_in_flight * n),
-                ("masks", MASK_BYTES_PER_NODE * angles * n + 2.0 * n),
-                ("writers", WRITE_BYTES_PER_NODE * n),
-            ],
-        }
+        let mut items = vec![
+            ("program", BASE_BYTES),
+            ("part", BYTES_PER_TRIANGLE * triangles as f64),
+        ];
+        items.extend(crate::engine::working_bytes(
+            spec, footprints, rule, threads,
+        ));
+        items.extend([
+            ("masks", MASK_BYTES_PER_NODE * angles * n + 2.0 * n),
+            ("writers", WRITE_BYTES_PER_NODE * n),
+        ]);
+        MemoryEstimate { items }
     }
 
     /// The estimate of reading a part file of `file_bytes` bytes holding at

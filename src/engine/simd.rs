@@ -15,10 +15,10 @@
 /// instruction set.
 macro_rules! dispatch {
     ($(#[$meta:meta])* $vis:vis fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? => $imp:ident) => {
-        $crate::simd::dispatch!(@copies [$(#[$meta])*] $vis $name ($($arg: $ty),*) ($($ret)?) $imp, $imp, $imp);
+        $crate::engine::simd::dispatch!(@copies [$(#[$meta])*] $vis $name ($($arg: $ty),*) ($($ret)?) $imp, $imp, $imp);
     };
     ($(#[$meta:meta])* $vis:vis fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? => $imp:ident::<$a:literal, $b:literal, $c:literal>) => {
-        $crate::simd::dispatch!(@copies [$(#[$meta])*] $vis $name ($($arg: $ty),*) ($($ret)?) $imp::<$a>, $imp::<$b>, $imp::<$c>);
+        $crate::engine::simd::dispatch!(@copies [$(#[$meta])*] $vis $name ($($arg: $ty),*) ($($ret)?) $imp::<$a>, $imp::<$b>, $imp::<$c>);
     };
     (@copies [$(#[$meta:meta])*] $vis:vis $name:ident ($($arg:ident: $ty:ty),*) ($($ret:ty)?) $f512:path, $f2:path, $f0:path) => {
         $(#[$meta])*
@@ -33,7 +33,7 @@ macro_rules! dispatch {
                 fn avx2($($arg: $ty),*) $(-> $ret)? {
                     $f2($($arg),*)
                 }
-                if $crate::simd::has_avx512() {
+                if $crate::engine::simd::has_avx512() {
                     // SAFETY: the CPU supports AVX-512F, AVX2 and FMA,
                     // checked at run time just above.
                     #[allow(unsafe_code)]

@@ -24,12 +24,12 @@
 //! that meets no node), the bounds add a few scalar loads to the 64
 //! vector loads each group's row costs a tile.
 //!
-//! Heights are taken as their ranks ([`crate::ranked`]): minima of ranks
+//! Heights are taken as their ranks ([`crate::engine::ranked`]): minima of ranks
 //! are the ranks of minima, exactly.
 
+use crate::engine::padded::{LANE_SLACK, PaddedGrid, fmin};
+use crate::engine::ranked::{NEVER, OFF, Rank};
 use crate::kneeform::GridFootprint;
-use crate::padded::{LANE_SLACK, PaddedGrid, fmin};
-use crate::ranked::{NEVER, OFF, Rank};
 
 /// Row window minima of a padded height grid's real rows, for every
 /// power-of-two width.
@@ -73,7 +73,7 @@ impl<'a> WindowMin<'a> {
     }
 
     /// Builds the table for windows up to `max_width` nodes over `ranks`,
-    /// the ranks of `grid`'s heights ([`crate::ranked::RankedGrid`]).
+    /// the ranks of `grid`'s heights ([`crate::engine::ranked::RankedGrid`]).
     pub fn new(grid: &PaddedGrid, ranks: &'a [Rank], max_width: usize) -> WindowMin<'a> {
         let stride = grid.stride;
         let first = grid.pad_rows * stride;
@@ -110,15 +110,6 @@ impl<'a> WindowMin<'a> {
             minima: self.level(l),
             first: self.first,
         })
-    }
-
-    /// Memory held (bytes), level 0 aside (it is the grid's).
-    pub fn bytes(&self) -> usize {
-        self.levels
-            .iter()
-            .chain(&self.groups.levels)
-            .map(|l| l.len() * size_of::<Rank>())
-            .sum()
     }
 
     /// The bytes [`WindowMin::bytes`] will be for a grid of `nz` real rows
@@ -421,9 +412,9 @@ pub fn push_start_literal(grid: &PaddedGrid, fp: &GridFootprint, i0: usize, j0: 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::engine::ranked::RankedGrid;
     use crate::grid::{GridSpec, HeightGrid};
     use crate::kneeform::KneeForm;
-    use crate::ranked::RankedGrid;
 
     /// The pruned push ([`push_tile`] passing over groups of footprint
     /// rows whose lower bound cannot lower a level) gives every start the

@@ -50,14 +50,9 @@ pub struct Padding {
 }
 
 impl Padding {
-    /// The padding of `spec` for all of `footprints`.
-    pub fn of(spec: &GridSpec, footprints: &[GridFootprint]) -> Padding {
-        Padding::deep(spec, footprints, 0)
-    }
-
     /// The padding of `spec` for all of `footprints`, for slides that
     /// reach `depth` columns past their first layer (the window rule's,
-    /// [`crate::slide::window_depth`]).
+    /// [`crate::engine::slide::window_depth`]).
     pub fn deep(spec: &GridSpec, footprints: &[GridFootprint], depth: usize) -> Padding {
         let nx = spec.nx;
         let (mut lo, mut hi, mut dj_max) = (0i64, 0i64, 0i64);
@@ -169,6 +164,7 @@ impl PaddedGrid {
     }
 
     /// Drops the padding of a padded per-node array.
+    #[cfg(test)]
     pub fn unpad<T: Copy>(&self, padded: &[T]) -> Vec<T> {
         let GridSpec { nx, nz, .. } = self.spec;
         padded[self.pad_rows * self.stride..]
@@ -186,10 +182,4 @@ impl PaddedGrid {
 #[inline(always)]
 pub fn fmin(a: f64, b: f64) -> f64 {
     if b < a { b } else { a }
-}
-
-/// The larger of two levels, as [`fmin`].
-#[inline(always)]
-pub fn fmax(a: f64, b: f64) -> f64 {
-    if b > a { b } else { a }
 }

@@ -20,10 +20,10 @@
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
+use crate::engine::padded::{PaddedGrid, fmin};
+use crate::engine::push::push_start_literal;
 use crate::grid::NODE_TOL;
 use crate::kneeform::GridFootprint;
-use crate::padded::{PaddedGrid, fmin};
-use crate::push::push_start_literal;
 use crate::strike::{LevelHistory, Meeting, RateEstimate, StrikeRule};
 
 /// One node of the merged list: its padded index, the layer it belongs to

@@ -9,19 +9,26 @@
 //! **Invariant:** the engine does no I/O and reads no clock; progress is
 //! reported through a callback.
 
+mod padded;
+mod paper;
+mod push;
+mod ranked;
+mod simd;
+mod slide;
+
 use rayon::prelude::*;
 
-use crate::grid::{GridSpec, HeightGrid};
-use crate::kneeform::GridFootprint;
-use crate::padded::PaddedGrid;
-use crate::paper::{PaperCounts, PaperScratch, paper_row};
-use crate::push::{PushRows, WindowMin, WindowOf, push_block, push_tile};
-use crate::ranked::{NEVER, OFF, Rank, RankedGrid};
-use crate::simd::dispatch;
-use crate::slide::{
+use crate::engine::padded::PaddedGrid;
+use crate::engine::paper::{PaperCounts, PaperScratch, paper_row};
+use crate::engine::push::{PushRows, WindowMin, WindowOf, push_block, push_tile};
+use crate::engine::ranked::{NEVER, OFF, Rank, RankedGrid};
+use crate::engine::simd::dispatch;
+use crate::engine::slide::{
     Extension, LayerRows, WindowLayers, WindowSlide, ones, slide_block, slide_block_window,
     slide_carried, window_depth,
 };
+use crate::grid::{GridSpec, HeightGrid};
+use crate::kneeform::GridFootprint;
 use crate::strike::StrikeRule;
 
 /// Which implementation of push and slide to run. Both give identical masks.
@@ -394,7 +401,7 @@ dispatch! {
     /// with AVX2 (eight), 16 without: wider blocks walk the footprint's
     /// offsets fewer times. Measured on AVX2 (11 angles, one thread): 64
     /// about 5% faster than 32 and level with 128 (the noise is about
-    /// 10%); 16 slower. [`LANE_SLACK`](crate::padded::LANE_SLACK) covers the
+    /// 10%); 16 slower. [`LANE_SLACK`](crate::engine::padded::LANE_SLACK) covers the
     /// widest block.
     fn fast_band(padded: &PaddedGrid, fast: &Fast, fp: &GridFootprint, band: &[usize], window: usize, visits: &ProbeVisits, out: BandOut) -> usize => fast_band_impl::<128, 64, 16>
 }
@@ -1145,6 +1152,53 @@ pub fn composite(masks: &[AngleMask]) -> Vec<u16> {
         }
     }
     count
+}
+
+/// The engine's working memory on `spec` at the angles of `footprints`
+/// under `rule`, `threads` angles at a time at most, by item (bytes): the
+/// height grid and its padded copy, the ranks and thresholds, the push's
+/// window-minimum table, the bands running and the angles in flight. The
+/// engine owns these figures because it owns the buffers;
+/// [`crate::memory::MemoryEstimate::analysis`] adds the part, the masks
+/// and the writers.
+pub fn working_bytes(
+    spec: &GridSpec,
+    footprints: &[GridFootprint],
+    rule: &StrikeRule,
+    threads: usize,
+) -> Vec<(&'static str, f64)> {
+    let n = spec.nx as f64 * spec.nz as f64;
+    let padding = padded::Padding::deep(spec, footprints, slide::window_depth(rule, spec.pitch));
+    let padded = padding.nodes(spec) as f64;
+    let threads = threads.max(1);
+    let angles_in_flight = threads.min(footprints.len().max(1)) as f64;
+    let span = footprints
+        .iter()
+        .map(|fp| {
+            let (lo, hi) = fp.dj_range();
+            (hi - lo) as usize + 1
+        })
+        .max()
+        .unwrap_or(1);
+    let band = BAND_ROWS.min(spec.nz.max(1));
+    let window = (padding.stride * (band - 1 + span)) as f64;
+    let bands = footprints.len().max(1) * spec.nz.div_ceil(band).max(1);
+    let tasks = threads.min(bands) as f64;
+    let thresholds = if rule.window_mm().is_some() { 2.0 } else { 1.0 };
+    vec![
+        ("height grid", 8.0 * n + 8.0 * padded),
+        // The ranks, the strike thresholds (two under the window rule) and
+        // the distinct heights (at most one per node).
+        ("ranks", 4.0 * padded + 4.0 * thresholds * padded + 8.0 * n),
+        (
+            "push table",
+            WindowMin::bytes_for(spec.nz, padding.stride, WindowMin::max_width(footprints)) as f64,
+        ),
+        // A rank of reach, a strike byte and a probe-corner bit per window
+        // node.
+        ("bands running", tasks * (5.125 * window).max(padded)),
+        ("angles in flight", angles_in_flight * n),
+    ]
 }
 
 #[cfg(test)]

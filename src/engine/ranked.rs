@@ -20,7 +20,7 @@
 
 use rayon::prelude::*;
 
-use crate::padded::PaddedGrid;
+use crate::engine::padded::PaddedGrid;
 use crate::strike::{Meeting, RateEstimate, StrikeRule};
 
 /// A height's rank: `NEVER` below every height, `1..=n` for the grid's `n`
@@ -151,11 +151,6 @@ impl RankedGrid {
                 }
             });
         out
-    }
-
-    /// Memory held (bytes).
-    pub fn bytes(&self) -> usize {
-        self.ranks.len() * 4 + self.heights.len() * 8
     }
 }
 

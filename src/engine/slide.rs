@@ -21,14 +21,14 @@
 //! monotone in the level, so applying it to the reach at the end gives the
 //! same mask with a `max` per visit instead of a compare-and-store.
 //!
-//! Heights and levels are taken as their ranks ([`crate::ranked`]), and
+//! Heights and levels are taken as their ranks ([`crate::engine::ranked`]), and
 //! the rule as each node's threshold rank: the same comparisons, exactly.
 
+use crate::engine::padded::PaddedGrid;
+use crate::engine::push::WindowOf;
+use crate::engine::ranked::{NEVER, OFF, Rank};
 use crate::grid::NODE_TOL;
 use crate::kneeform::GridFootprint;
-use crate::padded::PaddedGrid;
-use crate::push::WindowOf;
-use crate::ranked::{NEVER, OFF, Rank};
 use crate::strike::{LevelHistory, StrikeRule};
 
 /// The first layer of one footprint, ready for [`slide_block`]: the offset
@@ -128,7 +128,7 @@ impl LayerRows {
 /// row whose `W` nodes are none below any start's level is passed over: it
 /// lowers no level, and it meets each node at a level no higher than the
 /// node's own height, below its strike threshold
-/// ([`crate::ranked::RankedGrid::thresholds`]), so it decides no strike.
+/// ([`crate::engine::ranked::RankedGrid::thresholds`]), so it decides no strike.
 /// Its reach stays as it was, so a caller that reads the reach at levels
 /// below the nodes (the engine's probes) passes `None`.
 #[inline(always)]
