@@ -226,6 +226,12 @@ pub struct VerifyRow {
     /// knee-form (mm), away from blind spots.
     #[serde(default)]
     pub level_error_clearance: Option<f64>,
+    /// Where the decided miss inside the footprint exceeds `sqrt 2`
+    /// pitches: the same with the grid sampled at half the pitch, against
+    /// the same exact trace (mm; empty otherwise). At most half of it
+    /// names the miss `sampling`.
+    #[serde(default)]
+    pub miss_distance_half_pitch: Option<f64>,
     /// Why the oracle failed on this pair (`oracle_failed` rows).
     #[serde(default)]
     pub oracle_failure: Option<String>,
@@ -363,7 +369,8 @@ pub struct Unexplained {
     /// their start (a judged one: not an oracle failure).
     pub unmatched_grid: usize,
     /// `miss_distance_decided` over the exact strikes inside the grid's
-    /// footprint (not in the knee-form's rim; `null` when infinite).
+    /// footprint (not in the knee-form's rim) of starts whose miss does
+    /// not halve at half the pitch (`null` when infinite).
     #[serde(default, with = "crate::harness::compare::infinite_as_null")]
     pub miss_distance: f64,
     /// `area_miss_distance_decided` from those strikes.
@@ -385,13 +392,13 @@ pub struct Unexplained {
     #[serde(default)]
     pub miss_rim: f64,
     /// The largest one of a brief exact strike
-    /// ([`super::metrics::StartComparison::miss_brief`]): sampling in
-    /// travel.
+    /// ([`super::metrics::StartComparison::miss_brief`]) in a start whose
+    /// miss halves at half the pitch: sampling in travel.
     #[serde(default)]
     pub miss_brief: f64,
-    /// The largest one inside the footprint of a start whose inside miss
-    /// halves at half the pitch ([`StartComparison::halves`]): sampling,
-    /// shown by refinement.
+    /// The largest one inside the footprint, not brief, of a start whose
+    /// inside miss halves at half the pitch ([`StartComparison::halves`]):
+    /// sampling, shown by refinement.
     #[serde(default)]
     pub miss_refined: f64,
     /// `area_miss_distance_decided` from those starts' strikes.
@@ -501,6 +508,7 @@ pub fn row_of(
                 .collect::<Vec<f64>>(),
         ),
         level_error_clearance: worst(&cmp.level_clearance),
+        miss_distance_half_pitch: cmp.miss_half_pitch.filter(|v| v.is_finite()),
         oracle_failure: cmp.oracle_failure.map(|r| r.to_string()),
     }
 }
@@ -766,9 +774,11 @@ pub fn assemble(
             if !d.is_finite() {
                 continue;
             }
+            // Inside the footprint, sampling is shown by refinement
+            // alone: a start's miss that halves at half the pitch.
             if rim {
                 unexplained.miss_rim = unexplained.miss_rim.max(d);
-            } else if brief {
+            } else if cmp.halves() && brief {
                 unexplained.miss_brief = unexplained.miss_brief.max(d);
             } else if cmp.halves() {
                 unexplained.miss_refined = unexplained.miss_refined.max(d);
@@ -1231,15 +1241,21 @@ mod tests {
     /// A start whose inside miss (3 mm at a 1 mm pitch, beyond `sqrt 2`
     /// pitches) falls to at most half at half the pitch is named
     /// sampling, shown by refinement, in the per-start and the area
-    /// figures; one that does not halve stays unexplained.
+    /// figures; one that does not halve stays unexplained, brief or not.
     #[test]
     fn an_inside_miss_that_halves_at_half_the_pitch_is_sampling() {
+        for brief in [false, true] {
+            an_inside_miss_halving(brief);
+        }
+    }
+
+    fn an_inside_miss_halving(brief: bool) {
         let verdict = |half: f64| {
             let mut cmp = StartComparison {
                 miss: vec![3.0],
                 miss_decided: vec![3.0],
                 miss_rim: vec![false],
-                miss_brief: vec![false],
+                miss_brief: vec![brief],
                 miss_half_pitch: Some(half),
                 exact_strikes: 1,
                 ..StartComparison::default()
@@ -1281,7 +1297,7 @@ mod tests {
             let v = verdict(half);
             assert!(
                 v.len() == 2 && v.iter().all(|(_, m)| *m == Mechanism::Unexplained),
-                "{half}: {v:?}"
+                "brief {brief}, {half}: {v:?}"
             );
         }
     }
