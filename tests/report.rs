@@ -463,6 +463,18 @@ fn report_of_a_scenario_run_has_every_section_embeds_every_figure_and_cites_the_
     assert!(html.contains("ASSUMED"));
     assert!(html.contains("id=\"verdict-0\">FAIL"), "no FAIL verdict");
     assert!(html.contains("id=\"verdict-1\">PASS"), "no PASS verdict");
+    // Each verdict comes first, above the main image, not only in the
+    // accuracy section after the tables.
+    let main = html.find("id=\"main-view\"").unwrap();
+    for (k, word) in [(0, "FAIL"), (1, "PASS")] {
+        let at = html
+            .find(&format!(
+                "id=\"verdict-first-{k}\">{word} (verification {})",
+                k + 1
+            ))
+            .unwrap_or_else(|| panic!("no {word} verdict first"));
+        assert!(at < main, "verdict {k} after the main image");
+    }
     // Text from files is escaped.
     assert!(html.contains("&lt;b&gt;odd&lt;/b&gt;") && !html.contains("<b>odd</b>"));
     std::fs::remove_dir_all(dir).unwrap();

@@ -309,6 +309,11 @@ fn result_section(inputs: &Inputs) -> Markup {
             "\n"
             h2 { "1. Colliding area on the part" }
             "\n"
+            @for (k, v) in inputs.verifications.iter().enumerate() {
+                @if let Some(json) = &v.verify {
+                    (verdict_first(k, json, v.verdict(), run.blind_spots.len()))
+                }
+            }
             p class="headline" {
                 "Area the knee-form can strike at some angle: "
                 b { (cite(SUMMARY, j, "/composite_area_mm2")) " mm" (SUP2) }
@@ -348,6 +353,64 @@ fn result_section(inputs: &Inputs) -> Markup {
             "\n"
         }
         "\n"
+    }
+}
+
+/// The verdict of the `k`-th verification, first (issue 24): PASS or FAIL
+/// against its tolerance, the sentence a regulator signs, and on FAIL
+/// each failing figure with its mechanism and the worst start; section 5
+/// has the tables. `blind_cells` is the run's flagged blind spots.
+fn verdict_first(k: usize, json: &Value, verdict: Verdict, blind_cells: usize) -> Markup {
+    let file = verify_label(k, "verify.json");
+    let c = |p: &str| cite(&file, json, p);
+    let (class, word) = match verdict {
+        Verdict::Pass => ("pass", "PASS"),
+        Verdict::Fail => ("fail", "FAIL"),
+        Verdict::Unknown => ("unknown", "NO VERDICT IN FILE"),
+    };
+    let failing: Vec<(usize, &Value)> = json
+        .get("failures")
+        .and_then(Value::as_array)
+        .map(|f| {
+            f.iter()
+                .enumerate()
+                .filter(|(_, f)| f.get("fails_verdict") == Some(&Value::Bool(true)))
+                .collect()
+        })
+        .unwrap_or_default();
+    html! {
+        p class={ (class) " verdict" } id={ "verdict-first-" (k) } {
+            (word) " (verification " (k + 1) "): "
+            @match verdict {
+                Verdict::Pass => "every decided exact strike lies within ",
+                _ => "not every decided exact strike was found within ",
+            }
+            (c("/tolerance_mm")) " mm of the grid's colliding area at pitch " (c("/pitch_mm")) " mm ("
+            (c("/starts")) " starts x " (json.get("angles_deg").and_then(Value::as_array).map_or(0, Vec::len))
+            " angles against the exact oracle; the largest distance from a decided exact strike to the grid's area: "
+            (c("/metrics/area_miss_distance_decided/max")) " mm); "
+            (c("/counts/exact_undecided")) " exact contacts undecided (either answer is right at this pitch); "
+            (blind_cells) " grid cells flagged as blind spots (features narrower than the pitch, section 6)."
+        }
+        "\n"
+        @if !failing.is_empty() {
+            p class="headline" {
+                "Why it fails: "
+                @for (n, (i, _)) in failing.iter().enumerate() {
+                    @if n > 0 { "; " }
+                    code { (c(&format!("/failures/{i}/metric"))) } " "
+                    (c(&format!("/failures/{i}/value"))) " mm ("
+                    (c(&format!("/failures/{i}/mechanism"))) ")"
+                }
+                @if json.pointer("/worst_starts/0").is_some() {
+                    ". Worst start: x = " (c("/worst_starts/0/x")) ", z = " (c("/worst_starts/0/z"))
+                    " mm at " (c("/worst_starts/0/angle_deg")) " degrees, "
+                    code { (c("/worst_starts/0/metric")) } " = " (c("/worst_starts/0/value")) " mm"
+                }
+                ". Mechanisms: sampling (the grid's first-order error, shown by refinement: a finer pitch resolves it), rim, oracle-failure, unexplained (README, \"When verify fails\")."
+            }
+            "\n"
+        }
     }
 }
 
@@ -895,24 +958,88 @@ fn converge_block(k: usize, json: &Value) -> Markup {
     }
 }
 
-/// A CSV file as a table, its cells as written in the file.
+/// Rows of a CSV the report shows at most; a longer file shows its worst
+/// rows and is attached whole.
+const SHOWN_ROWS: usize = 20;
+
+/// The columns a `verify.csv` row is ranked by, worst first: the largest
+/// absolute value among them (an empty cell counts 0).
+const RANKED_BY: [&str; 4] = [
+    "miss_distance_decided",
+    "false_alarm_distance_unexplained",
+    "first_contact_error_decided",
+    "push_error",
+];
+
+/// A CSV file as a table, its cells as written in the file. A file of more
+/// than [`SHOWN_ROWS`] rows shows its header and the [`SHOWN_ROWS`] rows
+/// largest by [`RANKED_BY`] (in file order where equal), and is attached
+/// whole as a download inside the page: a verification of 6,100
+/// start-angle pairs once printed as 100 pages.
 fn csv_table(name: &str, text: &str) -> Markup {
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
         .from_reader(text.as_bytes());
+    let mut records: Vec<csv::StringRecord> = reader.records().flatten().collect();
+    let header = if records.is_empty() {
+        csv::StringRecord::new()
+    } else {
+        records.remove(0)
+    };
+    let total = records.len();
+    let columns: Vec<usize> = RANKED_BY
+        .iter()
+        .filter_map(|c| header.iter().position(|h| h == *c))
+        .collect();
+    let key = |r: &csv::StringRecord| -> f64 {
+        columns
+            .iter()
+            .filter_map(|&k| r.get(k)?.parse::<f64>().ok())
+            .map(f64::abs)
+            .fold(0.0, |m, v| if v > m || v.is_nan() { v } else { m })
+    };
+    let shown: Vec<&csv::StringRecord> = if total > SHOWN_ROWS {
+        let mut ranked: Vec<(usize, f64)> = records
+            .iter()
+            .enumerate()
+            .map(|(k, r)| (k, key(r)))
+            .collect();
+        ranked.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+        ranked
+            .iter()
+            .take(SHOWN_ROWS)
+            .map(|&(k, _)| &records[k])
+            .collect()
+    } else {
+        records.iter().collect()
+    };
     html! {
         table class="csv" {
-            caption { code { (name) } }
+            caption {
+                code { (name) }
+                @if total > SHOWN_ROWS {
+                    ": the " (SHOWN_ROWS) " of " (total) " rows with the largest "
+                    @if columns.is_empty() { "values" } @else {
+                        (RANKED_BY.iter().filter(|c| header.iter().any(|h| h == **c)).copied().collect::<Vec<_>>().join(", "))
+                    }
+                    "; every row in the attached file: "
+                    a download=(name) href={ "data:text/csv;base64," (super::html::base64(text.as_bytes())) } {
+                        "download " (name)
+                    }
+                }
+            }
             "\n"
-            @for (k, record) in reader.records().flatten().enumerate() {
+            tr {
+                @for f in &header {
+                    th class="num" { (f) }
+                }
+            }
+            "\n"
+            @for record in &shown {
                 tr {
-                    @for f in &record {
-                        @if k == 0 {
-                            th class="num" { (f) }
-                        } @else {
-                            td class="num" { (f) }
-                        }
+                    @for f in *record {
+                        td class="num" { (f) }
                     }
                 }
                 "\n"
@@ -1185,5 +1312,44 @@ fn run_figures_section(figures: &[(String, Vec<u8>)]) -> Markup {
             }
             "\n"
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A long `verify.csv` shows its header and its 20 worst rows, ranked
+    /// by the largest decided figure, and carries the whole file as a
+    /// download; a short one shows every row.
+    #[test]
+    fn a_long_csv_shows_its_worst_rows_and_attaches_the_file() {
+        let mut text = String::from("i,j,miss_distance_decided,push_error\n");
+        for k in 0..50 {
+            // Row k's worst figure is k (the push error, negative, on odd
+            // rows), so rows 30..49 are the worst 20.
+            let (miss, push) = if k % 2 == 0 {
+                (format!("{k}"), String::new())
+            } else {
+                ("0.5".into(), format!("-{k}"))
+            };
+            text += &format!("{k},{},{miss},{push}\n", k + 100);
+        }
+        let html = csv_table("verify.csv", &text).into_string();
+        assert_eq!(html.matches("<tr>").count(), 1 + SHOWN_ROWS, "{html}");
+        for k in 0..50 {
+            let cell = format!("<td class=\"num\">{}</td>", k + 100);
+            assert_eq!(html.contains(&cell), k >= 30, "row {k}");
+        }
+        let attached = format!(
+            "data:text/csv;base64,{}",
+            super::super::html::base64(text.as_bytes())
+        );
+        assert!(html.contains(&attached));
+        assert!(html.contains("the 20 of 50 rows"), "{html}");
+        let short: String = text.lines().take(11).map(|l| format!("{l}\n")).collect();
+        let html = csv_table("verify.csv", &short).into_string();
+        assert_eq!(html.matches("<tr>").count(), 11);
+        assert!(!html.contains("download"));
     }
 }
