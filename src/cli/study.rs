@@ -141,12 +141,11 @@ pub fn print_verification(result: &Verification, out: &Path) -> ExitCode {
             let hint = match mechanism {
                 Some(Mechanism::Rim) => "; it lies in the knee-form's rim, which the grid samples late (the nearest node met more than sqrt 2 pitches of travel after the touch, where the outline crosses the grid's rows at a shallow angle): a finer pitch narrows the rim, at half order along the slide".to_string(),
                 Some(Mechanism::Sampling) if w.value > std::f64::consts::SQRT_2 * s.pitch_mm => {
-                    let how = if s.unexplained.miss_brief >= w.value - 1e-9 {
-                        ": a strike lasting less than sqrt 2 pitches of travel before the knee-form touches elsewhere (brief), whose nodes the grid meets after it"
+                    if s.unexplained.miss_brief >= w.value - 1e-9 {
+                        "; a strike lasting less than sqrt 2 pitches of travel before the knee-form touches elsewhere (brief): the grid meets its nodes after it; a pitch finer than the touch resolves it".to_string()
                     } else {
-                        ", as where the exact knee-form strikes along a crease of the part between node rows that the grid's strikes meet later"
-                    };
-                    format!("; it falls to half or less with the grid sampled at half the pitch against the same exact trace (first order){how}; a finer pitch resolves it")
+                        "; it falls to half or less with the grid sampled at half the pitch against the same exact trace (first order), as where the exact knee-form strikes along a crease of the part between node rows that the grid's strikes meet later; a finer pitch resolves it".to_string()
+                    }
                 }
                 _ => resolving_pitch(s.pitch_mm, s.tolerance_mm, &w.metric, w.value),
             };

@@ -32,8 +32,10 @@
 //!   the pitch against the same exact trace, falls to at most half
 //!   (shown by refinement: on trimesh's teapot and the console, exact
 //!   strikes along a crease of the mesh between two node rows, which the
-//!   grid's strikes meet later, and brief strikes, lasting less than
-//!   `sqrt 2` pitches of travel). It fails the verdict (the pitch is too
+//!   grid's strikes meet later); or a brief strike, lasting less than
+//!   `sqrt 2` pitches of travel before the knee-form touches elsewhere,
+//!   whose nodes the grid meets after it (its miss falls once the pitch
+//!   is finer than the touch). It fails the verdict (the pitch is too
 //!   coarse for the tolerance).
 //! * **Unexplained.** None of the above: a real disagreement.
 
@@ -256,8 +258,8 @@ pub enum Mechanism {
     /// the size of error the grid makes at this pitch, which a finer pitch
     /// shrinks where the figure converges (`results/`); beyond it, a
     /// start's miss that halves at half the pitch against the same exact
-    /// trace ([`super::metrics::StartComparison::halves`]), a brief strike
-    /// among them. It fails the verdict: the pitch is too coarse for the
+    /// trace ([`super::metrics::StartComparison::halves`]), or a brief
+    /// strike. It fails the verdict: the pitch is too coarse for the
     /// tolerance.
     Sampling,
     /// A real disagreement.

@@ -369,8 +369,8 @@ pub struct Unexplained {
     /// their start (a judged one: not an oracle failure).
     pub unmatched_grid: usize,
     /// `miss_distance_decided` over the exact strikes inside the grid's
-    /// footprint (not in the knee-form's rim) of starts whose miss does
-    /// not halve at half the pitch (`null` when infinite).
+    /// footprint (not in the knee-form's rim), not brief, of starts whose
+    /// miss does not halve at half the pitch (`null` when infinite).
     #[serde(default, with = "crate::harness::compare::infinite_as_null")]
     pub miss_distance: f64,
     /// `area_miss_distance_decided` from those strikes.
@@ -392,8 +392,8 @@ pub struct Unexplained {
     #[serde(default)]
     pub miss_rim: f64,
     /// The largest one of a brief exact strike
-    /// ([`super::metrics::StartComparison::miss_brief`]) in a start whose
-    /// miss halves at half the pitch: sampling in travel.
+    /// ([`super::metrics::StartComparison::miss_brief`]): sampling in
+    /// travel.
     #[serde(default)]
     pub miss_brief: f64,
     /// The largest one inside the footprint, not brief, of a start whose
@@ -774,11 +774,11 @@ pub fn assemble(
             if !d.is_finite() {
                 continue;
             }
-            // Inside the footprint, sampling is shown by refinement
-            // alone: a start's miss that halves at half the pitch.
+            // Inside the footprint and not brief, sampling is shown by
+            // refinement: a start's miss that halves at half the pitch.
             if rim {
                 unexplained.miss_rim = unexplained.miss_rim.max(d);
-            } else if cmp.halves() && brief {
+            } else if brief {
                 unexplained.miss_brief = unexplained.miss_brief.max(d);
             } else if cmp.halves() {
                 unexplained.miss_refined = unexplained.miss_refined.max(d);
@@ -1241,16 +1241,10 @@ mod tests {
     /// A start whose inside miss (3 mm at a 1 mm pitch, beyond `sqrt 2`
     /// pitches) falls to at most half at half the pitch is named
     /// sampling, shown by refinement, in the per-start and the area
-    /// figures; one that does not halve stays unexplained, brief or not.
+    /// figures; one that does not halve stays unexplained, unless brief.
     #[test]
     fn an_inside_miss_that_halves_at_half_the_pitch_is_sampling() {
-        for brief in [false, true] {
-            an_inside_miss_halving(brief);
-        }
-    }
-
-    fn an_inside_miss_halving(brief: bool) {
-        let verdict = |half: f64| {
+        let verdict = |half: f64, brief: bool| {
             let mut cmp = StartComparison {
                 miss: vec![3.0],
                 miss_decided: vec![3.0],
@@ -1265,7 +1259,9 @@ mod tests {
             cmp.points.strikes = vec![[3.0, 0.0]];
             cmp.points.decided = vec![[3.0, 0.0]];
             cmp.points.possible = vec![[3.0, 0.0]];
-            cmp.points.decided_inside = vec![[3.0, 0.0]];
+            if !brief {
+                cmp.points.decided_inside = vec![[3.0, 0.0]];
+            }
             if cmp.halves() {
                 cmp.points.decided_refined = std::mem::take(&mut cmp.points.decided_inside);
             }
@@ -1282,7 +1278,7 @@ mod tests {
                 .map(|f| (f.metric, f.mechanism))
                 .collect::<Vec<_>>()
         };
-        let sampling = verdict(1.5);
+        let sampling = verdict(1.5, false);
         assert_eq!(
             sampling,
             [
@@ -1294,11 +1290,18 @@ mod tests {
             ]
         );
         for half in [1.6, f64::INFINITY] {
-            let v = verdict(half);
+            let v = verdict(half, false);
             assert!(
                 v.len() == 2 && v.iter().all(|(_, m)| *m == Mechanism::Unexplained),
-                "brief {brief}, {half}: {v:?}"
+                "{half}: {v:?}"
             );
         }
+        // A brief strike is sampling by the brief rule, halving or not: its
+        // miss falls once the pitch is finer than the touch.
+        let brief = verdict(f64::INFINITY, true);
+        assert!(
+            brief.len() == 2 && brief.iter().all(|(_, m)| *m == Mechanism::Sampling),
+            "{brief:?}"
+        );
     }
 }

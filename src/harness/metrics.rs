@@ -415,8 +415,8 @@ pub struct StartPoints {
     /// The exact strikes downstream of one, decided or not.
     pub blind: Vec<[f64; 2]>,
     /// The decided exact strikes away from blind spots that lie inside the
-    /// grid's footprint at their travel (not in the knee-form's rim; brief
-    /// ones included).
+    /// grid's footprint at their travel (not in the knee-form's rim), and
+    /// not brief.
     pub decided_inside: Vec<[f64; 2]>,
     /// Those of them in a start whose inside miss halves at half the pitch
     /// ([`StartComparison::halves`]): moved here from `decided_inside`.
@@ -479,14 +479,14 @@ impl StartPoints {
 
 impl StartComparison {
     /// The largest decided miss inside the grid's footprint: over the
-    /// decided exact strikes away from blind spots that are not in the rim
-    /// (brief ones included; mm, `+inf` where the grid strikes nothing in
-    /// the start); `None` where there is none.
+    /// decided exact strikes away from blind spots that are neither in the
+    /// rim nor brief (mm; `+inf` where the grid strikes nothing in the
+    /// start); `None` where there is none.
     pub fn inside_miss(&self) -> Option<f64> {
         self.miss_decided
             .iter()
-            .zip(&self.miss_rim)
-            .filter(|(_, rim)| !**rim)
+            .zip(self.miss_rim.iter().zip(&self.miss_brief))
+            .filter(|(_, (rim, brief))| !**rim && !**brief)
             .map(|(d, _)| *d)
             .reduce(f64::max)
     }
@@ -495,11 +495,10 @@ impl StartComparison {
     /// shown by refinement: with the grid sampled at half the pitch it
     /// falls to at most half its value (first order or better), against
     /// the same exact trace. A crease of the mesh between two node rows,
-    /// struck along by the exact knee-form, is such a miss (the grid's
-    /// strike along it starts later, by less at a finer pitch), and so is
-    /// a brief strike (on trimesh's teapot and the console every brief
-    /// miss beyond `sqrt 2` pitches fell to a half or less: 12.28 to 0.50
-    /// mm, 7.52 to 0.50 mm).
+    /// struck along by the exact knee-form, is such a miss: the grid's
+    /// strike along it starts later, by less at a finer pitch. (A brief
+    /// strike is left to [`StartComparison::miss_brief`]: its miss falls
+    /// once the pitch is finer than the touch, not in proportion to it.)
     pub fn halves(&self) -> bool {
         match (self.inside_miss(), self.miss_half_pitch) {
             (Some(d), Some(h)) => d.is_finite() && h <= 0.5 * d + LEVEL_TOL,
@@ -836,8 +835,8 @@ pub fn compare(
         blind: points(&|c| c.strike && is_blind(c.contact.travel)),
         decided_inside: decided_away
             .iter()
-            .zip(&miss_rim)
-            .filter(|(_, rim)| !**rim)
+            .zip(miss_rim.iter().zip(&miss_brief))
+            .filter(|(_, (rim, brief))| !**rim && !**brief)
             .map(|((_, c), _)| xz(c.contact.witness))
             .collect(),
         decided_refined: Vec::new(),
