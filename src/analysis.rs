@@ -316,9 +316,14 @@ impl Analysis {
                     start_rows: None,
                     probes,
                 };
-                let footprints: Vec<GridFootprint> =
-                    chosen.iter().map(|&a| footprints[a].clone()).collect();
-                colliding_masks(&grid, &footprints, &options, &step)
+                match only {
+                    None => colliding_masks(&grid, &footprints, &options, &step),
+                    Some(only) => {
+                        let mine: Vec<GridFootprint> =
+                            only.iter().map(|&a| footprints[a].clone()).collect();
+                        colliding_masks(&grid, &mine, &options, &step)
+                    }
+                }
             }
             Approach::Direct => {
                 progress.begin("direct approach", Some(chosen.len() as u64));

@@ -763,6 +763,9 @@ pub fn assemble(
         let unmatched_exact = push("miss_distance", &cmp.miss);
         let unmatched_exact_decided = push("miss_distance_decided", &cmp.miss_decided);
         push("miss_distance_blind", &cmp.miss_blind);
+        // Whether this start's inside miss halves: once per start, not
+        // per strike (it reads every strike of the start).
+        let halves = cmp.halves();
         for ((&d, &rim), &brief) in cmp
             .miss_decided
             .iter()
@@ -780,7 +783,7 @@ pub fn assemble(
                 unexplained.miss_rim = unexplained.miss_rim.max(d);
             } else if brief {
                 unexplained.miss_brief = unexplained.miss_brief.max(d);
-            } else if cmp.halves() {
+            } else if halves {
                 unexplained.miss_refined = unexplained.miss_refined.max(d);
             } else {
                 unexplained.miss_distance = unexplained.miss_distance.max(d);

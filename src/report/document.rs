@@ -1021,7 +1021,7 @@ fn csv_table(name: &str, text: &str) -> Markup {
                 @if total > SHOWN_ROWS {
                     ": the " (SHOWN_ROWS) " of " (total) " rows with the largest "
                     @if columns.is_empty() { "values" } @else {
-                        (RANKED_BY.iter().filter(|c| header.iter().any(|h| h == **c)).copied().collect::<Vec<_>>().join(", "))
+                        (columns.iter().map(|&k| &header[k]).collect::<Vec<_>>().join(", "))
                     }
                     "; every row in the attached file: "
                     a download=(name) href={ "data:text/csv;base64," (super::html::base64(text.as_bytes())) } {
