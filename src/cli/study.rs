@@ -9,6 +9,7 @@ use kneeform::harness::{
     Convergence, DECIDED_METRICS, DIRECT_METRICS, DirectConvergence, DirectVerification,
     Verification,
 };
+use kneeform::limits::short;
 
 /// What would resolve a failure, in words: the pitch a first-order error
 /// (`error ~ C p`, what the evidence in `results/` shows for push, miss and
@@ -72,7 +73,11 @@ pub fn print_verification(result: &Verification, out: &Path) -> ExitCode {
         }
     );
     let band = match s.window_mm {
-        Some(w) => format!("drop over {w} mm within its bound of sigma x {w} mm"),
+        Some(w) => format!(
+            "drop over {} mm within its bound of sigma x {} mm",
+            short(w),
+            short(w)
+        ),
         None => format!(
             "deflection rate in [{:.3}, {:.3}] deg",
             s.tie_band.bounds().0.atan().to_degrees(),
@@ -227,9 +232,9 @@ pub fn print_convergence(study: &Convergence, out: &Path) {
                     .filter(|f| f.fails_verdict)
                     .map(|f| f.phrase())
                     .collect();
-                format!(": at {} mm, {}", v.pitch_mm, failing.join("; "))
+                format!(": at {} mm, {}", short(v.pitch_mm), failing.join("; "))
             });
-            eprintln!("kneeform: no pitch tried is within {t} mm{why}")
+            eprintln!("kneeform: no pitch tried is within {} mm{why}", short(t))
         }
         _ => {}
     }
@@ -300,8 +305,12 @@ pub fn print_direct_convergence(study: &DirectConvergence, out: &Path) {
         study.summary.tolerance_mm,
         study.summary.recommended_pitch_mm,
     ) {
-        (Some(t), Some(p)) => eprintln!("kneeform: the coarsest pitch within {t} mm is {p} mm"),
-        (Some(t), None) => eprintln!("kneeform: no pitch tried is within {t} mm"),
+        (Some(t), Some(p)) => eprintln!(
+            "kneeform: the coarsest pitch within {} mm is {} mm",
+            short(t),
+            short(p)
+        ),
+        (Some(t), None) => eprintln!("kneeform: no pitch tried is within {} mm", short(t)),
         _ => {}
     }
     eprintln!("kneeform: results in {}", out.display());

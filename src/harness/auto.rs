@@ -142,7 +142,10 @@ pub fn choose_pitch(
                 tolerance: auto.tolerance,
                 spent_s,
                 next: if next_s > 0.0 {
-                    format!(" and {p} mm would take about {next_s:.0} s more")
+                    format!(
+                        " and {} mm would take about {next_s:.0} s more",
+                        crate::limits::short(p)
+                    )
                 } else {
                     String::new()
                 },
@@ -226,8 +229,11 @@ fn studied(rows: &[PitchStudyRow]) -> String {
     let words: Vec<String> = rows
         .iter()
         .map(|r| match r.exact_area_distance_mm {
-            Some(d) => format!("{} mm: {d:.3} mm", r.pitch_mm),
-            None => format!("{} mm: infinite (one side strikes nothing)", r.pitch_mm),
+            Some(d) => format!("{} mm: {d:.3} mm", crate::limits::short(r.pitch_mm)),
+            None => format!(
+                "{} mm: infinite (one side strikes nothing)",
+                crate::limits::short(r.pitch_mm)
+            ),
         })
         .collect();
     if words.is_empty() {

@@ -199,8 +199,8 @@ pub struct VerifyRow {
     /// Grid strikes.
     pub grid_colliding: usize,
     /// x of the worst decided disagreement of this start (mm, analysis
-    /// frame): the decided exact strike the grid missed furthest, or the
-    /// grid strike furthest from any possible exact one.
+    /// frame, to 1 um): the decided exact strike the grid missed furthest,
+    /// or the grid strike furthest from any possible exact one.
     pub worst_x: Option<f64>,
     /// Its z (mm).
     pub worst_z: Option<f64>,
@@ -465,6 +465,12 @@ pub const STATUSES: [&str; 5] = [
     "oracle_failed",
 ];
 
+/// `v` (mm) to the nearest micrometre, as a float that prints as its
+/// decimal (`1068.88`, not the node's `1068.8799999999999`; never `-0`).
+fn to_micrometre(v: f64) -> f64 {
+    (v * 1e3).round() / 1e3 + 0.0
+}
+
 /// The row of `verify.csv` of the pair at node `(i, j)` and `angle_deg`
 /// whose status is `status` (one of [`STATUSES`]) and comparison `cmp`.
 pub fn row_of(
@@ -493,8 +499,8 @@ pub fn row_of(
         exact_strikes: cmp.exact_strikes,
         exact_undecided: cmp.undecided,
         grid_colliding: cmp.false_alarm.len(),
-        worst_x: worst_at.map(|p| p[0]),
-        worst_z: worst_at.map(|p| p[1]),
+        worst_x: worst_at.map(|p| to_micrometre(p[0])),
+        worst_z: worst_at.map(|p| to_micrometre(p[1])),
         blind: cmp.blind,
         push_blind: cmp.push_blind,
         miss_distance_blind: worst(&cmp.miss_blind),
@@ -1106,7 +1112,7 @@ impl Comparison {
                 .map(Failure::phrase)
                 .collect();
             if of.is_empty() {
-                format!("within {tolerance} mm")
+                format!("within {} mm", crate::limits::short(tolerance))
             } else {
                 of.join(", ")
             }

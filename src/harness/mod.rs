@@ -92,7 +92,7 @@ pub enum HarnessError {
     #[error("no start is placed on this part: nothing to compare")]
     NoStarts,
     /// A start given is not a node of the grid compared.
-    #[error("start ({x}, {z}) mm is not a node of the {pitch} mm grid: the pitches must nest")]
+    #[error("start ({}, {}) mm is not a node of the {} mm grid: the pitches must nest", crate::limits::short(*x), crate::limits::short(*z), crate::limits::short(*pitch))]
     StartNotANode {
         /// The start's x (mm).
         x: f64,

@@ -9,10 +9,10 @@
 //! column: the index, in `summary.json`'s `files`, of the file whose
 //! surface set the node's height; a single part's tables have no such
 //! column. Rows come in a fixed order
-//! (angle, then row j, then column i) and numbers in a fixed form (the
-//! composite's coordinates rounded to 1 um, the colliding points' in Rust's
-//! shortest round-trip form), so the same result always gives the same
-//! bytes.
+//! (angle, then row j, then column i) and numbers in a fixed form (coordinates
+//! rounded to 1 um: a node at `i * p` is written `-282.72`, not its
+//! double's `-282.71999999999997`), so the same result always gives the
+//! same bytes.
 
 use std::fmt::Write as _;
 use std::io::{self, Write};
@@ -23,7 +23,7 @@ use crate::grid::HeightGrid;
 
 /// Writes `angle_deg,i,j,x,y,z`: one row per colliding node per angle, in
 /// increasing angle (degrees), then j, then i; x, y, z the node at its
-/// height in the part's frame (mm). With `node_file` (an assembly's
+/// height in the part's frame (mm, to 1 um). With `node_file` (an assembly's
 /// attribution per node), a last column `file`.
 ///
 /// Fails with [`io::ErrorKind::InvalidInput`] when a mask does not have one
@@ -51,7 +51,7 @@ pub fn write_colliding_points<W: Write>(
         for (k, _) in m.mask.iter().enumerate().filter(|&(_, &v)| v != 0) {
             if first_row[k] == u32::MAX {
                 first_row[k] = nodes.ends.len() as u32;
-                nodes.node(grid, k, placement);
+                nodes.node_rounded(grid, k, placement);
                 if let Some(files) = node_file {
                     nodes.int(files[k] as usize);
                 }
@@ -237,19 +237,8 @@ impl Row {
         self.ends.push(self.text.len());
     }
 
-    /// `i, j, x, y, z` of node `k` (row-major index) in the part's frame.
-    fn node(&mut self, grid: &HeightGrid, k: usize, placement: &Placement) {
-        let (i, j) = (k % grid.spec.nx, k / grid.spec.nx);
-        self.int(i);
-        self.int(j);
-        let [x, y, z] = placement.to_part([grid.spec.x(i), grid.h[k], grid.spec.z(j)]);
-        self.num(x);
-        self.num(y);
-        self.num(z);
-    }
-
-    /// `i, j, x, y, z` of node `k` as [`Row::node`], the coordinates
-    /// rounded to 1 um ([`micrometres`]).
+    /// `i, j, x, y, z` of node `k` (row-major index) in the part's frame,
+    /// the coordinates rounded to 1 um ([`micrometres`]).
     fn node_rounded(&mut self, grid: &HeightGrid, k: usize, placement: &Placement) {
         let (i, j) = (k % grid.spec.nx, k / grid.spec.nx);
         self.int(i);
