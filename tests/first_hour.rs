@@ -133,6 +133,45 @@ fn the_readme_first_command_analyses_and_reports_the_bundled_console() {
     let html = std::fs::read_to_string(dir.join("r.html")).unwrap();
     assert!(html.contains("id=\"main-view\""));
 
+    // Then a verification and a convergence study of it with small
+    // settings, and the report of all three (issue 24, item 2): the worst
+    // rows only, under 5 MB with the 3D view, at most 15 printed pages.
+    let small = ["--angles=-30,0,30", "--starts", "6"];
+    let verify = [
+        &["verify", "scenarios/console_side.stl", "--out", "v"][..],
+        &small,
+    ]
+    .concat();
+    ok(kneeform(&dir, &verify), "verify with small settings");
+    let converge = [
+        &[
+            "converge",
+            "scenarios/console_side.stl",
+            "--pitches",
+            "4.96,2.48,1.24",
+            "--out",
+            "c",
+        ][..],
+        &small,
+    ]
+    .concat();
+    ok(kneeform(&dir, &converge), "converge with small settings");
+    ok(
+        kneeform(
+            &dir,
+            &["report", "kneeform-out", "v", "c", "--out", "all.html"],
+        ),
+        "report with the verification and the study",
+    );
+    let size = std::fs::metadata(dir.join("all.html")).unwrap().len();
+    assert!(size < 5_000_000, "the report is {size} bytes");
+    if let Some(pages) = crate::util::pdf_pages(&dir.join("all.html"), &dir) {
+        assert!(
+            (3..=15).contains(&pages),
+            "the report prints to {pages} pages"
+        );
+    }
+
     // composite.png is cropped to the part: the pale of "no part" is a
     // small share of the image, where the whole grid made it most.
     let pixels =

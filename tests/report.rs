@@ -698,3 +698,142 @@ fn the_report_renders_in_headless_chromium() {
     );
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// The page's DOM after its scripts ran, from headless Chromium with
+/// `flags`; `None` (said on stderr) when Chromium is not installed.
+fn dump_dom(page: &Path, dir: &Path, flags: &[&str]) -> Option<String> {
+    let Some(browser) = crate::util::chromium() else {
+        eprintln!("skipped the browser check: chromium not installed (CI installs it in .ci/run)");
+        return None;
+    };
+    let out = std::process::Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            // Virtual time: the page's asynchronous image decoding is
+            // waited for, however slow the machine.
+            "--virtual-time-budget=30000",
+            "--dump-dom",
+        ])
+        .args(flags)
+        .arg(format!(
+            "--user-data-dir={}",
+            dir.join("chromium-profile").display()
+        ))
+        .arg(format!("file://{}", page.display()))
+        .output()
+        .expect("chromium runs");
+    Some(String::from_utf8_lossy(&out.stdout).into_owned())
+}
+
+/// The value of attribute `name` in the first tag of `dom` that starts
+/// with `tag`.
+fn attribute<'a>(dom: &'a str, tag: &str, name: &str) -> Option<&'a str> {
+    let start = dom.find(tag)?;
+    let end = start + dom[start..].find('>')?;
+    let open = &dom[start..end];
+    let at = open.find(&format!(" {name}=\""))? + name.len() + 3;
+    Some(&open[at..at + open[at..].find('"')?])
+}
+
+/// Issue 24, item 4: the report's interactive 3D view draws the part with
+/// the composite painted on it, and a click on a painted point reads its
+/// coordinates and angles. The probe (`tests/view3d_probe.html`, appended
+/// to the page) waits for the first frame, finds the pixels painted with
+/// the ramp's top colour (struck at every angle), and clicks the middle
+/// one with real pointer events. The step scenario at 2 mm is struck on
+/// the node column x = -2 mm only, at all 5 angles: the pick must land
+/// within half a pitch of it and list the 5 angles.
+#[test]
+fn the_3d_view_draws_the_painted_part_and_reads_a_picked_point() {
+    let dir = step_run("report-view3d", "left");
+    ok(
+        kneeform(&dir, &["report", "run", "--out", "report.html"]),
+        "report",
+    );
+    let page = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    assert!(
+        !page.contains("http://") && !page.contains("https://"),
+        "the page must not reach the network"
+    );
+    let probe = include_str!("view3d_probe.html");
+    std::fs::write(
+        dir.join("probe.html"),
+        page.replace("</body>", &format!("{probe}</body>")),
+    )
+    .unwrap();
+    let Some(dom) = dump_dom(&dir.join("probe.html"), &dir, &[]) else {
+        return;
+    };
+    let figure = "<figure class=\"view3d\"";
+    assert_eq!(
+        attribute(&dom, figure, "data-state"),
+        Some("drawn"),
+        "{}",
+        &dom[..dom.len().min(400)]
+    );
+    let number = |name: &str| -> usize {
+        attribute(&dom, figure, name)
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("no {name}"))
+    };
+    let (part, coloured) = (number("data-part-pixels"), number("data-coloured-pixels"));
+    // The canvas is 1100 x 640: the part fills a good share of it, the
+    // struck strip a small one.
+    assert!(
+        part > 1100 * 640 / 10,
+        "the part shows on {part} pixels only"
+    );
+    assert!(
+        coloured > 100 && coloured < part / 10,
+        "{coloured} painted of {part}"
+    );
+    let yellow: usize = attribute(&dom, "<body", "data-yellow")
+        .and_then(|v| v.parse().ok())
+        .expect("the probe ran");
+    assert!(yellow > 100, "{yellow} pixels of the top colour");
+
+    let start = dom.find("view3d-pick").expect("the readout");
+    let readout = &dom[start..start + dom[start..].find("</p>").unwrap()];
+    assert!(
+        readout.contains("struck at 5 of 5 angles (-30 to 30 degrees)"),
+        "{readout}"
+    );
+    let x: f64 = readout
+        .split("x = ")
+        .nth(1)
+        .and_then(|s| s.split(',').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no x in {readout}"));
+    assert!(
+        (x + 2.0).abs() <= 1.0 + 0.01,
+        "picked x = {x}, not on the column x = -2"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Issue 24, item 4: without WebGL the 3D view says so and hides its
+/// canvas; the static pictures stay.
+#[test]
+fn without_webgl_the_3d_view_gives_way_to_the_pictures() {
+    let dir = step_run("report-view3d-nogl", "left");
+    ok(
+        kneeform(&dir, &["report", "run", "--out", "report.html"]),
+        "report",
+    );
+    let Some(dom) = dump_dom(&dir.join("report.html"), &dir, &["--disable-3d-apis"]) else {
+        return;
+    };
+    assert_eq!(
+        attribute(&dom, "<figure class=\"view3d\"", "data-state"),
+        Some("unavailable")
+    );
+    assert!(dom.contains("No interactive 3D view: this browser has no WebGL 2."));
+    assert!(dom.contains("id=\"main-view\""));
+    std::fs::remove_dir_all(dir).unwrap();
+}

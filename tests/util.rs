@@ -397,7 +397,7 @@ pub fn lines(from: f64, to: f64, step: f64, extra: &[f64]) -> Vec<f64> {
 }
 
 /// Headless Chromium, when installed.
-fn chromium() -> Option<std::path::PathBuf> {
+pub fn chromium() -> Option<std::path::PathBuf> {
     let path = std::env::var_os("PATH")?;
     ["chromium", "chromium-browser"].iter().find_map(|name| {
         std::env::split_paths(&path)
@@ -442,6 +442,48 @@ pub fn screenshot(page: &std::path::Path, dir: &std::path::Path) -> Option<Vec<u
         String::from_utf8_lossy(&out.stderr)
     );
     Some(std::fs::read(&shot).expect("the screenshot"))
+}
+
+/// Prints the page `page` to PDF in headless Chromium (A4, the page's
+/// print stylesheet, no header or footer), with its profile and the PDF in
+/// `dir`; the number of pages, or `None` (said on stderr) when Chromium is
+/// not installed (CI installs it in .ci/run).
+pub fn pdf_pages(page: &std::path::Path, dir: &std::path::Path) -> Option<usize> {
+    let Some(browser) = chromium() else {
+        eprintln!("skipped the print check: chromium not installed (CI installs it in .ci/run)");
+        return None;
+    };
+    let pdf = dir.join("page.pdf");
+    let out = std::process::Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--no-pdf-header-footer",
+        ])
+        .arg(format!(
+            "--user-data-dir={}",
+            dir.join("chromium-profile").display()
+        ))
+        .arg(format!("--print-to-pdf={}", pdf.display()))
+        .arg(format!("file://{}", page.display()))
+        .output()
+        .expect("chromium runs");
+    let bytes = std::fs::read(&pdf).unwrap_or_else(|_| {
+        panic!("no PDF: {}", String::from_utf8_lossy(&out.stderr));
+    });
+    // Each page is one object of type /Page (the page tree's are /Pages).
+    let text = String::from_utf8_lossy(&bytes);
+    let pages = text
+        .match_indices("/Type /Page")
+        .filter(|(at, m)| !text[at + m.len()..].starts_with('s'))
+        .count();
+    assert!(pages > 0, "no page objects in the PDF");
+    Some(pages)
 }
 
 /// A decoded RGB(A) image.

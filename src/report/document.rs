@@ -1,11 +1,13 @@
 //! The report as one self-contained HTML page: images inline as `data:`
-//! URIs, charts and legends as inline SVG, a print stylesheet, no script
-//! and no network.
+//! URIs, charts and legends as inline SVG, a print stylesheet, no network;
+//! one script, the interactive 3D view's ([`super::view3d`]), which the
+//! page does without.
 //!
 //! Sections, in order (each a `<section>` with this id):
 //!
 //! * `result`: the analysed side painted with the composite (the main
-//!   image, `#main-view`), its legend, and the oblique view;
+//!   image, `#main-view`), its legend, the oblique view, and the
+//!   interactive 3D view (`#view3d`);
 //! * `compare` (with `--compare`): a push-and-slide run and a direct one
 //!   of the same part, both areas on one rendered part, and what only
 //!   push-and-slide strikes;
@@ -50,6 +52,8 @@ pub fn verify_label(k: usize, file: &str) -> String {
 pub struct Inputs<'a> {
     /// The run.
     pub run: &'a Run,
+    /// The interactive 3D view's figure ([`super::view3d`]).
+    pub view3d: Markup,
     /// The verification directories, in the order given.
     pub verifications: &'a [Verification],
     /// The rendered views, already PNG-encoded alongside.
@@ -166,11 +170,20 @@ footer { margin-top: 32px; font-size: 11px; color: #555; border-top: 1px solid #
 @page { size: A4; margin: 12mm; }
 @media print {
   body { max-width: none; margin: 0; padding: 0; font-size: 10pt; }
-  h2 { break-after: avoid; }
-  section { break-before: auto; }
-  figure, table.compact, .verdict { break-inside: avoid; }
+  h2 { break-after: avoid; margin-top: 0; }
+  section + section { break-before: page; }
+  figure, table.compact, .verdict, svg { break-inside: avoid; }
+  img, svg { max-width: 100%; height: auto; }
+  img { max-height: 230mm; width: auto; object-fit: contain; }
+  thead { display: table-header-group; }
+  tr, th, td { break-inside: avoid; }
   a { color: inherit; text-decoration: none; }
+  .view3d { display: none; }
 }
+.axes { position: relative; display: inline-block; margin: 22px 0 40px 64px; max-width: calc(100% - 70px); line-height: 0; }
+.axes img.main { max-width: 100%; box-sizing: border-box; }
+.axes svg.axes-overlay { position: absolute; left: 5px; top: 5px; width: calc(100% - 10px); height: calc(100% - 10px); overflow: visible; pointer-events: none; line-height: normal; }
+.view3d canvas { display: block; max-width: 100%; height: auto; border: 1px solid #bbb; cursor: grab; touch-action: none; }
 ";
 
 /// The approach in words.
@@ -324,7 +337,10 @@ fn result_section(inputs: &Inputs) -> Markup {
             "\n"
             figure {
                 "\n"
-                (image_tag(&views.side, &inputs.pngs[0], "main-view", "view main", true))
+                div class="axes" {
+                    (image_tag(&views.side, &inputs.pngs[0], "main-view", "view main", true))
+                    (axes_svg(&views.side.view, if direct { "y" } else { "x" }))
+                }
                 "\n"
                 (legend_svg(n))
                 "\n"
@@ -351,6 +367,7 @@ fn result_section(inputs: &Inputs) -> Markup {
                 "\n"
             }
             "\n"
+            (inputs.view3d)
         }
         "\n"
     }
@@ -426,6 +443,143 @@ fn image_tag(figure: &Figure, png: &[u8], id: &str, class: &str, mapping: bool) 
             data-mm-per-px=[v.map(|v| v.mm_per_px)] data-x-sign=[v.map(|v| v.camera.right[0])]
             src=(png_uri(png));
     }
+}
+
+/// The main image's axes: mm ticks on its lower and left edges, drawn
+/// over the image (an SVG of the image's pixel size laid on it; its
+/// labels reach out into the wrapper's margin), so they scale with it.
+/// `horizontal` names the image's horizontal coordinate (`x`, or `y` for
+/// the direct approach); its sign follows the camera (the right side's
+/// x runs leftwards).
+fn axes_svg(view: &super::render::View, horizontal: &str) -> Markup {
+    let (w, h) = (view.width as f64, view.height as f64);
+    let sign = if view.camera.right[0] + view.camera.right[1] < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    let mm = view.mm_per_px;
+    // The horizontal coordinate at pixel edge `c` is `sign * (u_left + c mm)`.
+    let h_at = |c: f64| sign * (view.u_left + c * mm);
+    let (h0, h1) = (h_at(0.0).min(h_at(w)), h_at(0.0).max(h_at(w)));
+    let (z0, z1) = (view.v_top - h * mm, view.v_top);
+    let step = tick_step((h1 - h0).max(z1 - z0) / 10.0);
+    let ticks = |lo: f64, hi: f64| -> Vec<f64> {
+        let first = (lo / step).ceil() as i64;
+        let last = (hi / step).floor() as i64;
+        (first..=last).map(|k| k as f64 * step).collect()
+    };
+    let label = |v: f64| fmt_num(if v == 0.0 { 0.0 } else { v });
+    html! {
+        svg class="axes-overlay" viewBox=(format!("0 0 {w} {h}")) role="img"
+            aria-label={ "axes: " (horizontal) " and z in mm" } {
+            @for v in ticks(h0, h1) {
+                @let c = (sign * v - view.u_left) / mm;
+                (svg_empty("line", &[("x1", &format!("{c:.1}")), ("x2", &format!("{c:.1}")), ("y1", &format!("{h:.1}")), ("y2", &format!("{:.1}", h + 7.0)), ("stroke", &"#333")]))
+                text x=(format!("{c:.1}")) y=(format!("{:.1}", h + 21.0)) font-size="13" text-anchor="middle" { (label(v)) }
+            }
+            text x=(format!("{:.1}", w)) y=(format!("{:.1}", h + 37.0)) font-size="13" text-anchor="end" {
+                (horizontal) " (mm, vehicle frame)"
+            }
+            @for v in ticks(z0, z1) {
+                @let r = (view.v_top - v) / mm;
+                (svg_empty("line", &[("x1", &"-7"), ("x2", &"0"), ("y1", &format!("{r:.1}")), ("y2", &format!("{r:.1}")), ("stroke", &"#333")]))
+                text x="-10" y=(format!("{:.1}", r + 4.5)) font-size="13" text-anchor="end" { (label(v)) }
+            }
+            text x="-10" y="-6" font-size="13" text-anchor="end" { "z (mm)" }
+        }
+    }
+}
+
+/// The knee-form's cross-section to scale (SPEC, "The knee-form"): the
+/// rounded triangle at angle 0 and at +20 degrees (dashed), the reference
+/// point, L, R, the direction of the slide, and a strip showing W.
+fn knee_form_svg(l: f64, r: f64, w: f64) -> Markup {
+    let h = l * 3f64.sqrt() / 2.0;
+    let tri = [[0.0, 0.0], [h, l / 2.0], [h, -l / 2.0]];
+    let rotate = |[x, z]: [f64; 2], deg: f64| {
+        let (s, c) = deg.to_radians().sin_cos();
+        [x * c - z * s, x * s + z * c]
+    };
+    // The outline of T (+) D_R: for each outward direction, the furthest
+    // vertex plus R along it.
+    let outline = |deg: f64| -> Vec<[f64; 2]> {
+        let t = tri.map(|v| rotate(v, deg));
+        (0..360)
+            .map(|k| {
+                let (nz, nx) = (k as f64).to_radians().sin_cos();
+                let v = t
+                    .iter()
+                    .max_by(|a, b| (a[0] * nx + a[1] * nz).total_cmp(&(b[0] * nx + b[1] * nz)))
+                    .expect("three vertices");
+                [v[0] + r * nx, v[1] + r * nz]
+            })
+            .collect()
+    };
+    let (flat, raised) = (outline(0.0), outline(20.0));
+    let all = flat.iter().chain(&raised);
+    let (x0, x1) = all
+        .clone()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p[0]), b.max(p[0]))
+        });
+    let (z0, z1) = all.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+        (a.min(p[1]), b.max(p[1]))
+    });
+    // 300 px for the taller of the two extents; room for labels around.
+    let scale = 300.0 / (x1 - x0).max(z1 - z0).max(1e-9);
+    let (left, top) = (150.0, 40.0);
+    let px = |[x, z]: [f64; 2]| [left + (x - x0) * scale, top + (z1 - z) * scale];
+    let path = |points: &[[f64; 2]]| {
+        let mut d = String::new();
+        for (k, p) in points.iter().enumerate() {
+            let [a, b] = px(*p);
+            d.push_str(&format!("{}{a:.1},{b:.1} ", if k == 0 { "M" } else { "L" }));
+        }
+        d.push('Z');
+        d
+    };
+    let [rx, ry] = px([0.0, 0.0]);
+    let [b1x, b1y] = px(tri[1]);
+    let [b2x, b2y] = px(tri[2]);
+    let [rr_x, rr_y] = px([tri[1][0] + r, tri[1][1]]);
+    let width = left + (x1 - x0) * scale + 230.0;
+    let height = top + (z1 - z0) * scale + 60.0;
+    // The thickness strip: W along y to the same scale, beside the section.
+    let (sx, sy) = (left + (x1 - x0) * scale + 60.0, top + 20.0);
+    let (sw, sh) = ((w * scale).min(150.0), (x1 - x0) * scale * 0.5);
+    let f = |v: f64| format!("{v:.1}");
+    html! {
+        svg class="knee-form" width=(f(width)) height=(f(height)) viewBox=(format!("0 0 {} {}", f(width), f(height)))
+            role="img" aria-label="the knee-form's cross-section with L, R, W and the reference point" {
+            (svg_empty("path", &[("d", &path(&raised)), ("fill", &"none"), ("stroke", &"#888"), ("stroke-dasharray", &"6 4")]))
+            (svg_empty("path", &[("d", &path(&flat)), ("fill", &"#e8eef8"), ("stroke", &"#1a1a1a"), ("stroke-width", &"1.5")]))
+            (svg_empty("path", &[("d", &format!("M{rx:.1},{ry:.1} L{b1x:.1},{b1y:.1} L{b2x:.1},{b2y:.1} Z")), ("fill", &"none"), ("stroke", &"#555"), ("stroke-width", &"0.8")]))
+            (svg_empty("circle", &[("cx", &f(rx)), ("cy", &f(ry)), ("r", &"4"), ("fill", &"#c62828")]))
+            text x=(f(rx - 8.0)) y=(f(ry - 10.0)) font-size="12" text-anchor="end" fill="#c62828" { "reference point" }
+            text x=(f(b1x + 8.0)) y=(f(0.5 * (b1y + b2y))) font-size="12" { "L = " (fmt_num(l)) " mm" }
+            (svg_empty("line", &[("x1", &f(b1x)), ("y1", &f(b1y)), ("x2", &f(rr_x)), ("y2", &f(rr_y)), ("stroke", &"#1a1a1a")]))
+            text x=(f(rr_x + 4.0)) y=(f(rr_y + 4.0)) font-size="12" { "R = " (fmt_num(r)) " mm" }
+            text x=(f(b1x - 40.0)) y=(f(top - 8.0)) font-size="12" fill="#666" { "+20" (PreEscaped("&deg;")) ": back raised" }
+            (svg_empty("path", &[("d", &format!("M{:.1},{:.1} l-70,0 m0,0 l10,-5 m-10,5 l10,5", rx - 20.0, height - 20.0)), ("stroke", &"#1a1a1a"), ("fill", &"none"), ("stroke-width", &"1.5")]))
+            text x=(f(rx - 20.0)) y=(f(height - 6.0)) font-size="12" text-anchor="end" { "slides in -x" }
+            text x=(f(left)) y="16" font-size="12" { "x (right), z (up)" }
+            (svg_empty("rect", &[("x", &f(sx)), ("y", &f(sy)), ("width", &f(sw)), ("height", &f(sh)), ("fill", &"#e8eef8"), ("stroke", &"#1a1a1a")]))
+            text x=(f(sx + 0.5 * sw)) y=(f(sy + sh + 16.0)) font-size="12" text-anchor="middle" { "W = " (fmt_num(w)) " mm" }
+            text x=(f(sx + 0.5 * sw)) y=(f(sy + sh + 30.0)) font-size="12" text-anchor="middle" { "along the push (y)" }
+        }
+    }
+}
+
+/// A tick step of 1, 2 or 5 times a power of ten, at least `raw` (mm).
+fn tick_step(raw: f64) -> f64 {
+    let raw = raw.max(1e-9);
+    let decade = 10f64.powf(raw.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * decade)
+        .find(|s| *s >= raw * (1.0 - 1e-12))
+        .unwrap_or(10.0 * decade)
 }
 
 /// The composite's colour ramp as an SVG bar, one swatch per count.
@@ -543,6 +697,13 @@ fn method_section(run: &Run) -> Markup {
         section id="method" {
             "\n"
             h2 { "3. Knee-form and analysis" }
+            "\n"
+            figure {
+                (knee_form_svg(s.triangle_side_mm, s.radius_mm, s.thickness_mm))
+                figcaption {
+                    "The knee-form's cross-section in the x-z plane (to scale): an equilateral triangle of side L rounded by R, its reference point the centre of the front corner's rounding; it is extruded over the thickness W along the push. Solid: angle 0; dashed: +20 degrees, which raises the back (negative angles lower it). It slides in -x, towards the vehicle front."
+                }
+            }
             "\n"
             table class="compact" {
                 "\n"
@@ -1351,5 +1512,97 @@ mod tests {
         let html = csv_table("verify.csv", &short).into_string();
         assert_eq!(html.matches("<tr>").count(), 11);
         assert!(!html.contains("download"));
+    }
+
+    /// The numbers of an SVG attribute `name` in `svg`, in order.
+    fn attribute_values(svg: &str, name: &str) -> Vec<f64> {
+        svg.match_indices(&format!(" {name}=\""))
+            .filter_map(|(at, m)| {
+                let rest = &svg[at + m.len()..];
+                rest[..rest.find('"')?].parse().ok()
+            })
+            .collect()
+    }
+
+    /// Issue 24, item 3: the knee-form is drawn to scale with the run's
+    /// L, R and W: the outline at angle 0 is `L sqrt(3) / 2 + 2 R` wide
+    /// and `L + 2 R` tall (SPEC), and its labels give the three values.
+    #[test]
+    fn the_knee_form_is_drawn_to_scale_with_its_dimensions() {
+        for (l, r, w) in [(200.0, 60.0, 120.0), (190.0, 35.0, 80.0)] {
+            let svg = knee_form_svg(l, r, w).into_string();
+            for label in [
+                format!("L = {l} mm"),
+                format!("R = {r} mm"),
+                format!("W = {w} mm"),
+            ] {
+                assert!(svg.contains(&label), "{label} missing");
+            }
+            // The second path is the outline at angle 0 (the first is the
+            // raised one, dashed).
+            let d = svg.split(" d=\"").nth(2).expect("the outline");
+            let d = &d[..d.find('"').unwrap()];
+            let points: Vec<[f64; 2]> = d
+                .trim_end_matches('Z')
+                .split_whitespace()
+                .map(|p| {
+                    let (a, b) = p[1..].split_once(',').unwrap();
+                    [a.parse().unwrap(), b.parse().unwrap()]
+                })
+                .collect();
+            let extent = |k: usize| {
+                let v = points.iter().map(|p| p[k]);
+                v.clone().fold(f64::NEG_INFINITY, f64::max) - v.fold(f64::INFINITY, f64::min)
+            };
+            let ratio = extent(0) / extent(1);
+            let expected = (l * 3f64.sqrt() / 2.0 + 2.0 * r) / (l + 2.0 * r);
+            assert!(
+                (ratio - expected).abs() < 0.01 * expected,
+                "{ratio} against {expected}"
+            );
+            assert!(svg.contains("reference point") && svg.contains("slides in -x"));
+        }
+    }
+
+    /// Issue 24, item 3: the main image's mm ticks sit where the image's
+    /// pixel mapping puts their values, for a left side (x to the right)
+    /// and a right side (x to the left).
+    #[test]
+    fn the_axes_ticks_sit_at_their_coordinates() {
+        use super::super::render::{Camera, View};
+        use nalgebra::Vector3;
+        for sign in [1.0, -1.0] {
+            let view = View {
+                camera: Camera::looking(Vector3::new(0.0, sign, 0.0), Vector3::z()),
+                u_left: -10.0,
+                v_top: 40.0,
+                mm_per_px: 0.5,
+                width: 200,
+                height: 100,
+            };
+            assert_eq!(view.camera.right[0], sign);
+            let svg = axes_svg(&view, "x").into_string();
+            // The ticks' labels and their x (the first line's, per tick).
+            let labels: Vec<f64> = svg
+                .split("text-anchor=\"middle\">")
+                .skip(1)
+                .map(|t| t[..t.find('<').unwrap()].parse().unwrap())
+                .collect();
+            let xs: Vec<f64> = attribute_values(&svg, "x1");
+            assert!(labels.len() >= 5, "{svg}");
+            for (v, c) in labels.iter().zip(&xs) {
+                // The horizontal coordinate at pixel edge c is sign * (u_left + c mm).
+                assert!(
+                    (sign * (-10.0 + c * 0.5) - v).abs() < 0.05 + 1e-9,
+                    "{v} at {c}"
+                );
+            }
+            // z ticks: row r holds z = v_top - r mm.
+            assert!(svg.contains("z (mm)") && svg.contains("x (mm, vehicle frame)"));
+        }
+        assert_eq!(tick_step(9.0), 10.0);
+        assert_eq!(tick_step(10.0), 10.0);
+        assert_eq!(tick_step(11.0), 20.0);
+        assert_eq!(tick_step(0.3), 0.5);
     }
 }

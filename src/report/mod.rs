@@ -25,6 +25,7 @@ mod html;
 mod render;
 mod run;
 mod verify;
+mod view3d;
 mod views;
 
 pub use self::document::MAIN_BORDER;
@@ -218,8 +219,10 @@ fn build_report(options: &ReportOptions) -> Result<(String, Report), ReportError
     if let Some(name) = &options.run_name {
         run.dir.clone_from(name);
     }
+    let view3d = view3d::view3d_figure(&run)?;
     let html = document::document(&document::Inputs {
         run: &run,
+        view3d,
         verifications: &verifications,
         views: &views,
         pngs: &pngs,

@@ -50,10 +50,14 @@ impl NodeCounts {
     ///
     /// This is the report's rule for painting a surface point: a point is
     /// coloured when it lies within half a pitch, in x and in z, of a
-    /// colliding node.
+    /// colliding node. The cells are closed within [`CELL_TOL`]: a point
+    /// on the border of two cells is in both, whatever the rounding of the
+    /// renderer's depth made of it (a face lying on the border, the pocket
+    /// floor of `scenarios/pocket-behind-ridge.toml` half a pitch between
+    /// the direct grid's node columns, was speckled grey pixel by pixel).
     pub fn at(&self, x: f64, z: f64) -> Option<(u16, f64)> {
         let s = &self.spec;
-        let half = 0.5 * s.pitch;
+        let half = 0.5 * s.pitch + CELL_TOL;
         let near = |v: f64, origin: i64, n: usize| {
             let k = (v / s.pitch).round() as i64 - origin;
             (k - 1).max(0)..(k + 2).min(n as i64)
@@ -81,6 +85,16 @@ impl NodeCounts {
     pub fn nodes(&self) -> usize {
         self.count.iter().filter(|&&c| c > 0).count()
     }
+}
+
+/// Every node's set of striking angles ([`Run::angle_bits`]).
+#[derive(Debug, Clone)]
+pub struct AngleBits {
+    /// Bytes per node: `ceil(angles / 8)`.
+    pub bytes: usize,
+    /// `bytes` per node, row-major by z; bit `a % 8` of byte `a / 8` is
+    /// the run's angle `a`.
+    pub bits: Vec<u8>,
 }
 
 /// A run directory, read.
@@ -286,6 +300,49 @@ impl Run {
         Ok(masks)
     }
 
+    /// Every node's set of striking angles, from `composite.csv`'s
+    /// `angle_mask`: `bytes` bytes per node (row-major by z, as
+    /// [`NodeCounts`]), bit `a % 8` of byte `a / 8` set when the run's
+    /// angle `a` strikes the node. `None` for a run of a version that wrote
+    /// no masks.
+    pub fn angle_bits(&self) -> Result<Option<AngleBits>, ReportError> {
+        let composite = self.dir.join("composite.csv");
+        let mut rows = CsvRows::open(&composite, &[])?;
+        if !rows.has_column("angle_mask") {
+            return Ok(None);
+        }
+        rows = CsvRows::open(&composite, &["i", "j", "x", "y", "z", "angle_mask"])?;
+        let n = self.summary.angles_deg.len();
+        let digits = n.div_ceil(4).max(1);
+        let bytes = n.div_ceil(8).max(1);
+        let len = self.spec.len() * bytes;
+        let mut bits = crate::limits::try_filled(len, 0u8).map_err(|e| ReportError::Memory {
+            what: format!(
+                "the angle sets of a {} x {} grid",
+                self.spec.nx, self.spec.nz
+            ),
+            source: e,
+        })?;
+        while let Some(row) = rows.next_row()? {
+            let (k, _) = rows.node(&row, self.spec, &self.frame, self.axes)?;
+            let field = row.get(rows.columns[5]).unwrap_or("");
+            let hex = field
+                .strip_prefix("0x")
+                .filter(|h| h.len() == digits && h.bytes().all(|b| b.is_ascii_hexdigit()))
+                .ok_or_else(|| {
+                    rows.bad(format!(
+                        "angle_mask = {field:?} is not 0x and {digits} hex digits"
+                    ))
+                })?;
+            // Digit d from the right holds angles 4d..4d+4: two digits a byte.
+            for (d, digit) in hex.bytes().rev().enumerate() {
+                let nibble = char::from(digit).to_digit(16).expect("checked hex") as u8;
+                bits[k * bytes + d / 2] |= nibble << (4 * (d % 2));
+            }
+        }
+        Ok(Some(AngleBits { bytes, bits }))
+    }
+
     /// [`Run::angle_masks`] from `colliding_points.csv`, as earlier
     /// versions wrote it by default.
     fn angle_masks_of_points(&self, angles: &[f64]) -> Result<Vec<NodeCounts>, ReportError> {
@@ -341,6 +398,12 @@ pub fn grid_spec(s: &Summary) -> Option<GridSpec> {
         nz: s.grid_size[1],
     })
 }
+
+/// How far past half a pitch (mm) a point still lies in a node's cell
+/// ([`NodeCounts::at`]): far above the rounding of a rendered surface
+/// point (a few units in the last place of its coordinates, about 1e-13
+/// mm on a part of a metre), far below a pixel of any view.
+pub const CELL_TOL: f64 = 1e-6;
 
 /// How far (relative to the coordinate, or to the pitch near 0) a grid
 /// coordinate read back from a file may be from the node it names: a few
@@ -496,7 +559,7 @@ struct CsvRows {
     line: u64,
     headers: csv::StringRecord,
     /// How far a coordinate may be from its node beyond float rounding
-    /// (mm): [`ROUNDED_TOL_MM`] in a table of rounded coordinates.
+    /// (mm): [`ROUNDED_TOL_MM`], the tables' rounding.
     rounding: f64,
 }
 
@@ -523,8 +586,6 @@ impl CsvRows {
                     .ok_or_else(|| bad(format!("no column {w:?}")))
             })
             .collect::<Result<_, _>>()?;
-        // The compact composite (it has the masks) rounds to 1 um.
-        let rounded = headers.iter().any(|h| h == "angle_mask");
         Ok(CsvRows {
             path: path.to_path_buf(),
             reader,
@@ -532,7 +593,9 @@ impl CsvRows {
             names: wanted.iter().map(|w| w.to_string()).collect(),
             line: 1,
             headers,
-            rounding: if rounded { ROUNDED_TOL_MM } else { 0.0 },
+            // Both tables round their coordinates to 1 um (an earlier
+            // version's colliding_points.csv wrote them whole: it passes).
+            rounding: ROUNDED_TOL_MM,
         })
     }
 

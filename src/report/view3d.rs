@@ -1,0 +1,274 @@
+//! The report's interactive 3D view: the part with the composite painted
+//! on it, drawn by WebGL 2 in the page itself (no library, no network).
+//!
+//! The page carries three things, base64 in one JSON block:
+//!
+//! * the part's triangles (vehicle coordinates, as the static views draw
+//!   them), vertices shared, as little-endian `f32` offsets from the
+//!   bounding box's centre and `u32` indices;
+//! * the grid's nodes as an RGBA PNG, one pixel per node (row `j`, column
+//!   `i`): red the composite count, green and blue the node's depth on the
+//!   grid in 16-bit fixed point over the colliding nodes' depth range;
+//! * each node's set of striking angles as an RGBA PNG, `ceil(bytes / 3)`
+//!   pixels per node (red, green, blue; alpha 255), bit `a % 8` of byte `a / 8` for the run's angle `a`
+//!   ([`Run::angle_bits`]), for reading a picked point's angles.
+//!
+//! The fragment shader paints a surface point by the static oblique view's
+//! rule ([`super::views`]): the count of its nearest node in x and z (the
+//! run's grid axes), when the point lies within
+//! [`OBLIQUE_Y_TOL_PITCHES`] pitches of the node's depth; grey otherwise.
+//! A click casts a ray against the triangles and reads the node under the
+//! hit. Where WebGL 2 is missing the figure says so and the static
+//! pictures stand; a print hides it.
+
+use std::collections::HashMap;
+
+use maud::{Markup, PreEscaped, html};
+use serde_json::json;
+
+use crate::frame::Approach;
+
+use super::ReportError;
+use super::html::base64;
+use super::run::Run;
+use super::views::{OBLIQUE_Y_TOL_PITCHES, composite_colour, ramp_len, run_oblique_camera};
+
+/// The most triangles the page carries (about 17 MB of base64 at the
+/// worst, no vertex shared); a larger part gets a note instead.
+pub const MAX_TRIANGLES: usize = 400_000;
+/// The most grid nodes the page carries: WebGL 2 guarantees textures of
+/// 2048 x 2048 only, and most browsers allow 8192 or more.
+pub const MAX_NODES: usize = 8192 * 8192;
+
+/// The 3D view's figure: a canvas, its controls' help, the readout of a
+/// picked point, and the data; or a note saying why there is none.
+pub fn view3d_figure(run: &Run) -> Result<Markup, ReportError> {
+    let triangles = &run.part.triangles;
+    let spec = run.spec;
+    if triangles.len() > MAX_TRIANGLES || spec.len() > MAX_NODES {
+        return Ok(html! {
+            p class="note" {
+                "No interactive 3D view: the part has " (triangles.len()) " triangles and the grid "
+                (spec.len()) " nodes, more than the page carries (" (MAX_TRIANGLES)
+                " triangles, " (MAX_NODES) " nodes); the pictures above show the same colours."
+            }
+            "\n"
+        });
+    }
+    let data = scene_json(run)?;
+    // `</` cannot appear in the JSON's strings (base64 and numbers), so the
+    // script element holds it whole.
+    let data = data.replace("</", "<\\/");
+    Ok(html! {
+        figure class="view3d" id="view3d" data-state="loading" {
+            "\n"
+            canvas width="1100" height="640" aria-label="interactive 3D view of the part" {}
+            "\n"
+            figcaption {
+                span class="view3d-status" { "Interactive 3D view: loading." }
+                noscript { " Scripts are off: the pictures above show the same colours." }
+                " Drag to turn, shift-drag (or right-drag) to move, wheel to zoom, double-click to reset; click a point to read its coordinates (vehicle frame, mm), its grid node and the angles that strike it. Colours as above; a surface point is painted by its nearest node in "
+                (if run.summary.approach == Approach::Direct { "y" } else { "x" })
+                " and z when it lies within " (OBLIQUE_Y_TOL_PITCHES) " pitches of the node's depth."
+            }
+            "\n"
+            p class="view3d-pick mono" { "No point picked." }
+            "\n"
+            script type="application/json" id="view3d-data" { (PreEscaped(data)) }
+            "\n"
+            script { (PreEscaped(SCRIPT)) }
+            "\n"
+        }
+        "\n"
+    })
+}
+
+/// The scene as JSON: geometry, node textures, the ramp, the grid's
+/// placement and the first camera.
+fn scene_json(run: &Run) -> Result<String, ReportError> {
+    let (centre, radius, positions, indices) = mesh(&run.part.triangles);
+    let spec = run.spec;
+    let composite = &run.composite;
+    let (lo, hi) = composite
+        .count
+        .iter()
+        .zip(&composite.y)
+        .filter(|(c, y)| **c > 0 && y.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (_, &y)| {
+            (lo.min(y), hi.max(y))
+        });
+    let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 1.0) };
+    let range = (hi - lo).max(1e-9);
+    let mut nodes = vec![0u8; spec.len() * 4];
+    for (k, px) in nodes.chunks_exact_mut(4).enumerate() {
+        let c = composite.count[k];
+        let y = composite.y[k];
+        let q = if c > 0 && y.is_finite() {
+            ((y - lo) / range * 65535.0).round().clamp(0.0, 65535.0) as u16
+        } else {
+            0
+        };
+        px.copy_from_slice(&[c.min(255) as u8, (q >> 8) as u8, q as u8, 255]);
+    }
+    let nodes_png = rgba_png(spec.nx, spec.nz, &nodes)?;
+    let angle_bits = run.angle_bits()?;
+    let (masks_png, words) = match &angle_bits {
+        None => (None, 0),
+        Some(bits) => {
+            // Three bytes a pixel, alpha 255: a browser premultiplies a
+            // pixel's colour by its alpha, which would lose the bits.
+            let words = bits.bytes.div_ceil(3);
+            let mut px = vec![255u8; spec.len() * words * 4];
+            for k in 0..spec.len() {
+                for (b, &byte) in bits.bits[k * bits.bytes..][..bits.bytes].iter().enumerate() {
+                    px[(k * words + b / 3) * 4 + b % 3] = byte;
+                }
+                for b in bits.bytes..words * 3 {
+                    px[(k * words + b / 3) * 4 + b % 3] = 0;
+                }
+            }
+            (Some(rgba_png(spec.nx * words, spec.nz, &px)?), words)
+        }
+    };
+    let n = ramp_len(run);
+    let ramp: Vec<u8> = (1..=n)
+        .flat_map(|c| {
+            let [r, g, b] = composite_colour(c as u16, n);
+            [r, g, b, 255]
+        })
+        .collect();
+    let to_grid: [f64; 9] = match run.axes.approach {
+        // Rows of the vehicle -> grid map ([`GridAxes::grid`]).
+        Approach::Slide => [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+        Approach::Direct => [
+            0.0,
+            run.axes.side.to_part(1.0),
+            0.0,
+            -1.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            1.0,
+        ],
+    };
+    let forward = run_oblique_camera(run.axes).forward;
+    Ok(json!({
+        "centre": centre,
+        "radius": radius,
+        "positions": base64(&positions),
+        "indices": base64(&indices),
+        "triangles": run.part.triangles.len(),
+        "pitch": spec.pitch,
+        "origin": [spec.i_origin, spec.j_origin],
+        "size": [spec.nx, spec.nz],
+        "to_grid": to_grid,
+        "depth_range": [lo, hi],
+        "depth_tol": OBLIQUE_Y_TOL_PITCHES * spec.pitch,
+        "nodes_png": base64(&nodes_png),
+        "masks_png": masks_png.as_deref().map(base64),
+        "mask_words": words,
+        "ramp": base64(&ramp),
+        "angles": run.summary.angles_deg,
+        "view": [forward.x, forward.y, forward.z],
+        "frame": !run.frame.is_none(),
+    })
+    .to_string())
+}
+
+/// The triangles as shared vertices: the bounding box's centre, the
+/// radius of its sphere, the vertices' `f32` offsets from the centre and
+/// the triangles' `u32` indices (little-endian bytes). Vertices are shared
+/// where their offsets are equal to the bit.
+fn mesh(triangles: &[crate::mesh::Triangle]) -> ([f64; 3], f64, Vec<u8>, Vec<u8>) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in triangles.iter().flatten() {
+        for a in 0..3 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    if triangles.is_empty() {
+        (lo, hi) = ([0.0; 3], [0.0; 3]);
+    }
+    let centre = [0, 1, 2].map(|a| 0.5 * (lo[a] + hi[a]));
+    let radius = (0..3)
+        .map(|a| (hi[a] - lo[a]).powi(2))
+        .sum::<f64>()
+        .sqrt()
+        .max(1.0)
+        * 0.5;
+    let mut shared: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut positions = Vec::new();
+    let mut indices = Vec::with_capacity(triangles.len() * 12);
+    for p in triangles.iter().flatten() {
+        let v = [0, 1, 2].map(|a| (p[a] - centre[a]) as f32);
+        let key = v.map(f32::to_bits);
+        let next = shared.len() as u32;
+        let index = *shared.entry(key).or_insert_with(|| {
+            for c in v {
+                positions.extend_from_slice(&c.to_le_bytes());
+            }
+            next
+        });
+        indices.extend_from_slice(&index.to_le_bytes());
+    }
+    (centre, radius, positions, indices)
+}
+
+/// RGBA pixels (`width` x `height`, row-major) as PNG bytes.
+fn rgba_png(width: usize, height: usize, pixels: &[u8]) -> Result<Vec<u8>, ReportError> {
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, width as u32, height as u32);
+    encoder.set_color(png::ColorType::Rgba);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_compression(png::Compression::Best);
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(pixels)?;
+    writer.finish()?;
+    Ok(bytes)
+}
+
+/// The viewer: WebGL 2, written here. It sets the figure's `data-state`
+/// to `drawn` (with `data-part-pixels` and `data-coloured-pixels`, the
+/// canvas pixels showing the part and those painted with a ramp colour,
+/// counted once after the first frame) or `unavailable` (and says why).
+const SCRIPT: &str = include_str!("view3d.js");
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shared vertices and indices give back every triangle (to f32),
+    /// a vertex shared by two triangles is stored once, and the centre and
+    /// radius are the bounding box's.
+    #[test]
+    fn the_mesh_shares_vertices_and_gives_back_every_triangle() {
+        let tris = vec![
+            [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [0.0, 0.0, 20.0]],
+            [[10.0, 0.0, 0.0], [10.0, 4.0, 20.0], [0.0, 0.0, 20.0]],
+        ];
+        let (centre, radius, positions, indices) = mesh(&tris);
+        assert_eq!(centre, [5.0, 2.0, 10.0]);
+        assert!((radius - 0.5 * (100.0f64 + 16.0 + 400.0).sqrt()).abs() < 1e-12);
+        let floats: Vec<f32> = positions
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+            .collect();
+        let index: Vec<usize> = indices
+            .chunks_exact(4)
+            .map(|b| u32::from_le_bytes(b.try_into().unwrap()) as usize)
+            .collect();
+        assert_eq!(floats.len(), 4 * 3, "four distinct vertices");
+        assert_eq!(index.len(), 6);
+        for (t, tri) in tris.iter().enumerate() {
+            for (v, p) in tri.iter().enumerate() {
+                let k = index[3 * t + v];
+                for a in 0..3 {
+                    assert_eq!(f64::from(floats[3 * k + a]) + centre[a], p[a]);
+                }
+            }
+        }
+    }
+}
