@@ -86,6 +86,7 @@ fn errors_shrink_with_the_pitch_on_smooth_parts() {
             selection: StartSelection::Sample { count: 25, seed: 3 },
             tie_band_per_mm: TieBand::DEFAULT_PER_MM,
             tolerance: None,
+            budget_s: None,
         };
         let study =
             harness::converge(&input(&scenario(s)), &setup(4.0, &[0.0]), &options, &()).unwrap();

@@ -327,3 +327,39 @@ fn verify_predicts_its_oracle_time_and_keeps_within_a_budget() {
     let csv = |d: &str| std::fs::read_to_string(dir.join(d).join("verify.csv")).unwrap();
     assert_eq!(csv("free"), csv("budget"), "the same rows either way");
 }
+
+/// Issue 26, item 4, for `converge`: its oracle runs once for the whole
+/// ladder, and its predicted time is printed and held to `--budget-s`
+/// as `verify`'s is, naming the `--shard` count that would fit.
+#[test]
+fn converge_predicts_its_oracle_time_and_keeps_within_a_budget() {
+    let dir = scratch_dir("second-hour-converge-budget");
+    let common = [
+        "converge",
+        &scenario("bump"),
+        "--pitches",
+        "8,4",
+        "--angles=-30,0,30",
+        "--starts",
+        "40",
+    ];
+    let run = |out: &str, extra: &[&str]| {
+        kneeform_in(&dir, &[&common[..], &["--out", out], extra].concat())
+    };
+    let o = run("refused", &["--budget-s", "0.000001"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--budget-s") && err.contains("--shard K/"),
+        "{err}"
+    );
+    assert!(!dir.join("refused").exists(), "a refused run wrote nothing");
+    let o = run("free", &["--budget-s", "100000"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    assert!(
+        err.contains("predicted from 2 of the 40 starts at every angle"),
+        "{err}"
+    );
+    assert!(dir.join("free/converge.json").is_file());
+}

@@ -456,6 +456,12 @@ pub struct ConvergeArgs {
     /// within this (mm).
     #[arg(long, value_name = "MM")]
     pub tolerance: Option<f64>,
+    /// The longest the exact oracle may take (seconds), as verify's: one
+    /// start in twenty is traced first, at every angle; its time predicts
+    /// the rest (always printed), and a prediction beyond this is refused
+    /// (exit 2) naming the --shard count that would fit. Default: no limit.
+    #[arg(long, value_name = "S")]
+    pub budget_s: Option<f64>,
     /// Output directory for converge.csv, converge.json and the plots.
     #[arg(long, default_value = "kneeform-converge", value_name = "DIR")]
     pub out: PathBuf,

@@ -34,10 +34,17 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
         selection: args.study.starts.validate()?,
         tie_band_per_mm: args.study.starts.tie_band,
         tolerance: args.tolerance,
+        budget_s: args.budget_s,
     };
     let shard = super::study_shard(&args.study)?;
     let (input, setup) = super::study_inputs(&args.study, options.validate())?;
     if setup.approach == Approach::Direct {
+        if args.budget_s.is_some() {
+            // The direct study casts once per position: no sample predicts it.
+            eprintln!(
+                "kneeform: warning: --budget-s is not applied with --approach direct (one cast per knee position; --shard fans it out)"
+            );
+        }
         if let Some(shard) = shard {
             let part =
                 harness::converge_direct_shard(&input, &setup, &options, shard, &Bars::default())

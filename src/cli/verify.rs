@@ -23,6 +23,12 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
     let shard = super::study_shard(&args.study)?;
     let (input, setup) = super::study_inputs(&args.study, options.validate())?;
     if setup.approach == Approach::Direct {
+        if args.budget_s.is_some() {
+            // The direct study casts once per position: no sample predicts it.
+            eprintln!(
+                "kneeform: warning: --budget-s is not applied with --approach direct (one cast per knee position; --shard fans it out)"
+            );
+        }
         if let Some(shard) = shard {
             let part =
                 harness::verify_direct_shard(&input, &setup, &options, shard, &Bars::default())

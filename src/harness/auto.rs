@@ -117,6 +117,7 @@ pub fn choose_pitch(
         super::converge::Share {
             shard: None,
             oracle_budget_s: Some(auto.budget_s),
+            refuse_beyond_s: None,
         },
         progress,
     )?;

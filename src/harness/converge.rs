@@ -213,6 +213,9 @@ pub(super) struct Share {
     /// Seconds the oracle may take (a pitch study's budget; unbounded
     /// when `None`).
     pub oracle_budget_s: Option<f64>,
+    /// The oracle's predicted time beyond which the study is refused
+    /// before the traces (`--budget-s`; none when `None`).
+    pub refuse_beyond_s: Option<f64>,
 }
 
 /// The exact traces of `starts` at `angles` (in [`run_oracle`]'s order),
@@ -279,6 +282,7 @@ impl<'a> Ladder<'a> {
         let Share {
             shard,
             oracle_budget_s,
+            refuse_beyond_s,
         } = share;
         setup.validate()?;
         let triangles = &input.part.triangles;
@@ -289,7 +293,14 @@ impl<'a> Ladder<'a> {
         let starts = super::sharded::share(&all_starts, shard)?;
         let oracle = oracle_options(&setup.knee, finest, coarse.x(0));
         let (traces, oracle_s) = match oracle_budget_s {
-            None => run_oracle(triangles, &starts, &setup.angles, &oracle, None, progress)?,
+            None => run_oracle(
+                triangles,
+                &starts,
+                &setup.angles,
+                &oracle,
+                refuse_beyond_s,
+                progress,
+            )?,
             Some(budget_s) => traces_within(
                 triangles,
                 &starts,
@@ -423,6 +434,10 @@ pub struct ConvergeOptions {
     pub tie_band_per_mm: f64,
     /// The tolerance to name the coarsest pitch for (mm).
     pub tolerance: Option<f64>,
+    /// The longest the exact oracle may take (seconds), as verify's
+    /// ([`super::VerifyOptions::budget_s`]): a prediction beyond it is
+    /// refused, naming the `--shard` count that fits. No limit when `None`.
+    pub budget_s: Option<f64>,
 }
 
 impl ConvergeOptions {
@@ -504,7 +519,10 @@ pub fn converge(
         pitches[pitches.len() - 1],
         &options.selection,
         options.tie_band_per_mm,
-        Share::default(),
+        Share {
+            refuse_beyond_s: options.budget_s,
+            ..Share::default()
+        },
         progress,
     )?;
     for &p in pitches {

@@ -279,6 +279,7 @@ pub fn converge_shard(
         super::converge::Share {
             shard: Some(shard),
             oracle_budget_s: None,
+            refuse_beyond_s: options.budget_s,
         },
         progress,
     )?;
