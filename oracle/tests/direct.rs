@@ -42,6 +42,7 @@ fn grid_and_exact_direct_contacts_agree_within_a_bound_that_shrinks_with_the_pit
         selection: StartSelection::Sample { count: 8, seed: 1 },
         tie_band_per_mm: 1.0,
         tolerance: None,
+        budget_s: None,
     };
     let study = converge_direct(&input, &setup, &options, &()).unwrap();
     assert_eq!(study.summary.approach, "direct");
