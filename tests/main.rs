@@ -11,6 +11,7 @@ mod fuzz_seeded;
 mod harness;
 mod hostile;
 mod oracle;
+mod readme;
 mod report;
 mod resolution;
 mod second_hour;
