@@ -13,6 +13,14 @@
 //! ([`RING_BELOW`]), so that a one-node result stays visible. Every colour
 //! is in a key: the colour bar, and a line of swatches under the plot.
 //!
+//! The layout is measured from the text: the image is as wide as its
+//! title, view line and widest key entry need, the key goes on to further
+//! lines where one would pass the image's edge, and the plot area is at
+//! least [`MIN_AXES`] pixels (and as long as its axis names) each way, the
+//! part's pixels centred in it, so that a tiny, narrow or flat part keeps
+//! its axis labels and a readable colour bar. The colour bar spans the
+//! plot's rows, with the words of its ends outside it.
+//!
 //! Text uses DejaVu Sans, embedded by the `dejavu` crate and registered with
 //! plotters once per process: no system font is needed.
 
@@ -29,7 +37,8 @@ use crate::frame::Placement;
 use crate::frame::Side;
 use crate::grid::{GridSpec, HeightGrid};
 
-/// Largest plot area width (pixels); the whole image stays under 1600.
+/// Largest plot area width (pixels); the whole image stays under 1600
+/// unless a title is wider.
 const MAX_PLOT_W: usize = 1300;
 /// Largest plot area height (pixels).
 const MAX_PLOT_H: usize = 900;
@@ -37,18 +46,36 @@ const MAX_PLOT_H: usize = 900;
 const MIN_PLOT: usize = 480;
 
 /// Space around the plot area (pixels): title above, axis labels left and
-/// below, the colour bar on the right.
+/// below, the colour bar on the right; and the empty border of the image.
 const MARGIN: usize = 10;
 /// Two lines (what is shown, and from where it is seen), then the colour
 /// bar's label and, on the depth image, the word at its top end.
-const TITLE_H: usize = 90;
-/// The line of colour swatches under the x axis.
+const TITLE_H: usize = 100;
+/// One line of colour swatches under the x axis; a key wider than the
+/// image takes more lines.
 const KEY_H: usize = 26;
+/// A key entry: the swatch and the gap before its words (pixels).
+const SWATCH_W: usize = 20;
+/// The gap between key entries on a line (pixels).
+const KEY_GAP: usize = 24;
 const Y_LABELS: usize = 80;
 const X_LABELS: usize = 50;
+/// The colour bar's strip, at least: the bar [`BAR_LEFT`] in, [`BAR_W`]
+/// wide, its value labels in [`BAR_LABELS`] right of it and a margin.
 const BAR_AREA_W: usize = 170;
-/// Images are at least this tall so the colour bar stays readable.
-const MIN_IMAGE_H: usize = 320;
+const BAR_LEFT: usize = 20;
+const BAR_W: usize = 70;
+const BAR_LABELS: usize = 70;
+/// The plot area is at least this wide and tall (pixels), the part's
+/// pixels centred in it: room for a few axis labels and a readable colour
+/// bar (it spans the plot's height) however narrow or flat the part.
+const MIN_AXES: usize = 160;
+
+/// Text sizes (points): title, view line, axis names, axis labels and key.
+const TITLE_PT: u32 = 20;
+const VIEW_PT: u32 = 15;
+const DESC_PT: u32 = 14;
+const LABEL_PT: u32 = 13;
 
 /// The font family every text style here uses.
 const FONT: &str = "sans-serif";
@@ -121,6 +148,11 @@ pub fn write_depth_png(
     grid: &HeightGrid,
     placement: &Placement,
 ) -> Result<(), PngError> {
+    depth_png(path, grid, placement).map(drop)
+}
+
+/// [`write_depth_png`], returning where it put things.
+fn depth_png(path: &Path, grid: &HeightGrid, placement: &Placement) -> Result<Layout, PngError> {
     let side = placement.side;
     let frame = placement.frame.record().map(|r| r.given);
     let direct = placement.approach == Approach::Direct;
@@ -129,7 +161,9 @@ pub fn write_depth_png(
     let shown = window.crop(grid);
     let title = format!(
         "Height grid (depth buffer seen from the knee): {} x {} nodes at {} mm pitch",
-        grid.spec.nx, grid.spec.nz, grid.spec.pitch
+        grid.spec.nx,
+        grid.spec.nz,
+        tick(&grid.spec.pitch)
     );
     let raster = Raster::plan(shown.spec.nx, shown.spec.nz)?;
     let heights = raster.reduce(shown.spec.nx, &shown.h, f64::INFINITY, f64::min);
@@ -149,7 +183,13 @@ pub fn write_depth_png(
     } else {
         (h_lo, h_hi)
     };
-    let [top, bottom] = depth_bar_ends(if flipped { Side::Right } else { Side::Left });
+    // With a frame the picture is in vehicle coordinates, and so is y.
+    let bar_label = match (direct, frame.is_some()) {
+        (false, true) => "y (mm, vehicle frame)",
+        (false, false) => "y (mm, part frame)",
+        (true, true) => "x (mm, vehicle frame)",
+        (true, false) => "x (mm, part frame)",
+    };
     let plot = Plot {
         grid: &shown,
         raster: &raster,
@@ -161,21 +201,21 @@ pub fn write_depth_png(
         key: &[(NO_PART, "no part (the node's line misses it)")],
         rings: &[],
         marks: &[],
+        bar_label,
+        bar_ends: Some(depth_bar_ends(if flipped {
+            Side::Right
+        } else {
+            Side::Left
+        })),
     };
-    draw_plot(path, &plot, |area, bar_top, bar_bottom| {
-        // With a frame the picture is in vehicle coordinates, and so is y.
-        let label = match (direct, frame.is_some()) {
-            (false, true) => "y (mm, vehicle frame)",
-            (false, false) => "y (mm, part frame)",
-            (true, true) => "x (mm, vehicle frame)",
-            (true, false) => "x (mm, part frame)",
-        };
-        let mut bar = colour_bar(area, label, y_lo..y_hi)?;
+    draw_plot(path, &plot, |area, rows| {
+        let mut bar = colour_bar(area, rows.clone(), y_lo..y_hi)?;
         bar.configure_mesh()
             .disable_mesh()
             .disable_x_axis()
+            .y_labels(((rows.end - rows.start) / 24).clamp(2, 10) as usize)
             .y_label_formatter(&tick)
-            .label_style((FONT, 13))
+            .label_style((FONT, LABEL_PT))
             .draw()?;
         // A smooth bar: enough bands that neighbours differ by under one
         // colour step.
@@ -190,9 +230,6 @@ pub fn write_depth_png(
             };
             Rectangle::new([(0.0, lo), (1.0, lo + dy)], colour(h).filled())
         }))?;
-        let style = (FONT, 13).into_text_style(area);
-        area.draw_text(top, &style, (20, bar_top - 18))?;
-        area.draw_text(bottom, &style, (20, bar_bottom + 4))?;
         Ok(())
     })
 }
@@ -242,6 +279,19 @@ pub fn write_composite_png(
     placement: &Placement,
     blind: &[(usize, usize)],
 ) -> Result<(), PngError> {
+    composite_png(path, grid, composite, n_angles, title, placement, blind).map(drop)
+}
+
+/// [`write_composite_png`], returning where it put things.
+fn composite_png(
+    path: &Path,
+    grid: &HeightGrid,
+    composite: &[u16],
+    n_angles: usize,
+    title: &str,
+    placement: &Placement,
+    blind: &[(usize, usize)],
+) -> Result<Layout, PngError> {
     let side = placement.side;
     let frame = placement.frame.record().map(|r| r.given);
     let approach = placement.approach;
@@ -300,10 +350,12 @@ pub fn write_composite_png(
         key: &key,
         rings: &rings,
         marks: &marks,
+        bar_label: "struck at N angles",
+        bar_ends: None,
     };
-    draw_plot(path, &plot, |area, _, _| {
+    draw_plot(path, &plot, |area, rows| {
         let top = n as f64 + 0.5;
-        let mut bar = colour_bar(area, "struck at N angles", 0.5..top)?;
+        let mut bar = colour_bar(area, rows.clone(), 0.5..top)?;
         let whole = |v: &f64| {
             if (v - v.round()).abs() < 1e-9 {
                 format!("{}", v.round())
@@ -314,9 +366,9 @@ pub fn write_composite_png(
         bar.configure_mesh()
             .disable_mesh()
             .disable_x_axis()
-            .y_labels(n.min(12))
+            .y_labels(n.min(12).min((rows.end - rows.start) as usize / 20).max(1))
             .y_label_formatter(&whole)
-            .label_style((FONT, 13))
+            .label_style((FONT, LABEL_PT))
             .draw()?;
         bar.draw_series((1..=n).map(|c| {
             let y = c as f64;
@@ -534,6 +586,43 @@ struct Plot<'a> {
     rings: &'a [usize],
     /// Pixels to cross (blind spots).
     marks: &'a [usize],
+    /// The words above the colour bar.
+    bar_label: &'a str,
+    /// The words at the bar's top and bottom ends, if any.
+    bar_ends: Option<[&'a str; 2]>,
+}
+
+impl Plot<'_> {
+    /// The second line of the title: where the part is seen from, and in
+    /// which axes.
+    fn view_text(&self) -> String {
+        let line = match self.approach {
+            Approach::Slide => view_line(self.side),
+            Approach::Direct => "Direct approach, seen from the knee (looking -x): y across, z up",
+        };
+        match self.frame {
+            None => line.to_string(),
+            Some(given) => format!("{line}; vehicle axes (part placed by --frame {given})"),
+        }
+    }
+
+    /// The names of the x and z axes.
+    fn axis_names(&self) -> (String, String) {
+        let direct = self.approach == Approach::Direct;
+        let x_desc = match (direct, self.side == Side::Right) {
+            (true, _) => "y (mm)",
+            (false, true) => "x (mm), vehicle front \u{2192}",
+            (false, false) => "x (mm), vehicle front \u{2190}",
+        };
+        // With a frame the axes are the vehicle's, not the part file's.
+        match self.frame {
+            None => (x_desc.to_string(), "z (mm), up".to_string()),
+            Some(_) => (
+                format!("vehicle {x_desc}"),
+                "vehicle z (mm), up".to_string(),
+            ),
+        }
+    }
 }
 
 /// The second line of every title: the side and where it is seen from.
@@ -548,72 +637,163 @@ pub fn view_line(side: Side) -> &'static str {
     }
 }
 
+/// The width and height (pixels) of `text` in the plots' font at `pt`.
+fn text_size(text: &str, pt: u32) -> Result<(usize, usize), PngError> {
+    let (w, h) = (FONT, pt)
+        .into_font()
+        .box_size(text)
+        .map_err(|_| PngError::Font)?;
+    Ok((w as usize, h as usize))
+}
+
+/// Where [`draw_plot`] puts things (pixels from the image's top left):
+/// sized from the part's raster and from every text, measured, so that
+/// nothing is cut at the image's edge however small, narrow or flat the
+/// part and however long the words.
+#[derive(Debug, Clone, PartialEq)]
+struct Layout {
+    /// Image width.
+    width: usize,
+    /// Image height.
+    height: usize,
+    /// The left strip: the plot, its axis labels and margins; the colour
+    /// bar's strip follows it.
+    chart_w: usize,
+    /// The colour bar's strip.
+    bar_w: usize,
+    /// The plot area: left column, top row, width, height; at least the
+    /// raster's size and [`MIN_AXES`].
+    plot: [usize; 4],
+    /// The raster's offset in the plot area (columns, rows): it is centred.
+    pad: [usize; 2],
+    /// Per key entry: the left column and top row of its swatch, and the
+    /// width of swatch and words.
+    key: Vec<[usize; 3]>,
+}
+
+impl Layout {
+    fn plan(plot: &Plot, view: &str, x_desc: &str, z_desc: &str) -> Result<Layout, PngError> {
+        let raster = plot.raster;
+        // Each axis's name is centred on its side of the plot: the plot
+        // is at least as long.
+        let pw = raster
+            .w
+            .max(MIN_AXES)
+            .max(text_size(x_desc, DESC_PT)?.0 + 2 * MARGIN);
+        let ph = raster
+            .h
+            .max(MIN_AXES)
+            .max(text_size(z_desc, DESC_PT)?.0 + 2 * MARGIN);
+        let chart_w = MARGIN + Y_LABELS + pw + MARGIN;
+        let mut bar_w = BAR_AREA_W.max(BAR_LEFT + text_size(plot.bar_label, DESC_PT)?.0 + MARGIN);
+        for end in plot.bar_ends.iter().flatten() {
+            bar_w = bar_w.max(BAR_LEFT + text_size(end, LABEL_PT)?.0 + MARGIN);
+        }
+        let key_x = MARGIN + Y_LABELS;
+        let entries = plot
+            .key
+            .iter()
+            .map(|(_, words)| Ok(SWATCH_W + text_size(words, LABEL_PT)?.0))
+            .collect::<Result<Vec<usize>, PngError>>()?;
+        let width = (chart_w + bar_w)
+            .max(MARGIN + text_size(plot.title, TITLE_PT)?.0 + MARGIN)
+            .max(MARGIN + text_size(view, VIEW_PT)?.0 + MARGIN)
+            .max(key_x + entries.iter().copied().max().unwrap_or(0) + MARGIN);
+        // The key's entries left to right, a new line where one would
+        // pass the image's right margin.
+        let key_top = TITLE_H + ph + X_LABELS + 6;
+        let (mut x, mut line) = (key_x, 0);
+        let mut key = Vec::with_capacity(entries.len());
+        for w in entries {
+            if x > key_x && x + w + MARGIN > width {
+                (x, line) = (key_x, line + 1);
+            }
+            key.push([x, key_top + line * KEY_H, w]);
+            x += w + KEY_GAP;
+        }
+        let lines = if key.is_empty() { 0 } else { line + 1 };
+        Ok(Layout {
+            width,
+            height: TITLE_H + ph + X_LABELS + lines * KEY_H + MARGIN,
+            chart_w,
+            bar_w,
+            plot: [MARGIN + Y_LABELS, TITLE_H, pw, ph],
+            pad: [(pw - raster.w) / 2, (ph - raster.h) / 2],
+            key,
+        })
+    }
+}
+
 /// Draws the title and view line, the pixels in a plot with mm axes (x
-/// reversed for the right side), the rings, the key and, through `legend`
-/// (given the bar's top and bottom pixel rows), the colour bar on the
-/// right; then encodes.
+/// reversed for the right side), the rings, the key, the colour bar's
+/// words and, through `legend` (given the bar's strip and its pixel rows,
+/// the plot's), the colour bar; then encodes.
 fn draw_plot(
     path: &Path,
     plot: &Plot,
-    legend: impl FnOnce(&Area, i32, i32) -> DrawResult,
-) -> Result<(), PngError> {
+    legend: impl FnOnce(&Area, Range<i32>) -> DrawResult,
+) -> Result<Layout, PngError> {
     register_font()?;
     let failed = |e: &dyn std::fmt::Display| PngError::Draw {
         path: path.to_path_buf(),
         reason: e.to_string(),
     };
     let raster = plot.raster;
-    let chart_w = MARGIN + Y_LABELS + raster.w + MARGIN;
-    let height = (TITLE_H + raster.h + X_LABELS + KEY_H + MARGIN).max(MIN_IMAGE_H);
-    let size = ((chart_w + BAR_AREA_W) as u32, height as u32);
+    let view = plot.view_text();
+    let (x_desc, z_desc) = plot.axis_names();
+    let layout = Layout::plan(plot, &view, &x_desc, &z_desc)?;
+    let [left, top, pw, ph] = layout.plot;
+    let [pad_l, pad_t] = layout.pad;
+    let size = (layout.width as u32, layout.height as u32);
     let root = BitMapBackend::new(path, size).into_drawing_area();
     let reversed = plot.side == Side::Right;
     let draw = || -> DrawResult {
         root.fill(&WHITE)?;
         root.draw_text(
             plot.title,
-            &(FONT, 20).into_text_style(&root),
+            &(FONT, TITLE_PT).into_text_style(&root),
             (MARGIN as i32, 10),
         )?;
-        let line = match plot.approach {
-            Approach::Slide => view_line(plot.side),
-            Approach::Direct => "Direct approach, seen from the knee (looking -x): y across, z up",
-        };
-        let view = match plot.frame {
-            None => line.to_string(),
-            Some(given) => format!("{line}; vehicle axes (part placed by --frame {given})"),
-        };
         root.draw_text(
             &view,
-            &(FONT, 15).into_text_style(&root),
+            &(FONT, VIEW_PT).into_text_style(&root),
             (MARGIN as i32, 36),
         )?;
-        let (chart_area, bar_area) = root.split_horizontally(chart_w as u32);
+        let chart_area = root.clone().shrink((0, 0), (layout.chart_w as u32, size.1));
+        let bar_area = root
+            .clone()
+            .shrink((layout.chart_w as u32, 0), (layout.bar_w as u32, size.1));
         let spec = plot.grid.spec;
         let p = spec.pitch;
+        // The axes in mm: the raster's span, and the plot area's columns
+        // and rows around it.
+        let mm = |pixels: usize| raster.span(pixels) * p;
         let x0 = spec.x(0) - 0.5 * p;
-        let x1 = x0 + raster.span(raster.w) * p;
+        let x1 = x0 + mm(raster.w);
         let z0 = spec.z(0) - 0.5 * p;
+        let z1 = z0 + mm(raster.h);
+        let (pad_r, pad_b) = (pw - raster.w - pad_l, ph - raster.h - pad_t);
         // The right side's axis runs over -x, labelled with x.
-        let x_axis = if reversed { -x1..-x0 } else { x0..x1 };
-        let bottom = (height - TITLE_H - raster.h - X_LABELS) as u32;
+        let (a, b) = if reversed { (-x1, -x0) } else { (x0, x1) };
+        let x_axis = a - mm(pad_l)..b + mm(pad_r);
+        let z_axis = z0 - mm(pad_b)..z1 + mm(pad_t);
         let mut chart = ChartBuilder::on(&chart_area)
-            .margin_top(TITLE_H as u32)
-            .margin_left(MARGIN as u32)
-            .margin_right(MARGIN as u32)
-            .margin_bottom(bottom)
+            .margin_top(top as u32)
+            .margin_left((left - Y_LABELS) as u32)
+            .margin_right((layout.chart_w - left - pw) as u32)
+            .margin_bottom((layout.height - top - ph - X_LABELS) as u32)
             .x_label_area_size(X_LABELS as u32)
             .y_label_area_size(Y_LABELS as u32)
-            .build_cartesian_2d(x_axis, z0..z0 + raster.span(raster.h) * p)?;
+            .build_cartesian_2d(x_axis, z_axis)?;
         let (px, py) = chart.plotting_area().get_pixel_range();
         debug_assert_eq!(
-            ((px.end - px.start) as usize, (py.end - py.start) as usize),
-            (raster.w, raster.h)
+            [px.start, py.start, px.end - px.start, py.end - py.start].map(|v| v as usize),
+            layout.plot
         );
         let at = |k: usize| -> (i32, i32) {
             let (c, r) = (k % raster.w, k / raster.w);
             let c = if reversed { raster.w - 1 - c } else { c };
-            (px.start + c as i32, py.start + r as i32)
+            ((left + pad_l + c) as i32, (top + pad_t + r) as i32)
         };
         for (k, colour) in plot.pixels.iter().enumerate() {
             root.draw_pixel(at(k), colour)?;
@@ -642,76 +822,70 @@ fn draw_plot(
         // the right side): the reversed axis is the part's y itself.
         let direct = plot.approach == Approach::Direct;
         let x_label = |v: &f64| tick(&if reversed && !direct { -v } else { *v });
-        let x_desc = match (direct, reversed) {
-            (true, _) => "y (mm)",
-            (false, true) => "x (mm), vehicle front \u{2192}",
-            (false, false) => "x (mm), vehicle front \u{2190}",
-        };
-        // With a frame the axes are the vehicle's, not the part file's.
-        let (x_desc, z_desc) = match plot.frame {
-            None => (x_desc.to_string(), "z (mm), up".to_string()),
-            Some(_) => (
-                format!("vehicle {x_desc}"),
-                "vehicle z (mm), up".to_string(),
-            ),
-        };
         chart
             .configure_mesh()
             .disable_mesh()
+            // At most one label per 60 pixels across, 30 up: they never
+            // overlap, however narrow the plot.
+            .x_labels((pw / 60).clamp(3, 10))
+            .y_labels((ph / 30).clamp(3, 10))
             .x_label_formatter(&x_label)
             .y_label_formatter(&tick)
             .x_desc(x_desc)
             .y_desc(z_desc)
-            .label_style((FONT, 13))
-            .axis_desc_style((FONT, 14))
+            .label_style((FONT, LABEL_PT))
+            .axis_desc_style((FONT, DESC_PT))
             .draw()?;
         // The key: a swatch (framed, so the pale one shows) and its words.
-        let key_y = (height - MARGIN - KEY_H + 6) as i32;
-        let mut x = (MARGIN + Y_LABELS) as i32;
-        let style = (FONT, 13).into_text_style(&root);
-        for (colour, words) in plot.key {
-            root.draw(&Rectangle::new(
-                [(x, key_y), (x + 14, key_y + 14)],
-                colour.filled(),
-            ))?;
-            root.draw(&Rectangle::new([(x, key_y), (x + 14, key_y + 14)], BLACK))?;
-            root.draw_text(words, &style, (x + 20, key_y))?;
-            let (w, _) = root.estimate_text_size(words, &style)?;
-            x += 20 + w as i32 + 24;
+        let style = (FONT, LABEL_PT).into_text_style(&root);
+        for ((colour, words), &[x, y, _]) in plot.key.iter().zip(&layout.key) {
+            let (x, y) = (x as i32, y as i32);
+            root.draw(&Rectangle::new([(x, y), (x + 14, y + 14)], colour.filled()))?;
+            root.draw(&Rectangle::new([(x, y), (x + 14, y + 14)], BLACK))?;
+            root.draw_text(words, &style, (x + SWATCH_W as i32, y))?;
         }
-        legend(&bar_area, py.start, py.end)?;
+        let left = BAR_LEFT as i32;
+        bar_area.draw_text(
+            plot.bar_label,
+            &(FONT, DESC_PT).into_text_style(&bar_area),
+            (left, TITLE_H as i32 - 40),
+        )?;
+        if let Some([high, low]) = plot.bar_ends {
+            let style = (FONT, LABEL_PT).into_text_style(&bar_area);
+            bar_area.draw_text(high, &style, (left, top as i32 - 22))?;
+            bar_area.draw_text(low, &style, (left, (top + ph) as i32 + 8))?;
+        }
+        legend(&bar_area, top as i32..(top + ph) as i32)?;
         root.present()
     };
-    draw().map_err(|e| failed(&e))
+    draw().map_err(|e| failed(&e))?;
+    Ok(layout)
 }
 
-/// The colour bar's frame in `area` (the image's right strip): a bar with
-/// value labels on its right, `label` above it, spanning the plot's height.
+/// The colour bar's frame in `area` (the image's strip right of the plot):
+/// a bar [`BAR_W`] wide with value labels on its right, spanning the pixel
+/// `rows` (the plot's).
 fn colour_bar<'a, 'b>(
     area: &'a Area<'b>,
-    label: &str,
+    rows: Range<i32>,
     values: Range<f64>,
 ) -> Result<
     ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     DrawError,
 > {
-    area.draw_text(
-        label,
-        &(FONT, 14).into_text_style(area),
-        (20, TITLE_H as i32 - 34),
-    )?;
+    let (w, h) = area.dim_in_pixel();
     ChartBuilder::on(area)
-        .margin_top(TITLE_H as u32)
-        .margin_bottom((MARGIN + X_LABELS + KEY_H) as u32)
-        .margin_left(20)
-        .margin_right(MARGIN as u32)
-        .set_label_area_size(LabelAreaPosition::Right, 70)
+        .margin_top(rows.start as u32)
+        .margin_bottom(h - rows.end as u32)
+        .margin_left(BAR_LEFT as u32)
+        .margin_right(w - (BAR_LEFT + BAR_W + BAR_LABELS) as u32)
+        .set_label_area_size(LabelAreaPosition::Right, BAR_LABELS as u32)
         .build_cartesian_2d(0.0..1.0, values)
 }
 
 /// An axis tick in mm: rounded to 1e-6 to hide the float noise of tick
 /// arithmetic, with no trailing zeros (`300`, `12.5`).
-fn tick(v: &f64) -> String {
+pub(crate) fn tick(v: &f64) -> String {
     let r = (v * 1e6).round() / 1e6;
     format!("{}", if r == 0.0 { 0.0 } else { r })
 }
@@ -807,8 +981,8 @@ mod tests {
         let mut composite = vec![0u16; g.spec.len()];
         composite[30 * 120 + 60] = 3;
         composite[10 * 120 + 20] = 61;
-        write_depth_png(&dir.join("depth.png"), &g, &Side::Left.into()).unwrap();
-        write_composite_png(
+        let depth = depth_png(&dir.join("depth.png"), &g, &Side::Left.into()).unwrap();
+        let comp = composite_png(
             &dir.join("composite.png"),
             &g,
             &composite,
@@ -835,10 +1009,17 @@ mod tests {
         assert_eq!((plot.w, plot.h, plot.up), (480, 240, 4));
         let want = (
             (MARGIN + Y_LABELS + 480 + MARGIN + BAR_AREA_W) as u32,
-            MIN_IMAGE_H.max(TITLE_H + 240 + X_LABELS + KEY_H + MARGIN) as u32,
+            (TITLE_H + 240 + X_LABELS + KEY_H + MARGIN) as u32,
         );
+        assert_eq!(depth.plot, [MARGIN + Y_LABELS, TITLE_H, 480, 240]);
         assert_eq!(png_size(&dir.join("depth.png")), want);
-        assert_eq!(png_size(&dir.join("composite.png")), want);
+        // The composite's key (four entries: the rings and the cross) takes
+        // two lines.
+        assert_eq!(comp.plot, depth.plot);
+        assert_eq!(
+            png_size(&dir.join("composite.png")),
+            (want.0, want.1 + KEY_H as u32)
+        );
         std::fs::remove_dir_all(dir).unwrap();
     }
 
@@ -1035,21 +1216,116 @@ mod tests {
         let g = grid(60, 60, |i, _| i as f64);
         for side in [Side::Left, Side::Right] {
             let path = dir.join("depth.png");
-            write_depth_png(&path, &g, &side.into()).unwrap();
+            let layout = depth_png(&path, &g, &side.into()).unwrap();
             let (w, h, pixels) = decode(&path);
+            let bar = layout.chart_w..layout.chart_w + layout.bar_w;
             // The bar: the image's right strip; its brightest (closest)
             // colour nearest the end the words say.
             // viridis(1) is (253, 231, 37); the bar's end band is within a
             // step of it.
             let bright = |p: [u8; 3]| p[0] > 240 && p[1] > 220 && p[2] < 60;
             let rows: Vec<usize> = (0..pixels.len())
-                .filter(|&k| k % w > w - BAR_AREA_W && bright(pixels[k]))
+                .filter(|&k| bar.contains(&(k % w)) && bright(pixels[k]))
                 .map(|k| k / w)
                 .collect();
             assert!(!rows.is_empty(), "{side:?}");
             let mean = rows.iter().sum::<usize>() as f64 / rows.len() as f64;
             let closer_at_top = depth_bar_ends(side)[0] == "closer to the knee";
             assert_eq!(mean < h as f64 / 2.0, closer_at_top, "{side:?}: {mean}");
+        }
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    /// Asserts that nothing of `path`'s image (drawn with `layout`) is cut
+    /// at its edges, and that every key entry, swatch and words, lies
+    /// inside it and is drawn whole.
+    fn assert_inside(path: &Path, layout: &Layout, what: &str) {
+        let (w, h, pixels) = decode(path);
+        assert_eq!((w, h), (layout.width, layout.height), "{what}");
+        let at = |c: usize, r: usize| pixels[r * w + c];
+        // The image's border (half its margin) is blank: no text, axis or
+        // swatch runs off any side.
+        let border = MARGIN / 2;
+        for r in 0..h {
+            for c in 0..w {
+                if r < border || r >= h - border || c < border || c >= w - border {
+                    assert_eq!(
+                        at(c, r),
+                        [255; 3],
+                        "{what}: drawn at the edge, {c},{r} of {w}x{h}"
+                    );
+                }
+            }
+        }
+        let dark = |p: [u8; 3]| p.iter().all(|&v| v < 140);
+        for (k, &[x, y, ew]) in layout.key.iter().enumerate() {
+            // The entry's box: the swatch, and the words to its right.
+            assert!(
+                x >= MARGIN && x + ew + MARGIN <= w && y + 18 + MARGIN <= h,
+                "{what}: key entry {k} at {x},{y} ({ew} wide) outside {w}x{h}"
+            );
+            // The swatch's frame is drawn, and so are the words, to
+            // within a few pixels of their measured end.
+            assert!(
+                dark(at(x, y + 7)) && dark(at(x + 14, y + 7)),
+                "{what}: swatch {k}"
+            );
+            let last = (x + SWATCH_W..x + ew + 3)
+                .filter(|&c| (y..y + 18).any(|r| dark(at(c, r))))
+                .max()
+                .unwrap_or(0);
+            assert!(
+                last + 6 >= x + ew,
+                "{what}: key words {k} end at {last}, not {}",
+                x + ew
+            );
+        }
+    }
+
+    #[test]
+    fn every_key_entry_and_label_lies_inside_the_image_whatever_the_part() {
+        let dir = temp_dir("png-inside");
+        let framed = Placement {
+            side: Side::Right,
+            frame: crate::frame::Frame::parse("-y,x,z").unwrap(),
+            approach: Approach::Direct,
+        };
+        let placements = [Side::Left.into(), Side::Right.into(), framed];
+        // Tiny, tall and narrow, wide and flat, a scenario seen edge-on
+        // (tilted-wave under --frame=-y,x,z: 7 x 80 nodes), ordinary, and
+        // larger than the plot.
+        for (nx, nz) in [
+            (2, 2),
+            (3, 400),
+            (1500, 2),
+            (7, 80),
+            (120, 60),
+            (3000, 1900),
+        ] {
+            let g = grid(nx, nz, |i, j| (i + 2 * j) as f64 * 0.37);
+            // Few struck nodes (circled) and a blind spot (crossed): the
+            // longest key, four entries.
+            let mut composite = vec![0u16; nx * nz];
+            composite[nx * nz / 2] = 2;
+            for (n, placement) in placements.iter().enumerate() {
+                let what = format!("{nx} x {nz}, placement {n}");
+                let path = dir.join("depth.png");
+                let layout = depth_png(&path, &g, placement).unwrap();
+                assert_inside(&path, &layout, &format!("depth {what}"));
+                let path = dir.join("composite.png");
+                let layout = composite_png(
+                    &path,
+                    &g,
+                    &composite,
+                    61,
+                    "Composite colliding area, 61 angles (L = 200 mm)",
+                    placement,
+                    &[(0, 0)],
+                )
+                .unwrap();
+                assert_eq!(layout.key.len(), 4);
+                assert_inside(&path, &layout, &format!("composite {what}"));
+            }
         }
         std::fs::remove_dir_all(dir).unwrap();
     }

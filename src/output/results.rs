@@ -137,7 +137,7 @@ pub fn write_results(
         let title = format!(
             "Composite colliding area, {} angles (L = {} mm)",
             masks.len(),
-            results.triangle_side
+            super::png::tick(&results.triangle_side)
         );
         let blind: Vec<(usize, usize)> = results.blind_spots.iter().map(|b| (b.i, b.j)).collect();
         super::write_composite_png(
