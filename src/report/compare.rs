@@ -98,14 +98,10 @@ impl Comparison {
         let direct_only = unmatched(&direct_points, &slide_points, match_mm);
         let tris = &run.part.triangles;
         let paint_both = |p: [f64; 3]| {
-            let s = hit(slide, p);
-            let d = hit(direct, p);
-            match (s, d) {
-                (true, true) => Some(BOTH),
-                (true, false) => Some(SLIDE_ONLY),
-                (false, true) => Some(DIRECT_ONLY),
-                (false, false) => None,
-            }
+            both_colour(
+                hit(&slide.composite, slide.axes, p),
+                hit(&direct.composite, direct.axes, p),
+            )
         };
         let figures = [run_camera(slide.axes), run_oblique_camera(direct.axes)]
             .into_iter()
@@ -127,15 +123,27 @@ impl Comparison {
     }
 }
 
-/// Whether the surface point `p` (vehicle coordinates) is painted by
-/// `run`'s composite: within half a pitch of a colliding node across its
-/// grid, and within [`OBLIQUE_Y_TOL_PITCHES`] of the node's depth.
-fn hit(run: &Run, p: [f64; 3]) -> bool {
-    let g = run.axes.grid(p);
-    let tol = OBLIQUE_Y_TOL_PITCHES * run.spec.pitch;
-    run.composite
+/// Whether the surface point `p` (vehicle coordinates) is painted by a
+/// run's `composite` (its grid mapped by `axes`): within half a pitch of a
+/// colliding node across its grid ([`NodeCounts::at`]), and within
+/// [`OBLIQUE_Y_TOL_PITCHES`] of the node's depth.
+fn hit(composite: &NodeCounts, axes: GridAxes, p: [f64; 3]) -> bool {
+    let g = axes.grid(p);
+    let tol = OBLIQUE_Y_TOL_PITCHES * composite.spec.pitch;
+    composite
         .at(g[0], g[2])
         .is_some_and(|(_, depth)| (g[1] - depth).abs() <= tol)
+}
+
+/// The colour of a point the slide run paints (`slide`) or the direct run
+/// paints (`direct`), or both; `None` (the part's grey) for neither.
+fn both_colour(slide: bool, direct: bool) -> Option<Rgb> {
+    match (slide, direct) {
+        (true, true) => Some(BOTH),
+        (true, false) => Some(SLIDE_ONLY),
+        (false, true) => Some(DIRECT_ONLY),
+        (false, false) => None,
+    }
 }
 
 /// The colliding nodes of `run`'s composite as points (vehicle
@@ -188,6 +196,8 @@ fn unmatched(these: &[[f64; 3]], those: &[[f64; 3]], d: f64) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::grid::GridSpec;
+    use crate::report::render::BACKGROUND;
 
     #[test]
     fn points_are_matched_within_the_distance_only() {
@@ -199,6 +209,103 @@ mod tests {
             [-2.1, 0.0, 0.0],
         ];
         assert_eq!(unmatched(&these, &those, 2.0), 2);
+    }
+
+    /// A grey pixel (the part's, painted by neither run) whose eight
+    /// neighbours are all painted: a speckle.
+    fn speckles(image: &RgbImage) -> Vec<(usize, usize)> {
+        let grey = |[r, g, b]: Rgb| r == g && g == b && [r, g, b] != BACKGROUND;
+        let painted = |[r, g, b]: Rgb| !(r == g && g == b);
+        let (w, h) = (image.width, image.height);
+        (1..h.saturating_sub(1))
+            .flat_map(|r| (1..w.saturating_sub(1)).map(move |c| (c, r)))
+            .filter(|&(c, r)| {
+                grey(image.at(c, r))
+                    && (r - 1..=r + 1).all(|rr| {
+                        (c - 1..=c + 1).all(|cc| (cc, rr) == (c, r) || painted(image.at(cc, rr)))
+                    })
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_surface_on_a_cell_border_is_painted_whole_without_grey_speckles() {
+        // scenarios/pocket-behind-ridge.toml at 4 mm: the pocket's floor
+        // lies at y = 30, half a pitch between the direct grid's node
+        // columns y = 28 (the near wall's first contact, x = 60) and
+        // y = 32 (behind the floor: no part). The floor within two pitches
+        // of x = 60 is the direct run's, on the border of its cell.
+        let pitch = 4.0;
+        let direct_spec = GridSpec {
+            pitch,
+            i_origin: 0,
+            j_origin: -6,
+            nx: 12,
+            nz: 13,
+        };
+        let mut direct = NodeCounts {
+            spec: direct_spec,
+            count: vec![0; direct_spec.len()],
+            y: vec![f64::NAN; direct_spec.len()],
+        };
+        for j in 0..direct_spec.nz {
+            direct.count[j * direct_spec.nx + 7] = 3;
+            direct.y[j * direct_spec.nx + 7] = -60.0;
+        }
+        let slide = NodeCounts {
+            spec: direct_spec,
+            count: vec![0; direct_spec.len()],
+            y: vec![f64::NAN; direct_spec.len()],
+        };
+        let left = |approach| GridAxes {
+            approach,
+            side: crate::Side::Left,
+        };
+        // The floor, x in [50, 70], z in [-20, 20], as a mesh of 1 mm
+        // squares (as a scenario is written: many triangles, each
+        // interpolating the same depth with its own rounding).
+        let mut tris = Vec::new();
+        for a in 0..20 {
+            for b in 0..40 {
+                let (x, z) = (50.0 + f64::from(a), -20.0 + f64::from(b));
+                let q = |dx: f64, dz: f64| [x + dx, 30.0, z + dz];
+                tris.push([q(0.0, 0.0), q(1.0, 0.0), q(1.0, 1.0)]);
+                tris.push([q(0.0, 0.0), q(1.0, 1.0), q(0.0, 1.0)]);
+            }
+        }
+        let view = View::fit(run_camera(left(Approach::Slide)), &tris, 400, 8);
+        let image = paint(&rasterize(&tris, &view), |p| {
+            both_colour(
+                hit(&slide, left(Approach::Slide), p),
+                hit(&direct, left(Approach::Direct), p),
+            )
+        });
+        // Every pixel of the floor within two pitches of x = 60 is the
+        // direct run's, away from that band's ends.
+        let mut inside = 0;
+        let mut grey = Vec::new();
+        for r in 0..view.height {
+            for c in 0..view.width {
+                let (u, _) = view.pixel_centre(c, r);
+                let [red, green, blue] = image.at(c, r);
+                if image.at(c, r) == BACKGROUND {
+                    continue;
+                }
+                if (53.0..67.0).contains(&u) {
+                    inside += 1;
+                    if red == green && green == blue {
+                        grey.push((c, r));
+                    }
+                }
+                // Beyond two pitches of the contact's depth: the part's.
+                if !(51.0..69.0).contains(&u) {
+                    assert!(red == green && green == blue, "painted at x = {u}");
+                }
+            }
+        }
+        assert!(inside > 1000, "{inside}");
+        assert!(grey.is_empty(), "{} grey of {inside}: {grey:?}", grey.len());
+        assert_eq!(speckles(&image), []);
     }
 
     #[test]
