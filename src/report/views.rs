@@ -93,21 +93,22 @@ pub fn run_oblique_camera(axes: GridAxes) -> Camera {
     }
 }
 
-/// [`View::fit`] at `width` pixels; for the direct approach, narrower
-/// when that would make the picture more than [`MAX_ASPECT`] times as tall
-/// as wide (seen along -x, a console side is a thin strip, and a picture
-/// 1100 pixels wide would be ten thousand tall).
-fn fit(axes: GridAxes, camera: Camera, tris: &[Triangle], width: usize) -> View {
+/// [`View::fit`] at `width` pixels; narrower when that would make the
+/// picture more than [`MAX_ASPECT`] times as tall as wide (seen along -x,
+/// a console side is a thin strip, and a picture 1100 pixels wide would be
+/// ten thousand tall; so is a part turned by `--frame` to face +x, seen
+/// along the push: tilted-wave's was 1100 x 40,667).
+fn fit(camera: Camera, tris: &[Triangle], width: usize) -> View {
     let view = View::fit(camera, tris, width, MARGIN);
     let tall = MAX_ASPECT * width as f64;
-    if axes.approach == Approach::Direct && view.height as f64 > tall {
+    if view.height as f64 > tall {
         let narrower = (width as f64 * tall / view.height as f64).floor() as usize;
         return View::fit(camera, tris, narrower.max(4 * MARGIN), MARGIN);
     }
     view
 }
 
-/// The tallest a direct run's picture is, in widths.
+/// The tallest a picture is, in widths.
 const MAX_ASPECT: f64 = 1.5;
 
 /// The number of colours of the composite's ramp: the angles analysed (or
@@ -162,14 +163,14 @@ pub fn render_views(run: &Run, masks: &[(f64, NodeCounts)]) -> Views {
             .map(|(c, _)| composite_colour(c, n))
     };
 
-    let view = fit(axes, run_camera(axes), tris, LARGE_WIDTH);
+    let view = fit(run_camera(axes), tris, LARGE_WIDTH);
     let side = Figure {
         image: paint(&rasterize(tris, &view), by_count),
         view,
     };
 
     let y_tol = OBLIQUE_Y_TOL_PITCHES * run.spec.pitch;
-    let view = fit(axes, run_oblique_camera(axes), tris, LARGE_WIDTH);
+    let view = fit(run_oblique_camera(axes), tris, LARGE_WIDTH);
     let oblique = Figure {
         image: paint(&rasterize(tris, &view), |p| {
             let p = axes.grid(p);
@@ -181,7 +182,7 @@ pub fn render_views(run: &Run, masks: &[(f64, NodeCounts)]) -> Views {
         view,
     };
 
-    let view = fit(axes, run_camera(axes), tris, SMALL_WIDTH);
+    let view = fit(run_camera(axes), tris, SMALL_WIDTH);
     let small = rasterize(tris, &view);
     let per_angle = masks
         .iter()
@@ -249,5 +250,30 @@ mod tests {
         let o = oblique_camera(Side::Left);
         assert!(o.forward[0] > 0.0 && o.forward[1] > 0.0 && o.forward[2] < 0.0);
         assert!(o.up[2] > 0.0);
+    }
+
+    /// A part far taller than wide, seen along the push (tilted-wave turned
+    /// by `--frame=-y,x,z`: a slide run's face-on view was 1100 x 40,667
+    /// pixels), is drawn narrower: at most [`MAX_ASPECT`] widths tall.
+    #[test]
+    fn a_tall_thin_part_is_drawn_narrower_not_taller() {
+        let tris: Vec<Triangle> = vec![
+            [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [0.0, 0.0, 400.0]],
+            [[10.0, 0.0, 0.0], [10.0, 0.0, 400.0], [0.0, 0.0, 400.0]],
+        ];
+        let view = fit(side_camera(Side::Left), &tris, LARGE_WIDTH);
+        assert!(view.width < LARGE_WIDTH, "{} wide", view.width);
+        assert!(
+            view.height as f64 <= MAX_ASPECT * LARGE_WIDTH as f64,
+            "{} x {}",
+            view.width,
+            view.height
+        );
+        // A wide part keeps the full width.
+        let wide: Vec<Triangle> = tris.iter().map(|t| t.map(|[x, y, z]| [z, y, x])).collect();
+        assert_eq!(
+            fit(side_camera(Side::Left), &wide, LARGE_WIDTH).width,
+            LARGE_WIDTH
+        );
     }
 }
