@@ -50,6 +50,7 @@ pub mod direct;
 pub mod engine;
 pub mod frame;
 pub mod grid;
+#[cfg(feature = "harness")]
 pub mod harness;
 pub mod input;
 pub mod kneeform;

@@ -335,6 +335,20 @@ impl Summary {
     }
 }
 
+/// The metrics a user's guarantee is made of (and `verify` passes or fails
+/// on): the push error and the decided strike metrics, away from blind
+/// spots, and the decided area distance. The others are shown beside them,
+/// never hidden. Named here, below the harness that measures them, for
+/// the report, which reads a study's files without the harness.
+pub const DECIDED_METRICS: [&str; 6] = [
+    "push_error_decided",
+    "first_contact_error_decided",
+    "miss_distance_decided",
+    "false_alarm_distance_decided",
+    "unmatched_deflection_decided",
+    "area_distance_decided",
+];
+
 // The pitch study of `--pitch auto` ([`crate::harness::choose_pitch`]),
 // as `summary.json` records it.
 

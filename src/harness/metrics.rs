@@ -47,18 +47,7 @@ pub const METRICS: [&str; 26] = [
     "level_error_bound",
 ];
 
-/// The metrics a user's guarantee is made of (and `verify` passes or fails
-/// on): the push error and the decided strike metrics, away from blind
-/// spots, and the decided area distance. The others are shown beside them,
-/// never hidden.
-pub const DECIDED_METRICS: [&str; 6] = [
-    "push_error_decided",
-    "first_contact_error_decided",
-    "miss_distance_decided",
-    "false_alarm_distance_decided",
-    "unmatched_deflection_decided",
-    "area_distance_decided",
-];
+pub use crate::summary::DECIDED_METRICS;
 
 /// The index of `name` in [`METRICS`].
 pub fn metric_index(name: &str) -> usize {

@@ -23,30 +23,37 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 mod csv;
+#[cfg(feature = "harness")]
 mod plot;
 mod ply;
 mod png;
 mod results;
 mod stl;
+#[cfg(feature = "harness")]
+mod studies;
 mod surface;
 
 pub use self::csv::{
     MICROMETRE_DIGITS, angle_mask, micrometres, write_colliding_points, write_composite,
 };
+#[cfg(feature = "harness")]
 pub use self::plot::write_plots;
 pub use self::ply::write_colliding_area_ply;
 pub(crate) use self::png::count_colour;
+#[cfg(feature = "harness")]
 pub(crate) use self::png::register_font;
 pub use self::png::{
     BLIND_COLOUR, CROP_MARGIN, NO_PART, PngError, RING_BELOW, RING_COLOUR, Window, composite_key,
     crop_window, depth_bar_ends, view_line, write_composite_png, write_depth_png,
 };
-pub use self::results::{
-    RunResults, WriteOptions, write_analysis, write_convergence, write_convergence_files,
-    write_direct_convergence, write_direct_convergence_files, write_direct_verification,
-    write_direct_verification_files, write_results, write_verification, write_verification_files,
-};
+pub use self::results::{RunResults, WriteOptions, write_analysis, write_results};
 pub use self::stl::{write_colliding_area, write_stl};
+#[cfg(feature = "harness")]
+pub use self::studies::{
+    write_convergence, write_convergence_files, write_direct_convergence,
+    write_direct_convergence_files, write_direct_verification, write_direct_verification_files,
+    write_verification, write_verification_files,
+};
 
 /// The files kneeform writes into a result directory: a run's, a
 /// verification's, a convergence study's, a shard's, the report, and a

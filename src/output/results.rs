@@ -1,9 +1,6 @@
-//! Each command's result files, from the library's results: an analysis
-//! ([`write_analysis`], or [`write_results`] from its results merged from
-//! shards), a verification ([`write_verification`]), a convergence study
-//! ([`write_convergence`]; both also into a staged directory, for a merge
-//! of their shards), and the same two for the direct approach
-//! ([`write_direct_verification`], [`write_direct_convergence`]).
+//! An analysis's result files ([`write_analysis`], or [`write_results`]
+//! from its results merged from shards); the studies' are
+//! [`super::studies`]'s.
 
 use std::io::{BufWriter, Write};
 use std::path::Path;
@@ -15,7 +12,6 @@ use crate::blind::BlindSpot;
 use crate::engine::AngleMask;
 use crate::frame::Placement;
 use crate::grid::HeightGrid;
-use crate::harness::{Convergence, DirectConvergence, DirectVerification, Verification};
 use crate::summary::Summary;
 
 /// What [`write_analysis`] writes besides the default files.
@@ -163,174 +159,6 @@ pub fn write_results(
     Ok(summary)
 }
 
-/// Writes `verify.csv` (one row per start and angle) and `verify.json`
-/// into `dir`, which appears with both or is left as it was.
-pub fn write_verification(dir: &Path, verification: &Verification) -> Result<(), WriteError> {
-    let out = stage(dir)?;
-    write_verification_files(&out, verification)?;
-    commit(out, dir)
-}
-
-/// Writes [`write_verification`]'s files into the staged directory `out`
-/// (`kneeform merge` of a verification's shards).
-pub fn write_verification_files(
-    out: &OutputDir,
-    verification: &Verification,
-) -> Result<(), WriteError> {
-    write_rows(&out.path("verify.csv"), &verification.comparison.rows)?;
-    write_json(&out.path("verify.json"), &verification.summary)
-}
-
-/// Writes a convergence study into `dir`: `converge.csv` (every metric at
-/// every pitch), `verify_<pitch>mm.csv` (each pitch's per-start rows),
-/// `converge.json` and the plots; `dir` appears with all of them or is
-/// left as it was.
-pub fn write_convergence(dir: &Path, convergence: &Convergence) -> Result<(), WriteError> {
-    let out = stage(dir)?;
-    write_convergence_files(&out, convergence)?;
-    commit(out, dir)
-}
-
-/// Writes [`write_convergence`]'s files into the staged directory `out`
-/// (`kneeform merge` of a convergence study's shards).
-pub fn write_convergence_files(
-    out: &OutputDir,
-    convergence: &Convergence,
-) -> Result<(), WriteError> {
-    let results = &convergence.results;
-    let tolerance = convergence.summary.tolerance_mm;
-    let path = out.path("converge.csv");
-    (|| -> csv::Result<()> {
-        let mut csv = csv::Writer::from_path(&path)?;
-        csv.write_record([
-            "pitch_mm", "metric", "max", "p95", "mean", "n", "seconds", "area_iou", "pass",
-        ])?;
-        for r in results {
-            let pass = tolerance.map_or(String::new(), |t| r.comparison.passes(t).to_string());
-            for (metric, s) in &r.comparison.stats {
-                csv.write_record([
-                    r.pitch.to_string(),
-                    metric.clone(),
-                    s.max.to_string(),
-                    s.p95.to_string(),
-                    s.mean.to_string(),
-                    s.n.to_string(),
-                    r.seconds.to_string(),
-                    r.comparison.area_iou.to_string(),
-                    pass.clone(),
-                ])?;
-            }
-        }
-        csv.flush()?;
-        Ok(())
-    })()
-    .map_err(WriteError::at(&path))?;
-    // Every pitch's per-start rows, as `verify.csv` has them: where each
-    // figure of converge.csv comes from.
-    for r in results {
-        write_rows(
-            &out.path(format!("verify_{}mm.csv", r.pitch)),
-            &r.comparison.rows,
-        )?;
-    }
-    write_json(&out.path("converge.json"), &convergence.summary)?;
-    super::write_plots(out.path(".").as_path(), results, &convergence.fits)
-}
-
-/// Writes a direct verification into `dir`: `verify.csv` (one row per
-/// position and angle) and `verify.json` (`"approach": "direct"`).
-pub fn write_direct_verification(
-    dir: &Path,
-    verification: &DirectVerification,
-) -> Result<(), WriteError> {
-    let out = stage(dir)?;
-    write_direct_verification_files(&out, verification)?;
-    commit(out, dir)
-}
-
-/// Writes [`write_direct_verification`]'s files into the staged directory
-/// `out` (`kneeform merge` of a direct verification's shards).
-pub fn write_direct_verification_files(
-    out: &OutputDir,
-    verification: &DirectVerification,
-) -> Result<(), WriteError> {
-    write_rows(&out.path("verify.csv"), &verification.comparison.rows)?;
-    write_json(&out.path("verify.json"), &verification.summary)
-}
-
-/// Writes a direct convergence study into `dir`: `converge.csv` (both
-/// metrics at every pitch), `verify_<pitch>mm.csv` (each pitch's rows) and
-/// `converge.json` (`"approach": "direct"`).
-pub fn write_direct_convergence(
-    dir: &Path,
-    convergence: &DirectConvergence,
-) -> Result<(), WriteError> {
-    let out = stage(dir)?;
-    write_direct_convergence_files(&out, convergence)?;
-    commit(out, dir)
-}
-
-/// Writes [`write_direct_convergence`]'s files into the staged directory
-/// `out` (`kneeform merge` of a direct convergence study's shards).
-pub fn write_direct_convergence_files(
-    out: &OutputDir,
-    convergence: &DirectConvergence,
-) -> Result<(), WriteError> {
-    let tolerance = convergence.summary.tolerance_mm;
-    let path = out.path("converge.csv");
-    (|| -> csv::Result<()> {
-        let mut csv = csv::Writer::from_path(&path)?;
-        csv.write_record([
-            "approach",
-            "pitch_mm",
-            "metric",
-            "max",
-            "p95",
-            "median",
-            "mean",
-            "n",
-            "both",
-            "grid_only",
-            "exact_only",
-            "oracle_failed",
-            "engine_mismatch",
-            "pass",
-        ])?;
-        for r in &convergence.results {
-            let c = &r.comparison.counts;
-            let pass = tolerance.map_or(String::new(), |t| r.comparison.passes(t).to_string());
-            for (metric, s) in &r.comparison.stats {
-                csv.write_record([
-                    "direct".to_string(),
-                    r.pitch.to_string(),
-                    metric.clone(),
-                    s.max.to_string(),
-                    s.p95.to_string(),
-                    s.median.to_string(),
-                    s.mean.to_string(),
-                    s.n.to_string(),
-                    c.both.to_string(),
-                    c.grid_only.to_string(),
-                    c.exact_only.to_string(),
-                    c.oracle_failed.to_string(),
-                    c.engine_mismatch.to_string(),
-                    pass.clone(),
-                ])?;
-            }
-        }
-        csv.flush()?;
-        Ok(())
-    })()
-    .map_err(WriteError::at(&path))?;
-    for r in &convergence.results {
-        write_rows(
-            &out.path(format!("verify_{}mm.csv", r.pitch)),
-            &r.comparison.rows,
-        )?;
-    }
-    write_json(&out.path("converge.json"), &convergence.summary)
-}
-
 /// Writes `blind_spots.csv`: one row per blind spot ([`crate::blind`]),
 /// where (cell `i, j` of the analysis grid; `x, y, z` of its lowest point,
 /// mm, in the part's coordinates through `placement`), how deep and wide,
@@ -347,14 +175,17 @@ fn write_blind_spots(
         for b in spots {
             let angles: Vec<String> = b.met_angles_deg.iter().map(f64::to_string).collect();
             let [x, y, z] = b.in_part(placement);
+            // Lengths to 1 um, as composite.csv's: a node's `i * p` is
+            // written as the reader means it, not as its double.
+            let um = super::csv::micrometres;
             csv.write_record([
                 b.i.to_string(),
                 b.j.to_string(),
-                x.to_string(),
-                y.to_string(),
-                z.to_string(),
-                b.depth_missed_mm.to_string(),
-                b.width_mm.to_string(),
+                um(x),
+                um(y),
+                um(z),
+                um(b.depth_missed_mm),
+                um(b.width_mm),
                 b.resolving_pitch_mm.to_string(),
                 angles.join(";"),
             ])?;
@@ -365,36 +196,8 @@ fn write_blind_spots(
     .map_err(WriteError::at(path))
 }
 
-/// Stages `dir` for a verification's or a convergence study's files.
-fn stage(dir: &Path) -> Result<OutputDir, WriteError> {
-    OutputDir::stage(dir).map_err(|source| WriteError::Commit {
-        path: dir.to_path_buf(),
-        source,
-    })
-}
-
 /// Writes `value` as pretty JSON with a final newline.
-fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<(), WriteError> {
+pub(super) fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<(), WriteError> {
     let text = serde_json::to_string_pretty(value).map_err(WriteError::at(path))? + "\n";
     std::fs::write(path, text).map_err(WriteError::at(path))
-}
-
-/// Writes serialisable rows as CSV with a header.
-fn write_rows(path: &Path, rows: &[impl serde::Serialize]) -> Result<(), WriteError> {
-    (|| -> csv::Result<()> {
-        let mut csv = csv::Writer::from_path(path)?;
-        for row in rows {
-            csv.serialize(row)?;
-        }
-        csv.flush()?;
-        Ok(())
-    })()
-    .map_err(WriteError::at(path))
-}
-
-fn commit(out: OutputDir, dir: &Path) -> Result<(), WriteError> {
-    out.commit().map(drop).map_err(|source| WriteError::Commit {
-        path: dir.to_path_buf(),
-        source,
-    })
 }

@@ -1077,7 +1077,7 @@ fn verify_block(k: usize, json: &Value, verdict: Verdict) -> Markup {
 
 /// Whether a metric of `verify.json` is one a verdict rests on.
 fn kneeform_decides(name: &str) -> bool {
-    crate::harness::DECIDED_METRICS.contains(&name)
+    crate::summary::DECIDED_METRICS.contains(&name)
 }
 
 fn converge_block(k: usize, json: &Value) -> Markup {

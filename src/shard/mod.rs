@@ -46,7 +46,9 @@ use crate::output::{OutputDir, RunResults, WriteError};
 use crate::partition::{Shard, ShardSyntax};
 use crate::summary::{AngleSummary, Summary};
 
+#[cfg(feature = "harness")]
 mod codec;
+#[cfg(feature = "harness")]
 pub mod study;
 
 /// The SHA-256 (hex) of a `shard.json`'s content with its
