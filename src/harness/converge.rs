@@ -113,24 +113,10 @@ pub fn recommended_pitch(results: &[PitchResult], tolerance: f64) -> Option<&Pit
 /// `converge.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ConvergeSummary {
-    /// Version of kneeform.
-    pub kneeform_version: String,
-    /// The part as given.
-    pub input_file: String,
-    /// SHA-256 of the part file's bytes (hex), as `summary.json`'s
-    /// `sha256`: what `kneeform report` matches a study to its run by.
-    #[serde(default)]
-    pub input_sha256: String,
-    /// Factor from the file's units to mm.
-    #[serde(default = "super::verify::unit_scale")]
-    pub scale: f64,
-    /// `left` or `right`.
-    #[serde(default = "super::verify::left_side")]
-    pub side: crate::Side,
-    /// `--frame`: the map from the part's coordinates into vehicle
-    /// coordinates; absent without one.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub frame: Option<crate::frame::FrameRecord>,
+    /// Which part, read how, by which kneeform: the same record, in the
+    /// same order, in every study's JSON.
+    #[serde(flatten)]
+    pub run: super::RunIdentity,
     /// Knee-form L, R, W (mm).
     #[serde(default)]
     pub knee_form_mm: [f64; 3],
@@ -553,12 +539,7 @@ impl ConvergeSummary {
         results: &[PitchResult],
     ) -> ConvergeSummary {
         let mut summary = ConvergeSummary {
-            kneeform_version: env!("CARGO_PKG_VERSION").into(),
-            input_file: input.path.display().to_string(),
-            input_sha256: input.sha256.clone(),
-            scale: input.scale,
-            side: input.side,
-            frame: input.frame.record(),
+            run: super::RunIdentity::of(input),
             knee_form_mm: [
                 setup.knee.triangle_side,
                 setup.knee.radius,

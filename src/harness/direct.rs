@@ -543,19 +543,10 @@ fn footprints(setup: &Setup, pitch: f64) -> Vec<DirectFootprint> {
 pub struct DirectVerifySummary {
     /// Always `direct`.
     pub approach: String,
-    /// Version of kneeform.
-    pub kneeform_version: String,
-    /// The part as given.
-    pub input_file: String,
-    /// SHA-256 of the part file's bytes (hex).
-    pub input_sha256: String,
-    /// Factor from the file's units to mm.
-    pub scale: f64,
-    /// `left` or `right`.
-    pub side: crate::Side,
-    /// `--frame`, absent without one.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub frame: Option<crate::frame::FrameRecord>,
+    /// Which part, read how, by which kneeform: the same record, in the
+    /// same order, in every study's JSON.
+    #[serde(flatten)]
+    pub run: super::RunIdentity,
     /// Grid pitch (mm).
     pub pitch_mm: f64,
     /// The tolerance both metrics' max is held to (mm).
@@ -630,12 +621,7 @@ impl DirectVerifySummary {
         let (starts, seed) = super::verify::selection_words(&options.selection);
         DirectVerifySummary {
             approach: "direct".into(),
-            kneeform_version: env!("CARGO_PKG_VERSION").into(),
-            input_file: input.path.display().to_string(),
-            input_sha256: input.sha256.clone(),
-            scale: input.scale,
-            side: input.side,
-            frame: input.frame.record(),
+            run: super::RunIdentity::of(input),
             pitch_mm: setup.pitch,
             tolerance_mm: options.tolerance,
             pass: false,
@@ -744,19 +730,10 @@ pub struct DirectPitchResult {
 pub struct DirectConvergeSummary {
     /// Always `direct`.
     pub approach: String,
-    /// Version of kneeform.
-    pub kneeform_version: String,
-    /// The part as given.
-    pub input_file: String,
-    /// SHA-256 of the part file's bytes (hex).
-    pub input_sha256: String,
-    /// Factor from the file's units to mm.
-    pub scale: f64,
-    /// `left` or `right`.
-    pub side: crate::Side,
-    /// `--frame`, absent without one.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub frame: Option<crate::frame::FrameRecord>,
+    /// Which part, read how, by which kneeform: the same record, in the
+    /// same order, in every study's JSON.
+    #[serde(flatten)]
+    pub run: super::RunIdentity,
     /// Knee-form L, R, W (mm).
     pub knee_form_mm: [f64; 3],
     /// The pitches, coarsest first (mm).
@@ -893,12 +870,7 @@ impl DirectConvergeSummary {
         let (_, seed) = super::verify::selection_words(&options.selection);
         DirectConvergeSummary {
             approach: "direct".into(),
-            kneeform_version: env!("CARGO_PKG_VERSION").into(),
-            input_file: input.path.display().to_string(),
-            input_sha256: input.sha256.clone(),
-            scale: input.scale,
-            side: input.side,
-            frame: input.frame.record(),
+            run: super::RunIdentity::of(input),
             knee_form_mm: [
                 setup.knee.triangle_side,
                 setup.knee.radius,

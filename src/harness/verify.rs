@@ -345,12 +345,7 @@ impl VerifySummary {
     ) -> VerifySummary {
         let (starts, seed) = selection_words(&options.selection);
         let mut summary = VerifySummary {
-            kneeform_version: env!("CARGO_PKG_VERSION").into(),
-            input_file: input.path.display().to_string(),
-            input_sha256: input.sha256.clone(),
-            scale: input.scale,
-            side: input.side,
-            frame: input.frame.record(),
+            run: super::RunIdentity::of(input),
             pitch_mm: setup.pitch,
             tolerance_mm: options.tolerance,
             pass: false,
@@ -458,24 +453,10 @@ pub(super) fn selection_words(selection: &StartSelection) -> (String, u64) {
 /// `verify.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct VerifySummary {
-    /// Version of kneeform.
-    pub kneeform_version: String,
-    /// The part (STL or scenario file) as given.
-    pub input_file: String,
-    /// SHA-256 of the part file's bytes (hex), as `summary.json`'s
-    /// `sha256`: what `kneeform report` matches a verification to its run by.
-    #[serde(default)]
-    pub input_sha256: String,
-    /// Factor from the file's units to mm.
-    #[serde(default = "unit_scale")]
-    pub scale: f64,
-    /// `left` or `right`.
-    #[serde(default = "left_side")]
-    pub side: crate::Side,
-    /// `--frame`: the map from the part's coordinates into vehicle
-    /// coordinates; absent without one.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub frame: Option<crate::frame::FrameRecord>,
+    /// Which part, read how, by which kneeform: the same record, in the
+    /// same order, in every study's JSON.
+    #[serde(flatten)]
+    pub run: super::RunIdentity,
     /// Grid pitch (mm).
     pub pitch_mm: f64,
     /// The tolerance every metric's max is held to (mm).
