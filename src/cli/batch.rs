@@ -150,7 +150,8 @@ fn is_done(out: &Path, fingerprint: &str) -> bool {
     let recorded = kneeform::limits::read_text_bounded(&out.join(FINGERPRINT_FILE))
         .ok()
         .and_then(|t| serde_json::from_str::<Fingerprint>(&t).ok());
-    let complete = out.join("summary.json").is_file() || out.join("shard.json").is_file();
+    let complete =
+        out.join(kneeform::output::SUMMARY_JSON).is_file() || out.join("shard.json").is_file();
     complete && recorded.is_some_and(|r| r.fingerprint == fingerprint)
 }
 

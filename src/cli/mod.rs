@@ -183,9 +183,14 @@ pub fn stage_output(out: &Path, force: bool) -> anyhow::Result<OutputDir> {
             // A run's directory, a study's, or a shard's, holding nothing
             // but kneeform's files: a folder of the user's with a
             // summary.json beside their own files is not replaced.
-            let is_run = ["summary.json", "shard.json", "verify.json", "converge.json"]
-                .iter()
-                .any(|f| out.join(f).is_file());
+            let is_run = [
+                kneeform::output::SUMMARY_JSON,
+                "shard.json",
+                "verify.json",
+                "converge.json",
+            ]
+            .iter()
+            .any(|f| out.join(f).is_file());
             let is_empty = std::fs::read_dir(out)
                 .with_context(|| format!("cannot read --out {}", out.display()))?
                 .next()

@@ -55,11 +55,15 @@ pub use self::studies::{
     write_verification, write_verification_files,
 };
 
+/// A run's record of everything it did (`summary.json`): the one name
+/// every reader and writer uses.
+pub const SUMMARY_JSON: &str = "summary.json";
+
 /// The files kneeform writes into a result directory: a run's, a
 /// verification's, a convergence study's, a shard's, the report, and a
 /// batch item's fingerprint.
 pub const OWN_FILES: [&str; 18] = [
-    "summary.json",
+    SUMMARY_JSON,
     "composite.csv",
     "colliding_points.csv",
     "colliding_area.stl",

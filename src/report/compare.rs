@@ -83,7 +83,7 @@ impl Comparison {
         };
         if let Some(reason) = differs {
             return Err(ReportError::Inconsistent {
-                path: other.dir.join("summary.json"),
+                path: other.dir.join(crate::output::SUMMARY_JSON),
                 reason: format!("cannot be compared with {}: {reason}", run.dir.display()),
             });
         }

@@ -41,7 +41,7 @@ use super::views::{ANGLE_COLOUR, Figure, Views, composite_colour, ramp_len};
 pub const MAIN_BORDER: [u8; 3] = [0, 90, 181];
 
 /// The file name the report cites the run's summary as.
-pub const SUMMARY: &str = "summary.json";
+pub const SUMMARY: &str = crate::output::SUMMARY_JSON;
 
 /// The citation prefix of the `k`-th verification directory's files.
 pub fn verify_label(k: usize, file: &str) -> String {
@@ -932,7 +932,7 @@ fn area_chart_svg(run: &Run) -> Markup {
             }
             "\n"
             figcaption {
-                "Colliding area per angle (" code { "summary.json" } ", " code { "per_angle" } ")."
+                "Colliding area per angle (" code { (SUMMARY) } ", " code { "per_angle" } ")."
             }
             "\n"
         }

@@ -178,7 +178,7 @@ impl Run {
     /// relative to the run directory's parent; the first file whose SHA-256
     /// is the run's is used ([`crate::input::read_part_bytes`]).
     pub fn read(dir: &Path, part: Option<&Path>) -> Result<Run, ReportError> {
-        let summary_path = dir.join("summary.json");
+        let summary_path = dir.join(crate::output::SUMMARY_JSON);
         // A run replaced while it is read (`analyze --force` renames a
         // whole new directory into place) would give one run's numbers
         // beside another's pictures: the directory read is the one there
@@ -265,7 +265,7 @@ impl Run {
                     .iter()
                     .position(|r| r.to_bits() == a.to_bits())
                     .ok_or_else(|| ReportError::Inconsistent {
-                        path: self.dir.join("summary.json"),
+                        path: self.dir.join(crate::output::SUMMARY_JSON),
                         reason: format!("angle {a} is not one of the run's"),
                     })
             })
@@ -721,7 +721,7 @@ fn find_parts(
         bodies += part.bodies;
     }
     let first = first.ok_or_else(|| ReportError::Part {
-        path: dir.join("summary.json"),
+        path: dir.join(crate::output::SUMMARY_JSON),
         reason: "every file of the assembly is ignored".into(),
     })?;
     Ok((
