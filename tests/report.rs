@@ -332,10 +332,21 @@ fn report_of_a_scenario_run_has_every_section_embeds_every_figure_and_cites_the_
     }
     // Self-contained: no link, nothing fetched; the one script is the 3D
     // view's, written into the page whole, and fetches nothing.
-    for banned in ["<link", "http://", "https://", "file:", "url(", "<script src"] {
+    for banned in [
+        "<link",
+        "http://",
+        "https://",
+        "file:",
+        "url(",
+        "<script src",
+    ] {
         assert!(!html.contains(banned), "the page contains {banned:?}");
     }
-    assert_eq!(html.matches("<script").count(), 2, "the 3D view's data and code only");
+    assert_eq!(
+        html.matches("<script").count(),
+        2,
+        "the 3D view's data and code only"
+    );
     assert!(html.contains("<script type=\"application/json\" id=\"view3d-data\">"));
     let viewer = include_str!("../src/report/view3d.js");
     assert!(html.contains(&format!("<script>{viewer}</script>")));
