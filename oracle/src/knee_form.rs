@@ -66,6 +66,44 @@ pub struct KneeForm {
     angle_deg: f64,
     /// `v0, v1, v2` rotated by the angle, as (x, z) relative to `v0`, mm.
     triangle: [[f64; 2]; 3],
+    /// Per end ([`End::Left`], [`End::Right`]), what [`KneeForm::x_at`]
+    /// reads, computed once: the BVH traversal asks for the footprint's
+    /// ends at every node it visits.
+    outlines: [Outline; 2],
+}
+
+/// The footprint mirrored in x so that one of its ends is its left end:
+/// the triangle's vertices (centres of the end discs) and, per edge, its
+/// two segments offset by `R` along the edge's normals.
+#[derive(Copy, Clone, Debug, PartialEq)]
+struct Outline {
+    vertices: [[f64; 2]; 3],
+    /// Per edge `k` (from vertex `k` to `k + 1`), the offset segments on
+    /// its two sides, each as its two ends.
+    segments: [[[[f64; 2]; 2]; 2]; 3],
+}
+
+impl Outline {
+    /// The outline of `triangle` rounded by `r`, mirrored by `sign` in x.
+    fn new(triangle: [[f64; 2]; 3], r: f64, sign: f64) -> Outline {
+        let t = triangle.map(|[x, zz]| [sign * x, zz]);
+        let segments = [0, 1, 2].map(|k| {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let e = [b[0] - a[0], b[1] - a[1]];
+            let len = e[0].hypot(e[1]);
+            [1.0, -1.0].map(|side| {
+                let n = [side * e[1] / len, -side * e[0] / len];
+                [
+                    [a[0] + r * n[0], a[1] + r * n[1]],
+                    [b[0] + r * n[0], b[1] + r * n[1]],
+                ]
+            })
+        });
+        Outline {
+            vertices: t,
+            segments,
+        }
+    }
 }
 
 impl KneeForm {
@@ -85,6 +123,7 @@ impl KneeForm {
             dims,
             angle_deg,
             triangle,
+            outlines: [1.0, -1.0].map(|sign| Outline::new(triangle, dims.radius, sign)),
         }
     }
 
@@ -176,13 +215,13 @@ impl KneeForm {
     /// or on one of its end discs, so the extreme of those candidates is
     /// exact.
     pub(crate) fn x_at(&self, z: f64, end: End) -> Option<f64> {
-        let sign = match end {
-            End::Left => 1.0,
-            End::Right => -1.0,
+        let (sign, outline) = match end {
+            End::Left => (1.0, &self.outlines[0]),
+            End::Right => (-1.0, &self.outlines[1]),
         };
         let r = self.dims.radius;
-        // Work on the shape mirrored in x for the right end: its left end.
-        let t = self.triangle.map(|[x, zz]| [sign * x, zz]);
+        // On the shape mirrored in x for the right end: its left end.
+        let t = &outline.vertices;
         let mut best = f64::INFINITY;
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
@@ -192,14 +231,7 @@ impl KneeForm {
                     best = best.min(v[0] - (r * r - dz * dz).sqrt());
                 }
             }
-            let e = [b[0] - a[0], b[1] - a[1]];
-            let len = e[0].hypot(e[1]);
-            for side in [1.0, -1.0] {
-                let n = [side * e[1] / len, -side * e[0] / len];
-                let (a_off, b_off) = (
-                    [a[0] + r * n[0], a[1] + r * n[1]],
-                    [b[0] + r * n[0], b[1] + r * n[1]],
-                );
+            for [a_off, b_off] in outline.segments[k] {
                 let dz = b_off[1] - a_off[1];
                 if dz != 0.0 {
                     let u = (z - a_off[1]) / dz;

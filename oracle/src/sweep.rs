@@ -81,6 +81,13 @@ pub(crate) fn cast(
         if zb < z_lo || za > z_hi {
             return f64::MAX;
         }
+        // The slide's cheap rejections first: the footprint's ends (below)
+        // cost a few square roots, and most nodes fail on y or x alone.
+        if motion == Motion::Slide
+            && (mins.y > origin.y || maxs.y < origin.y - width || mins.x > origin.x + x_back)
+        {
+            return f64::MAX;
+        }
         let (Some(left), Some(right)) = (
             knee.extreme_x(za, zb, End::Left),
             knee.extreme_x(za, zb, End::Right),
