@@ -68,6 +68,7 @@ mod direct;
 mod error;
 mod knee_form;
 mod part;
+mod prune;
 mod rapier;
 mod rate;
 mod sweep;

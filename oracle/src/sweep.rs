@@ -33,6 +33,7 @@ use parry3d_f64::shape::TriMesh;
 
 use crate::FailureReason;
 use crate::knee_form::{End, KneeForm, SweptKneeForm};
+use crate::prune::{Sweep, far_from_sweep};
 
 /// The two motions of SPEC's push and slide.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -118,8 +119,31 @@ pub(crate) fn cast(
     let pos12 = Pose::from_translation(-origin);
     let vel12 = -motion.dir();
     let failure: Cell<Option<FailureReason>> = Cell::new(None);
+    let placed = knee.triangle().map(|[x, z]| [x + origin.x, z + origin.z]);
     let leaf = |id: u32, best: f64| -> Option<ShapeCastHit> {
         let triangle = mesh.triangle(id);
+        // A triangle further than a margin from all the knee-form sweeps
+        // within `best` cannot be met (crate::prune): GJK would say so,
+        // and the contact query confirm it, at far greater cost.
+        let swept = match motion {
+            Motion::Slide => Sweep {
+                triangle: placed,
+                sweep_x: best,
+                y0: origin.y - width,
+                y1: origin.y,
+                radius: knee.dims().radius,
+            },
+            Motion::Push => Sweep {
+                triangle: placed,
+                sweep_x: 0.0,
+                y0: origin.y - width,
+                y1: origin.y + best,
+                radius: knee.dims().radius,
+            },
+        };
+        if far_from_sweep(&swept, [triangle.a, triangle.b, triangle.c]) {
+            return None;
+        }
         let options = ShapeCastOptions {
             max_time_of_impact: best,
             target_distance: 0.0,
