@@ -230,6 +230,7 @@ fn first_contact(
         Motion::Slide,
         max_travel,
         GRAZING,
+        true,
     )?
     else {
         return Ok(None);

@@ -95,6 +95,16 @@ pub struct OracleOptions {
     /// The grid's -x edge (mm): a contact whose witness has `x < x_min`
     /// ends the trace and is not reported. Default `-inf`.
     pub x_min: f64,
+    /// Whether a cast skips, before GJK, the triangles it cannot meet
+    /// ([`crate::prune`]): the same traces, bit for bit, about three times
+    /// faster on a console. Off only to check that (default on).
+    #[serde(default = "prune_on")]
+    pub prune: bool,
+}
+
+/// [`OracleOptions::prune`]'s default.
+fn prune_on() -> bool {
+    true
 }
 
 impl Default for OracleOptions {
@@ -107,6 +117,7 @@ impl Default for OracleOptions {
             jump_tolerance: 1e-6,
             max_casts: 100_000,
             x_min: f64::NEG_INFINITY,
+            prune: true,
         }
     }
 }
@@ -366,6 +377,7 @@ impl Tracer<'_> {
             motion,
             max_travel,
             grazing,
+            self.options.prune,
         )?;
         Ok(hit.map(|c| (c.travel, c.witness)))
     }
