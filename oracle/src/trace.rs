@@ -96,7 +96,7 @@ pub struct OracleOptions {
     /// ends the trace and is not reported. Default `-inf`.
     pub x_min: f64,
     /// Whether a cast skips, before GJK, the triangles it cannot meet
-    /// ([`crate::prune`]): the same traces, bit for bit, about three times
+    /// (the oracle's `prune` module): the same traces, bit for bit, about three times
     /// faster on a console. Off only to check that (default on).
     #[serde(default = "prune_on")]
     pub prune: bool,

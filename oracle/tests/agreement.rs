@@ -106,7 +106,7 @@ fn the_skip_changes_no_trace_on_the_real_meshes() {
         };
         let (mins, maxs) = raw.bounds();
         let extent = (0..3).map(|k| maxs[k] - mins[k]).fold(0.0, f64::max);
-        if !(extent > 0.0) {
+        if extent.is_nan() || extent <= 0.0 {
             continue;
         }
         let part = Part::from_stl_path(path, 600.0 / extent, Side::Left).unwrap();
