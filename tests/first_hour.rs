@@ -156,13 +156,25 @@ fn the_readme_first_command_analyses_and_reports_the_bundled_console() {
     ]
     .concat();
     ok(kneeform(&dir, &converge), "converge with small settings");
+    let report = ["report", "kneeform-out", "v", "c", "--out", "all.html"];
     ok(
-        kneeform(
-            &dir,
-            &["report", "kneeform-out", "v", "c", "--out", "all.html"],
-        ),
+        kneeform(&dir, &report),
         "report with the verification and the study",
     );
+    // These are the README's evidence commands, word for word
+    // (tests/readme.rs accounts for that block by this test).
+    let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
+    let analyze = [
+        "analyze",
+        "scenarios/console_side.stl",
+        "--out",
+        "kneeform-out",
+        "--report",
+    ];
+    for args in [&analyze[..], &verify, &converge, &report] {
+        let line = format!("kneeform {}", args.join(" "));
+        assert!(readme.contains(&line), "README lacks: {line}");
+    }
     let size = std::fs::metadata(dir.join("all.html")).unwrap().len();
     assert!(size < 5_000_000, "the report is {size} bytes");
     if let Some(pages) = crate::util::pdf_pages(&dir.join("all.html"), &dir) {

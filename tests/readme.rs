@@ -89,6 +89,15 @@ const ENTRIES: &[Entry] = &[
         how: How::Run(quick_start),
     },
     Entry {
+        name: "the evidence",
+        key: "kneeform report kneeform-out v c --out all.html",
+        how: How::Skip(
+            "run as written, its report printed to PDF (at most 15 pages) and weighed (under \
+             5 MB), by tests/first_hour.rs's \
+             the_readme_first_command_analyses_and_reports_the_bundled_console",
+        ),
+    },
+    Entry {
         name: "knee-form dimensions",
         key: "--triangle-side 190 --radius 60 --thickness 120",
         how: How::Run(knee_form_dimensions),
