@@ -185,7 +185,9 @@ fn build_report(options: &ReportOptions) -> Result<(String, Report), ReportError
         v.check_against(&run.summary_json)?;
     }
     let angles = small_multiple_angles(&run.summary.angles_deg);
-    let masks = run.angle_masks(&angles)?;
+    // The angle sets, read once: the small multiples and the 3D view.
+    let angle_bits = run.angle_bits()?;
+    let masks = run.angle_masks(&angles, angle_bits.as_ref())?;
     let masks: Vec<(f64, NodeCounts)> = angles.into_iter().zip(masks).collect();
     let views = render_views(&run, &masks);
     let comparison = match &options.compare {
@@ -219,7 +221,7 @@ fn build_report(options: &ReportOptions) -> Result<(String, Report), ReportError
     if let Some(name) = &options.run_name {
         run.dir.clone_from(name);
     }
-    let view3d = view3d::view3d_figure(&run)?;
+    let view3d = view3d::view3d_figure(&run, angle_bits.as_ref())?;
     let html = document::document(&document::Inputs {
         run: &run,
         view3d,

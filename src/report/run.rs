@@ -249,16 +249,20 @@ impl Run {
     }
 
     /// The colliding masks of `angles` (degrees, each one of the run's),
-    /// as counts of 1: from `composite.csv`'s `angle_mask` (bit `a` for
-    /// the run's angle `a`), or, for a run of a version that wrote no
-    /// masks, from `colliding_points.csv`.
-    pub fn angle_masks(&self, angles: &[f64]) -> Result<Vec<NodeCounts>, ReportError> {
-        let composite = self.dir.join("composite.csv");
-        if !CsvRows::open(&composite, &[])?.has_column("angle_mask") {
+    /// as counts of 1 with the composite's heights: from the run's angle
+    /// sets ([`Run::angle_bits`], bit `a` for the run's angle `a`), or,
+    /// for a run of a version that wrote no masks (`bits` is `None`), from
+    /// `colliding_points.csv`.
+    pub fn angle_masks(
+        &self,
+        angles: &[f64],
+        bits: Option<&AngleBits>,
+    ) -> Result<Vec<NodeCounts>, ReportError> {
+        let Some(sets) = bits else {
             return self.angle_masks_of_points(angles);
-        }
+        };
         let run_angles = &self.summary.angles_deg;
-        let bits: Vec<usize> = angles
+        let positions: Vec<usize> = angles
             .iter()
             .map(|a| {
                 run_angles
@@ -274,26 +278,12 @@ impl Run {
             .iter()
             .map(|_| NodeCounts::empty(self.spec))
             .collect::<Result<_, _>>()?;
-        let mut rows = CsvRows::open(&composite, &["i", "j", "x", "y", "z", "angle_mask"])?;
-        let digits = run_angles.len().div_ceil(4).max(1);
-        while let Some(row) = rows.next_row()? {
-            let (k, y) = rows.node(&row, self.spec, &self.frame, self.axes)?;
-            let field = row.get(rows.columns[5]).unwrap_or("");
-            let hex = field
-                .strip_prefix("0x")
-                .filter(|h| h.len() == digits && h.bytes().all(|b| b.is_ascii_hexdigit()))
-                .ok_or_else(|| {
-                    rows.bad(format!(
-                        "angle_mask = {field:?} is not 0x and {digits} hex digits"
-                    ))
-                })?;
-            for (mask, &a) in masks.iter_mut().zip(&bits) {
-                // Digit d (from the right) holds angles 4d..4d+4.
-                let digit = hex.as_bytes()[digits - 1 - a / 4];
-                let nibble = char::from(digit).to_digit(16).expect("checked hex");
-                if nibble >> (a % 4) & 1 == 1 {
+        for (mask, &a) in masks.iter_mut().zip(&positions) {
+            for k in 0..self.spec.len() {
+                if sets.bits[k * sets.bytes + a / 8] >> (a % 8) & 1 == 1 {
                     mask.count[k] = 1;
-                    mask.y[k] = y;
+                    // The node's row of composite.csv, read once.
+                    mask.y[k] = self.composite.y[k];
                 }
             }
         }
@@ -307,11 +297,10 @@ impl Run {
     /// no masks.
     pub fn angle_bits(&self) -> Result<Option<AngleBits>, ReportError> {
         let composite = self.dir.join("composite.csv");
-        let mut rows = CsvRows::open(&composite, &[])?;
-        if !rows.has_column("angle_mask") {
+        if !CsvRows::open(&composite, &[])?.has_column("angle_mask") {
             return Ok(None);
         }
-        rows = CsvRows::open(&composite, &["i", "j", "x", "y", "z", "angle_mask"])?;
+        let mut rows = CsvRows::open(&composite, &["i", "j", "x", "y", "z", "angle_mask"])?;
         let n = self.summary.angles_deg.len();
         let digits = n.div_ceil(4).max(1);
         let bytes = n.div_ceil(8).max(1);

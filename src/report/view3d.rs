@@ -27,10 +27,11 @@ use maud::{Markup, PreEscaped, html};
 use serde_json::json;
 
 use crate::frame::Approach;
+use crate::mesh::Part;
 
 use super::ReportError;
 use super::html::base64;
-use super::run::Run;
+use super::run::{AngleBits, Run};
 use super::views::{OBLIQUE_Y_TOL_PITCHES, composite_colour, ramp_len, run_oblique_camera};
 
 /// The most triangles the page carries (about 17 MB of base64 at the
@@ -42,7 +43,7 @@ pub const MAX_NODES: usize = 8192 * 8192;
 
 /// The 3D view's figure: a canvas, its controls' help, the readout of a
 /// picked point, and the data; or a note saying why there is none.
-pub fn view3d_figure(run: &Run) -> Result<Markup, ReportError> {
+pub fn view3d_figure(run: &Run, angle_bits: Option<&AngleBits>) -> Result<Markup, ReportError> {
     let triangles = &run.part.triangles;
     let spec = run.spec;
     if triangles.len() > MAX_TRIANGLES || spec.len() > MAX_NODES {
@@ -55,7 +56,7 @@ pub fn view3d_figure(run: &Run) -> Result<Markup, ReportError> {
             "\n"
         });
     }
-    let data = scene_json(run)?;
+    let data = scene_json(run, angle_bits)?;
     // `</` cannot appear in the JSON's strings (base64 and numbers), so the
     // script element holds it whole.
     let data = data.replace("</", "<\\/");
@@ -85,8 +86,8 @@ pub fn view3d_figure(run: &Run) -> Result<Markup, ReportError> {
 
 /// The scene as JSON: geometry, node textures, the ramp, the grid's
 /// placement and the first camera.
-fn scene_json(run: &Run) -> Result<String, ReportError> {
-    let (centre, radius, positions, indices) = mesh(&run.part.triangles);
+fn scene_json(run: &Run, angle_bits: Option<&AngleBits>) -> Result<String, ReportError> {
+    let (centre, radius, positions, indices) = mesh(&run.part);
     let spec = run.spec;
     let composite = &run.composite;
     let (lo, hi) = composite
@@ -111,8 +112,7 @@ fn scene_json(run: &Run) -> Result<String, ReportError> {
         px.copy_from_slice(&[c.min(255) as u8, (q >> 8) as u8, q as u8, 255]);
     }
     let nodes_png = rgba_png(spec.nx, spec.nz, &nodes)?;
-    let angle_bits = run.angle_bits()?;
-    let (masks_png, words) = match &angle_bits {
+    let (masks_png, words) = match angle_bits {
         None => (None, 0),
         Some(bits) => {
             // Three bytes a pixel, alpha 255: a browser premultiplies a
@@ -180,18 +180,14 @@ fn scene_json(run: &Run) -> Result<String, ReportError> {
 /// radius of its sphere, the vertices' `f32` offsets from the centre and
 /// the triangles' `u32` indices (little-endian bytes). Vertices are shared
 /// where their offsets are equal to the bit.
-fn mesh(triangles: &[crate::mesh::Triangle]) -> ([f64; 3], f64, Vec<u8>, Vec<u8>) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in triangles.iter().flatten() {
-        for a in 0..3 {
-            lo[a] = lo[a].min(p[a]);
-            hi[a] = hi[a].max(p[a]);
-        }
-    }
-    if triangles.is_empty() {
-        (lo, hi) = ([0.0; 3], [0.0; 3]);
-    }
+fn mesh(part: &Part) -> ([f64; 3], f64, Vec<u8>, Vec<u8>) {
+    let triangles = &part.triangles;
+    let (lo, hi) = if triangles.is_empty() {
+        ([0.0; 3], [0.0; 3])
+    } else {
+        let b = part.bbox();
+        (b.min, b.max)
+    };
     let centre = [0, 1, 2].map(|a| 0.5 * (lo[a] + hi[a]));
     let radius = (0..3)
         .map(|a| (hi[a] - lo[a]).powi(2))
@@ -249,7 +245,13 @@ mod tests {
             [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [0.0, 0.0, 20.0]],
             [[10.0, 0.0, 0.0], [10.0, 4.0, 20.0], [0.0, 0.0, 20.0]],
         ];
-        let (centre, radius, positions, indices) = mesh(&tris);
+        let part = Part {
+            file_triangles: tris.len(),
+            triangles: tris.clone(),
+            degenerate: 0,
+            bodies: 1,
+        };
+        let (centre, radius, positions, indices) = mesh(&part);
         assert_eq!(centre, [5.0, 2.0, 10.0]);
         assert!((radius - 0.5 * (100.0f64 + 16.0 + 400.0).sqrt()).abs() < 1e-12);
         let floats: Vec<f32> = positions
