@@ -719,34 +719,20 @@ fn the_report_renders_in_headless_chromium() {
 }
 
 /// The page's DOM after its scripts ran, from headless Chromium with
-/// `flags`; `None` (said on stderr) when Chromium is not installed.
+/// `flags`; `None` when Chromium is not installed
+/// ([`crate::util::headless`]).
 fn dump_dom(page: &Path, dir: &Path, flags: &[&str]) -> Option<String> {
-    let Some(browser) = crate::util::chromium() else {
-        eprintln!("skipped the browser check: chromium not installed (CI installs it in .ci/run)");
-        return None;
-    };
-    let out = std::process::Command::new(browser)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            // Virtual time: the page's asynchronous image decoding is
-            // waited for, however slow the machine.
-            "--virtual-time-budget=30000",
-            "--dump-dom",
-        ])
-        .args(flags)
-        .arg(format!(
-            "--user-data-dir={}",
-            dir.join("chromium-profile").display()
-        ))
-        .arg(format!("file://{}", page.display()))
-        .output()
-        .expect("chromium runs");
+    let args: Vec<String> = [
+        // Virtual time: the page's asynchronous image decoding is waited
+        // for, however slow the machine.
+        "--virtual-time-budget=30000",
+        "--dump-dom",
+    ]
+    .iter()
+    .chain(flags)
+    .map(|a| a.to_string())
+    .collect();
+    let out = crate::util::headless(page, dir, "browser check", &args)?;
     Some(String::from_utf8_lossy(&out.stdout).into_owned())
 }
 

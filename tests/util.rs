@@ -397,7 +397,7 @@ pub fn lines(from: f64, to: f64, step: f64, extra: &[f64]) -> Vec<f64> {
 }
 
 /// Headless Chromium, when installed.
-pub fn chromium() -> Option<std::path::PathBuf> {
+fn chromium() -> Option<std::path::PathBuf> {
     let path = std::env::var_os("PATH")?;
     ["chromium", "chromium-browser"].iter().find_map(|name| {
         std::env::split_paths(&path)
@@ -406,15 +406,20 @@ pub fn chromium() -> Option<std::path::PathBuf> {
     })
 }
 
-/// Screenshots the page `page` in headless Chromium at 1200 x 1600, with
-/// its profile and the shot in `dir`; the PNG's bytes, or `None` (said on
-/// stderr) when Chromium is not installed (CI installs it in .ci/run).
-pub fn screenshot(page: &std::path::Path, dir: &std::path::Path) -> Option<Vec<u8>> {
+/// Runs headless Chromium on the page `page` with `args` besides the
+/// common ones (no sandbox, GPU or network, its profile in `dir`); its
+/// output, or `None` (said on stderr, naming `check`) when Chromium is not
+/// installed (CI installs it in .ci/run).
+pub fn headless(
+    page: &std::path::Path,
+    dir: &std::path::Path,
+    check: &str,
+    args: &[String],
+) -> Option<std::process::Output> {
     let Some(browser) = chromium() else {
-        eprintln!("skipped the browser check: chromium not installed (CI installs it in .ci/run)");
+        eprintln!("skipped the {check}: chromium not installed (CI installs it in .ci/run)");
         return None;
     };
-    let shot = dir.join("shot.png");
     let out = std::process::Command::new(browser)
         .args([
             "--headless",
@@ -425,17 +430,29 @@ pub fn screenshot(page: &std::path::Path, dir: &std::path::Path) -> Option<Vec<u
             "--disable-background-networking",
             "--disable-component-update",
             "--disable-sync",
-            "--hide-scrollbars",
-            "--window-size=1200,1600",
         ])
+        .args(args)
         .arg(format!(
             "--user-data-dir={}",
             dir.join("chromium-profile").display()
         ))
-        .arg(format!("--screenshot={}", shot.display()))
         .arg(format!("file://{}", page.display()))
         .output()
         .expect("chromium runs");
+    Some(out)
+}
+
+/// Screenshots the page `page` in headless Chromium at 1200 x 1600, with
+/// its profile and the shot in `dir`; the PNG's bytes, or `None` when
+/// Chromium is not installed ([`headless`]).
+pub fn screenshot(page: &std::path::Path, dir: &std::path::Path) -> Option<Vec<u8>> {
+    let shot = dir.join("shot.png");
+    let args = [
+        "--hide-scrollbars".to_string(),
+        "--window-size=1200,1600".to_string(),
+        format!("--screenshot={}", shot.display()),
+    ];
+    let out = headless(page, dir, "browser check", &args)?;
     assert!(
         shot.is_file(),
         "no screenshot: {}",
@@ -446,33 +463,15 @@ pub fn screenshot(page: &std::path::Path, dir: &std::path::Path) -> Option<Vec<u
 
 /// Prints the page `page` to PDF in headless Chromium (A4, the page's
 /// print stylesheet, no header or footer), with its profile and the PDF in
-/// `dir`; the number of pages, or `None` (said on stderr) when Chromium is
-/// not installed (CI installs it in .ci/run).
+/// `dir`; the number of pages, or `None` when Chromium is not installed
+/// ([`headless`]).
 pub fn pdf_pages(page: &std::path::Path, dir: &std::path::Path) -> Option<usize> {
-    let Some(browser) = chromium() else {
-        eprintln!("skipped the print check: chromium not installed (CI installs it in .ci/run)");
-        return None;
-    };
     let pdf = dir.join("page.pdf");
-    let out = std::process::Command::new(browser)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--no-pdf-header-footer",
-        ])
-        .arg(format!(
-            "--user-data-dir={}",
-            dir.join("chromium-profile").display()
-        ))
-        .arg(format!("--print-to-pdf={}", pdf.display()))
-        .arg(format!("file://{}", page.display()))
-        .output()
-        .expect("chromium runs");
+    let args = [
+        "--no-pdf-header-footer".to_string(),
+        format!("--print-to-pdf={}", pdf.display()),
+    ];
+    let out = headless(page, dir, "print check", &args)?;
     let bytes = std::fs::read(&pdf).unwrap_or_else(|_| {
         panic!("no PDF: {}", String::from_utf8_lossy(&out.stderr));
     });
