@@ -286,6 +286,35 @@ fn the_area_iou_says_what_it_cannot_see() {
     assert!(html.contains("cannot see a difference under half a pitch"));
 }
 
+/// Runs the study `common` (a `verify` or `converge` command line) in
+/// `dir` with `--out out` and `extra`.
+fn study(dir: &Path, common: &[&str], out: &str, extra: &[&str]) -> std::process::Output {
+    kneeform_in(dir, &[common, &["--out", out], extra].concat())
+}
+
+/// Issue 26, item 4: the study `common`, 40 starts, is refused under a
+/// budget its prediction exceeds, naming the `--shard` count that would
+/// fit, before it writes anything; run with `free` (no budget, or a
+/// generous one) into `free/`, it prints its prediction from one start in
+/// twenty.
+fn holds_to_its_budget(dir: &Path, common: &[&str], free: &[&str]) {
+    let o = study(dir, common, "refused", &["--budget-s", "0.000001"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--budget-s") && err.contains("--shard K/"),
+        "{err}"
+    );
+    assert!(!dir.join("refused").exists(), "a refused run wrote nothing");
+    let o = study(dir, common, "free", free);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    assert!(
+        err.contains("predicted from 2 of the 40 starts at every angle"),
+        "{err}"
+    );
+}
+
 /// Issue 26, item 4: `verify` printed nothing about how long its oracle
 /// would take. One start in twenty is traced first, at every angle; its
 /// time predicts the rest (printed), and a prediction beyond `--budget-s`
@@ -295,34 +324,18 @@ fn the_area_iou_says_what_it_cannot_see() {
 #[test]
 fn verify_predicts_its_oracle_time_and_keeps_within_a_budget() {
     let dir = scratch_dir("second-hour-budget");
+    let part = scenario("bump");
     let common = [
         "verify",
-        &scenario("bump"),
+        &part,
         "--pitch",
         "4",
         "--angles=-30,0,30",
         "--starts",
         "40",
     ];
-    let run = |out: &str, extra: &[&str]| {
-        kneeform_in(&dir, &[&common[..], &["--out", out], extra].concat())
-    };
-    let o = run("refused", &["--budget-s", "0.000001"]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("--budget-s") && err.contains("--shard K/"),
-        "{err}"
-    );
-    assert!(!dir.join("refused").exists(), "a refused run wrote nothing");
-    let o = run("free", &[]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
-    assert!(
-        err.contains("predicted from 2 of the 40 starts at every angle"),
-        "{err}"
-    );
-    let o = run("budget", &["--budget-s", "100000"]);
+    holds_to_its_budget(&dir, &common, &[]);
+    let o = study(&dir, &common, "budget", &["--budget-s", "100000"]);
     assert!(matches!(o.status.code(), Some(0 | 1)));
     let csv = |d: &str| std::fs::read_to_string(dir.join(d).join("verify.csv")).unwrap();
     assert_eq!(csv("free"), csv("budget"), "the same rows either way");
@@ -334,33 +347,17 @@ fn verify_predicts_its_oracle_time_and_keeps_within_a_budget() {
 #[test]
 fn converge_predicts_its_oracle_time_and_keeps_within_a_budget() {
     let dir = scratch_dir("second-hour-converge-budget");
+    let part = scenario("bump");
     let common = [
         "converge",
-        &scenario("bump"),
+        &part,
         "--pitches",
         "8,4",
         "--angles=-30,0,30",
         "--starts",
         "40",
     ];
-    let run = |out: &str, extra: &[&str]| {
-        kneeform_in(&dir, &[&common[..], &["--out", out], extra].concat())
-    };
-    let o = run("refused", &["--budget-s", "0.000001"]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("--budget-s") && err.contains("--shard K/"),
-        "{err}"
-    );
-    assert!(!dir.join("refused").exists(), "a refused run wrote nothing");
-    let o = run("free", &["--budget-s", "100000"]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
-    assert!(
-        err.contains("predicted from 2 of the 40 starts at every angle"),
-        "{err}"
-    );
+    holds_to_its_budget(&dir, &common, &["--budget-s", "100000"]);
     assert!(dir.join("free/converge.json").is_file());
 }
 
