@@ -540,6 +540,22 @@ impl Drop for OutputDir {
     }
 }
 
+/// Decodes a PNG written here (RGB or RGBA, 8 bits): width, height and
+/// its pixels' RGB.
+#[cfg(test)]
+pub(crate) fn decode_png(path: &Path) -> (usize, usize, Vec<[u8; 3]>) {
+    let decoder = ::png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let channels = info.line_size / info.width as usize;
+    let pixels = buf[..info.buffer_size()]
+        .chunks(channels)
+        .map(|c| [c[0], c[1], c[2]])
+        .collect();
+    (info.width as usize, info.height as usize, pixels)
+}
+
 /// A fresh, empty directory under the system's temporary directory.
 #[cfg(test)]
 pub(crate) fn temp_dir(tag: &str) -> PathBuf {

@@ -402,22 +402,7 @@ fn draw_error<E: std::fmt::Display>(e: E) -> WriteError {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::output::temp_dir;
-
-    /// Decodes a PNG written here (RGB, 8 bits).
-    fn decode(path: &Path) -> (usize, usize, Vec<[u8; 3]>) {
-        let decoder =
-            ::png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
-        let mut reader = decoder.read_info().unwrap();
-        let mut buf = vec![0; reader.output_buffer_size()];
-        let info = reader.next_frame(&mut buf).unwrap();
-        let channels = info.line_size / info.width as usize;
-        let pixels = buf[..info.buffer_size()]
-            .chunks(channels)
-            .map(|c| [c[0], c[1], c[2]])
-            .collect();
-        (info.width as usize, info.height as usize, pixels)
-    }
+    use crate::output::{decode_png, temp_dir};
 
     #[test]
     fn labels_have_three_significant_digits_and_no_float_noise() {
@@ -484,7 +469,7 @@ mod tests {
                 },
             )
             .unwrap();
-            let (w, h, pixels) = decode(&path);
+            let (w, h, pixels) = decode_png(&path);
             assert_eq!((w as u32, h as u32), (layout.width, layout.height));
             // Nothing is drawn in the canvas's outer margin: no label
             // runs off an edge.

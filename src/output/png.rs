@@ -943,7 +943,7 @@ fn grey(t: f64) -> RGBColor {
 mod tests {
     use super::*;
     use crate::grid::GridSpec;
-    use crate::output::temp_dir;
+    use crate::output::{decode_png, temp_dir};
 
     fn grid(nx: usize, nz: usize, h: impl Fn(usize, usize) -> f64) -> HeightGrid {
         let spec = GridSpec {
@@ -993,7 +993,7 @@ mod tests {
         )
         .unwrap();
         // The blind spot's cross is drawn.
-        let (_, _, pixels) = decode(&dir.join("composite.png"));
+        let (_, _, pixels) = decode_png(&dir.join("composite.png"));
         assert!(count_of(&pixels, BLIND_COLOUR) > 4);
         // The part meets columns 5..120: grown by a twentieth of that
         // (5 nodes), the window is the whole grid, 120 x 60 nodes, enlarged
@@ -1083,21 +1083,6 @@ mod tests {
         ));
     }
 
-    /// Decodes a PNG written here (RGB, 8 bits).
-    fn decode(path: &Path) -> (usize, usize, Vec<[u8; 3]>) {
-        let decoder =
-            ::png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
-        let mut reader = decoder.read_info().unwrap();
-        let mut buf = vec![0; reader.output_buffer_size()];
-        let info = reader.next_frame(&mut buf).unwrap();
-        let channels = info.line_size / info.width as usize;
-        let pixels = buf[..info.buffer_size()]
-            .chunks(channels)
-            .map(|c| [c[0], c[1], c[2]])
-            .collect();
-        (info.width as usize, info.height as usize, pixels)
-    }
-
     fn count_of(pixels: &[[u8; 3]], colour: RGBColor) -> usize {
         pixels
             .iter()
@@ -1162,7 +1147,7 @@ mod tests {
             &[],
         )
         .unwrap();
-        let (_, _, pixels) = decode(&path);
+        let (_, _, pixels) = decode_png(&path);
         // The ring: 2 px wide, radius 9: well over 50 pixels.
         assert!(count_of(&pixels, RING_COLOUR) > 50, "no ring");
         assert!(count_of(&pixels, count_colour(5, 61)) >= 1, "no node");
@@ -1172,7 +1157,7 @@ mod tests {
         // Many struck nodes: no rings.
         let many = vec![1u16; nx * nz];
         write_composite_png(&path, &g, &many, 61, "all", &Side::Left.into(), &[]).unwrap();
-        let (_, _, pixels) = decode(&path);
+        let (_, _, pixels) = decode_png(&path);
         assert_eq!(count_of(&pixels, RING_COLOUR), 0);
         std::fs::remove_dir_all(dir).unwrap();
     }
@@ -1188,7 +1173,7 @@ mod tests {
         for side in [Side::Left, Side::Right] {
             let path = dir.join("side.png");
             write_composite_png(&path, &g, &composite, 1, "side", &side.into(), &[]).unwrap();
-            let (w, _, pixels) = decode(&path);
+            let (w, _, pixels) = decode_png(&path);
             let cols: Vec<usize> = (0..pixels.len())
                 .filter(|&k| pixels[k] == [struck.0, struck.1, struck.2])
                 .map(|k| k % w)
@@ -1217,7 +1202,7 @@ mod tests {
         for side in [Side::Left, Side::Right] {
             let path = dir.join("depth.png");
             let layout = depth_png(&path, &g, &side.into()).unwrap();
-            let (w, h, pixels) = decode(&path);
+            let (w, h, pixels) = decode_png(&path);
             let bar = layout.chart_w..layout.chart_w + layout.bar_w;
             // The bar: the image's right strip; its brightest (closest)
             // colour nearest the end the words say.
@@ -1240,7 +1225,7 @@ mod tests {
     /// at its edges, and that every key entry, swatch and words, lies
     /// inside it and is drawn whole.
     fn assert_inside(path: &Path, layout: &Layout, what: &str) {
-        let (w, h, pixels) = decode(path);
+        let (w, h, pixels) = decode_png(path);
         assert_eq!((w, h), (layout.width, layout.height), "{what}");
         let at = |c: usize, r: usize| pixels[r * w + c];
         // The image's border (half its margin) is blank: no text, axis or
