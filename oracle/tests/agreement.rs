@@ -11,6 +11,8 @@ use std::path::{Path, PathBuf};
 
 use kneeform_oracle::{OracleOptions, Part, Side, StartTrace, evaluate};
 
+mod util;
+
 /// The repository's root.
 fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -19,17 +21,8 @@ fn repo() -> PathBuf {
 /// 3 x 2 starts over the part's xz-extent, at -30, 0 and 30 degrees, with
 /// and without the skip; the traces must be equal.
 fn agree(name: &str, part: &Part) -> usize {
-    let (mins, maxs) = part.bounds();
-    let starts: Vec<[f64; 2]> = (0..3)
-        .flat_map(|i| {
-            (0..2).map(move |j| {
-                [
-                    mins[0] + (maxs[0] - mins[0]) * (i as f64 + 0.5) / 3.0,
-                    mins[2] + (maxs[2] - mins[2]) * (j as f64 + 0.5) / 2.0,
-                ]
-            })
-        })
-        .collect();
+    let (mins, _) = part.bounds();
+    let starts = util::starts_over(part, 3, 2);
     let angles = [-30.0, 0.0, 30.0];
     // A 4 mm study's bisection: coarse enough to keep the test short,
     // fine enough for hundreds of casts per start.
@@ -101,15 +94,9 @@ fn the_skip_changes_no_trace_on_the_real_meshes() {
     let mut compared = 0;
     for path in &files {
         // Scaled to about 600 mm, as a user's part (tests/real_meshes.rs).
-        let Ok(raw) = Part::from_stl_path(path, 1.0, Side::Left) else {
+        let Ok(part) = util::stl_at_size(path, 600.0, Side::Left) else {
             continue; // empty or broken: refused, as real_meshes.rs checks
         };
-        let (mins, maxs) = raw.bounds();
-        let extent = (0..3).map(|k| maxs[k] - mins[k]).fold(0.0, f64::max);
-        if extent.is_nan() || extent <= 0.0 {
-            continue;
-        }
-        let part = Part::from_stl_path(path, 600.0 / extent, Side::Left).unwrap();
         agree(&path.display().to_string(), &part);
         compared += 1;
     }

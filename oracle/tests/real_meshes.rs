@@ -7,6 +7,8 @@ use kneeform_oracle::{
     KneeForm, OracleError, OracleOptions, Part, Side, StartStatus, StartTrace, evaluate,
 };
 
+mod util;
+
 fn mesh(name: &str) -> PathBuf {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes")).join(name)
 }
@@ -44,22 +46,9 @@ fn in_footprint(knee: &KneeForm, start: [f64; 2], x: f64, z: f64) -> bool {
 /// Scales the file to about 600 mm, evaluates a 5 x 4 grid of starts over
 /// its xz-extent at three angles, and checks each answer.
 fn check(name: &str, side: Side) -> Vec<StartTrace> {
-    let raw = Part::from_stl_path(&mesh(name), 1.0, Side::Left).unwrap();
-    let (mins, maxs) = raw.bounds();
-    let extent = (0..3).map(|k| maxs[k] - mins[k]).fold(0.0, f64::max);
-    let scale = 600.0 / extent;
-    let part = Part::from_stl_path(&mesh(name), scale, side).unwrap();
-    let (mins, maxs) = part.bounds();
-    let starts: Vec<[f64; 2]> = (0..5)
-        .flat_map(|i| {
-            (0..4).map(move |j| {
-                [
-                    mins[0] + (maxs[0] - mins[0]) * (i as f64 + 0.5) / 5.0,
-                    mins[2] + (maxs[2] - mins[2]) * (j as f64 + 0.5) / 4.0,
-                ]
-            })
-        })
-        .collect();
+    let part = util::stl_at_size(&mesh(name), 600.0, side).unwrap();
+    let (mins, _) = part.bounds();
+    let starts = util::starts_over(&part, 5, 4);
     let options = OracleOptions {
         witness_tolerance: 1.0,
         level_step: 5.0,
