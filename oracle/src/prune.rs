@@ -78,18 +78,21 @@ pub(crate) fn far_from_sweep(sweep: &Sweep, tri: [Vector; 3]) -> bool {
     }
     // Otherwise the distance is between boundaries: P's boundary lies on
     // the union of T's edges, the shifted T's edges and the connectors.
-    let mut segments: Vec<[[f64; 2]; 2]> = Vec::with_capacity(9);
+    let mut segments = [[[0.0; 2]; 2]; 9];
+    let mut m = 0;
     for k in 0..3 {
-        segments.push([t[k], t[(k + 1) % 3]]);
+        segments[m] = [t[k], t[(k + 1) % 3]];
+        m += 1;
         if sweep.sweep_x > 0.0 {
-            segments.push([shifted[k], shifted[(k + 1) % 3]]);
-            segments.push([t[k], shifted[k]]);
+            segments[m] = [shifted[k], shifted[(k + 1) % 3]];
+            segments[m + 1] = [t[k], shifted[k]];
+            m += 2;
         }
     }
     let reach2 = reach * reach;
     for k in 0..n {
         let e = [q[k], q[(k + 1) % n]];
-        for s in &segments {
+        for s in &segments[..m] {
             if segment_distance2(e, *s) <= reach2 {
                 return false;
             }
@@ -104,8 +107,12 @@ fn clip_to_slab(tri: [Vector; 3], y0: f64, y1: f64) -> Option<([[f64; 2]; 5], us
     if tri.iter().all(|p| p.y < y0) || tri.iter().all(|p| p.y > y1) {
         return None;
     }
-    // Sutherland-Hodgman against y >= y0, then y <= y1, in 3D.
-    let mut a: Vec<Vector> = tri.to_vec();
+    // Sutherland-Hodgman against y >= y0, then y <= y1, in 3D; a triangle
+    // clipped by two planes keeps at most five points. Fixed arrays: this
+    // runs for every triangle a cast's traversal reaches.
+    let mut a = [Vector::ZERO; 5];
+    a[..3].copy_from_slice(&tri);
+    let mut n = 3;
     for (bound, keep_above) in [(y0, true), (y1, false)] {
         let inside = |p: &Vector| {
             if keep_above {
@@ -114,28 +121,31 @@ fn clip_to_slab(tri: [Vector; 3], y0: f64, y1: f64) -> Option<([[f64; 2]; 5], us
                 p.y <= bound
             }
         };
-        let mut out = Vec::with_capacity(a.len() + 1);
-        for k in 0..a.len() {
-            let (p, q) = (a[k], a[(k + 1) % a.len()]);
+        let mut out = [Vector::ZERO; 5];
+        let mut m = 0;
+        for k in 0..n {
+            let (p, q) = (a[k], a[(k + 1) % n]);
             let (pin, qin) = (inside(&p), inside(&q));
             if pin {
-                out.push(p);
+                out[m] = p;
+                m += 1;
             }
             if pin != qin {
                 let t = (bound - p.y) / (q.y - p.y);
-                out.push(p + (q - p) * t);
+                out[m] = p + (q - p) * t;
+                m += 1;
             }
         }
-        a = out;
-        if a.is_empty() {
+        (a, n) = (out, m);
+        if n == 0 {
             return None;
         }
     }
     let mut points = [[0.0; 2]; 5];
-    for (slot, p) in points.iter_mut().zip(&a) {
+    for (slot, p) in points.iter_mut().zip(&a[..n]) {
         *slot = [p.x, p.z];
     }
-    Some((points, a.len().min(5)))
+    Some((points, n))
 }
 
 /// The box of `P`.
