@@ -5,6 +5,7 @@ use kneeform_oracle::{ContactPoint, FailureReason, LevelCurve, StartStatus, Star
 use serde::{Deserialize, Serialize};
 
 use super::causes::{Cells, RISE_REACH};
+use super::nearest::PointSet;
 use super::trace::GridTrace;
 
 /// The metric names, as the rows of `converge.csv` and the keys of
@@ -520,12 +521,6 @@ fn xz(p: [f64; 3]) -> [f64; 2] {
     [p[0], p[2]]
 }
 
-fn nearest(p: [f64; 2], set: &[[f64; 2]]) -> f64 {
-    set.iter()
-        .map(|q| (p[0] - q[0]).hypot(p[1] - q[1]))
-        .fold(f64::INFINITY, f64::min)
-}
-
 /// The stated bound of the grid's level error along one exact trace: how
 /// much deeper than the exact knee-form's level `f*(s)` the grid's level
 /// may lie at travel `s` (mm).
@@ -895,11 +890,10 @@ pub fn compare(
             .filter(|_| first_blind == blind)
             .map(|(e, _)| e)
     };
-    let miss_of =
-        |set: &[[f64; 2]]| -> Vec<f64> { set.iter().map(|&e| nearest(e, grid_points)).collect() };
-    let false_alarm_of = |set: &[[f64; 2]], to: &[[f64; 2]]| -> Vec<f64> {
-        set.iter().map(|&g| nearest(g, to)).collect()
-    };
+    let grid_set = PointSet::new(grid_points.clone());
+    let miss_of = |set: &[[f64; 2]]| grid_set.distances(set);
+    let strikes_or_push = PointSet::new(strikes_or_push);
+    let possible_or_push = PointSet::new(possible_or_push);
     StartComparison {
         push_error: match (grid.yr.is_finite(), exact.yr_star) {
             (true, Some(star)) if placed => Some(grid.yr - star),
@@ -926,10 +920,10 @@ pub fn compare(
         miss_brief,
         miss_half_pitch: None,
         miss_blind: miss_of(&pts.blind),
-        false_alarm: false_alarm_of(grid_points, &strikes_or_push),
-        false_alarm_decided: false_alarm_of(&pts.grid_decided, &possible_or_push),
+        false_alarm: strikes_or_push.distances(grid_points),
+        false_alarm_decided: possible_or_push.distances(&pts.grid_decided),
         false_alarm_explained: explained_flags,
-        false_alarm_blind: false_alarm_of(&pts.grid_blind, &possible_or_push),
+        false_alarm_blind: possible_or_push.distances(&pts.grid_blind),
         unmatched_deflection: deflection(&|c| c.strike),
         unmatched_deflection_decided: deflection(&|c| {
             decided_strike(c) && !is_blind(c.contact.travel)

@@ -116,33 +116,27 @@ pub(crate) fn grid_trace(
             front: spec.x(i0) + f64::from(row.kf) * p + row.d0,
         })
         .collect();
-    let rows = fp
-        .rows
-        .iter()
-        .filter(|r| !(fault == Some(Fault::FootprintRowShort) && Some(r.dj) == leading))
-        .filter_map(on_grid);
+    let short = |r: &crate::kneeform::FootprintRow| {
+        fault == Some(Fault::FootprintRowShort) && Some(r.dj) == leading
+    };
     let mut yr = f64::INFINITY;
-    let mut front: Vec<(f64, usize, usize)> = Vec::new();
-    for (row, j) in rows {
+    // The rows in the footprint's slide order (by `d0`, then `j`), each
+    // with the column of its first node in front.
+    let mut in_order: Vec<(f64, i64, usize)> = Vec::with_capacity(fp.rows.len());
+    for &r in &fp.slide_order {
+        let row = &fp.rows[r as usize];
+        let Some((row, j)) = on_grid(row).filter(|_| !short(row)) else {
+            continue;
+        };
         for k in row.klo..=row.khi {
             let i = i0 as i64 + i64::from(k);
             if (0..spec.nx as i64).contains(&i) {
                 yr = yr.min(h(i as usize, j));
             }
         }
-        // Nodes in front: offsets kf, kf - 1, ... down to column 0.
-        let mut m = 0;
-        loop {
-            let i = i0 as i64 + i64::from(row.kf) - m;
-            if i < 0 {
-                break;
-            }
-            if i < spec.nx as i64 {
-                front.push((row.d0 + m as f64 * p, i as usize, j));
-            }
-            m += 1;
-        }
+        in_order.push((row.d0, i0 as i64 + i64::from(row.kf), j));
     }
+    let front = front_in_distance_order(&in_order, p, spec.nx);
     let mut trace = GridTrace {
         yr,
         colliding: Vec::new(),
@@ -151,7 +145,6 @@ pub(crate) fn grid_trace(
     if yr == f64::INFINITY {
         return trace;
     }
-    front.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
     let mut f = yr;
     let mut history = LevelHistory::new(yr);
     let mut k = 0;
@@ -196,12 +189,105 @@ pub(crate) fn grid_trace(
     trace
 }
 
+/// Every node in front of a start, `(distance, i, j)`, in the order the
+/// slide meets them: by distance, ties by row. `rows` holds each row's
+/// `d0` (in `(0, p]`, up to rounding), the column of its first node in
+/// front and its grid row, in the order of `d0` then row; the row meets
+/// its columns `first, first - 1, ... 0` at `d0, d0 + p, ...`.
+///
+/// Generated layer by layer (the `m`-th node in front of every row, rows
+/// in `d0` order), which is that order up to rounding at the layers'
+/// borders; an insertion sort settles those, so the result is the sorted
+/// order exactly, in time linear in the nodes instead of a sort's
+/// `n log n` (the per-start trace met 10^5 nodes on the console).
+fn front_in_distance_order(
+    rows: &[(f64, i64, usize)],
+    p: f64,
+    nx: usize,
+) -> Vec<(f64, usize, usize)> {
+    let deepest = rows.iter().map(|r| r.1).max().unwrap_or(-1);
+    let mut front: Vec<(f64, usize, usize)> = Vec::new();
+    for m in 0..=deepest {
+        for &(d0, first, j) in rows {
+            let i = first - m;
+            if (0..nx as i64).contains(&i) {
+                front.push((d0 + m as f64 * p, i as usize, j));
+            }
+        }
+    }
+    let before = |a: &(f64, usize, usize), b: &(f64, usize, usize)| {
+        a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)).is_lt()
+    };
+    for k in 1..front.len() {
+        let mut n = k;
+        while n > 0 && before(&front[n], &front[n - 1]) {
+            front.swap(n, n - 1);
+            n -= 1;
+        }
+    }
+    front
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::engine::{EngineOptions, colliding_masks};
     use crate::grid::GridSpec;
     use crate::kneeform::KneeForm;
+
+    /// The layered order is the sorted order exactly, rounding ties at
+    /// the layers' borders included.
+    #[test]
+    fn nodes_in_front_come_in_sorted_order() {
+        for (pitch, angle) in [(3.0, -30.0), (1.24, 7.0), (0.7, 30.0), (2.0, 0.0)] {
+            let spec = GridSpec {
+                pitch,
+                i_origin: -3,
+                j_origin: 0,
+                nx: 90,
+                nz: 60,
+            };
+            let knee = KneeForm {
+                triangle_side: 50.0,
+                radius: 15.0,
+                thickness: 100.0,
+            };
+            let fp = GridFootprint::new(&knee, angle, &spec);
+            let mut met = 0;
+            for (i0, j0) in [(0, 30), (40, 30), (89, 5), (70, 59)] {
+                let rows: Vec<(f64, i64, usize)> = fp
+                    .slide_order
+                    .iter()
+                    .map(|&r| &fp.rows[r as usize])
+                    .filter_map(|r| {
+                        let j = j0 as i64 + i64::from(r.dj);
+                        (0..spec.nz as i64).contains(&j).then_some((
+                            r.d0,
+                            i0 as i64 + i64::from(r.kf),
+                            j as usize,
+                        ))
+                    })
+                    .collect();
+                let mut sorted = Vec::new();
+                for &(d0, first, j) in &rows {
+                    for m in 0..=first.max(-1) {
+                        let i = first - m;
+                        if i < spec.nx as i64 {
+                            sorted.push((d0 + m as f64 * pitch, i as usize, j));
+                        }
+                    }
+                }
+                sorted.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
+                let layered = front_in_distance_order(&rows, pitch, spec.nx);
+                met += layered.len();
+                assert_eq!(
+                    layered, sorted,
+                    "pitch {pitch}, angle {angle}, start {i0} {j0}"
+                );
+            }
+            assert!(met > 1000, "{met}");
+        }
+    }
 
     /// The union of the per-start traces is the engine's mask.
     #[test]
