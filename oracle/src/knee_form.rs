@@ -70,6 +70,11 @@ pub struct KneeForm {
     /// reads, computed once: the BVH traversal asks for the footprint's
     /// ends at every node it visits.
     outlines: [Outline; 2],
+    /// The footprint's z-range (relative), computed once.
+    z_span: (f64, f64),
+    /// Per end, the height (relative z) of the triangle's vertex furthest
+    /// that way in x: where the footprint's end is extreme.
+    apex_z: [f64; 2],
 }
 
 /// The footprint mirrored in x so that one of its ends is its left end:
@@ -119,12 +124,23 @@ impl KneeForm {
             [half_height, -dims.length / 2.0],
         ];
         let triangle = unrotated.map(|[x, z]| [x * cos - z * sin, x * sin + z * cos]);
-        Self {
+        let apex = |dir: f64| {
+            triangle
+                .iter()
+                .max_by(|p, q| (dir * p[0]).total_cmp(&(dir * q[0])))
+                .map_or(0.0, |v| v[1])
+        };
+        let mut knee = Self {
             dims,
             angle_deg,
             triangle,
             outlines: [1.0, -1.0].map(|sign| Outline::new(triangle, dims.radius, sign)),
-        }
+            z_span: (0.0, 0.0),
+            apex_z: [apex(-1.0), apex(1.0)],
+        };
+        let (min, max) = knee.xz_extent();
+        knee.z_span = (min[1], max[1]);
+        knee
     }
 
     /// The dimensions this knee-form was built with.
@@ -203,8 +219,7 @@ pub(crate) enum End {
 impl KneeForm {
     /// The footprint's z-range relative to the reference point, mm.
     pub(crate) fn z_range(&self) -> (f64, f64) {
-        let (min, max) = self.xz_extent();
-        (min[1], max[1])
+        self.z_span
     }
 
     /// Where the line at height `z` (relative to the reference point)
@@ -255,16 +270,11 @@ impl KneeForm {
         if za > zb {
             return None;
         }
-        let dir = match end {
-            End::Left => -1.0,
-            End::Right => 1.0,
-        };
         // The extreme point in x is a vertex's (the disc adds R along x).
-        let apex = self
-            .triangle
-            .iter()
-            .max_by(|p, q| (dir * p[0]).total_cmp(&(dir * q[0])))
-            .map_or(0.0, |v| v[1]);
+        let apex = match end {
+            End::Left => self.apex_z[0],
+            End::Right => self.apex_z[1],
+        };
         self.x_at(apex.clamp(za, zb), end)
     }
 }

@@ -67,6 +67,10 @@ pub(crate) fn far_from_sweep(sweep: &Sweep, tri: [Vector; 3]) -> bool {
     {
         return true;
     }
+    // Still cheap: a line between them, further than `reach` from both.
+    if separated(sweep, q, reach) {
+        return true;
+    }
     // Overlap: a point of Q in P, or a point of P in Q.
     if q.iter().any(|&p| in_sweep(sweep, p)) {
         return false;
@@ -99,6 +103,38 @@ pub(crate) fn far_from_sweep(sweep: &Sweep, tri: [Vector; 3]) -> bool {
         }
     }
     true
+}
+
+/// Whether a line perpendicular to an edge of `P` or of `Q` separates them
+/// by more than `reach` (the separating-axis test: a lower bound of their
+/// distance, exact unless their nearest points are two corners). `P` is
+/// `T` and `T` moved by `-sweep_x` along x: its edges are `T`'s and, swept,
+/// two along x.
+fn separated(sweep: &Sweep, q: &[[f64; 2]], reach: f64) -> bool {
+    let t = sweep.triangle;
+    let apart = |n: [f64; 2]| {
+        let dot = |p: [f64; 2]| n[0] * p[0] + n[1] * p[1];
+        let (mut p_lo, mut p_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        let shift = -sweep.sweep_x * n[0];
+        for &v in &t {
+            let d = dot(v);
+            p_lo = p_lo.min(d).min(d + shift);
+            p_hi = p_hi.max(d).max(d + shift);
+        }
+        let (mut q_lo, mut q_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for &v in q {
+            let d = dot(v);
+            q_lo = q_lo.min(d);
+            q_hi = q_hi.max(d);
+        }
+        let gap = (q_lo - p_hi).max(p_lo - q_hi);
+        gap > 0.0 && gap * gap > reach * reach * (n[0] * n[0] + n[1] * n[1])
+    };
+    let normal = |a: [f64; 2], b: [f64; 2]| [b[1] - a[1], a[0] - b[0]];
+    let n = q.len();
+    (0..3).any(|k| apart(normal(t[k], t[(k + 1) % 3])))
+        || (sweep.sweep_x > 0.0 && apart([0.0, 1.0]))
+        || (n >= 2 && (0..n).any(|k| apart(normal(q[k], q[(k + 1) % n]))))
 }
 
 /// The triangle's part with `y0 <= y <= y1`, as its xz-projection: up to
