@@ -32,9 +32,12 @@ impl PointSet {
     /// The distance from `q` to the nearest point of the set, `+inf` when
     /// the set is empty.
     pub fn distance(&self, q: [f64; 2]) -> f64 {
-        let mut best = f64::INFINITY;
+        let mut best = Best {
+            d2: f64::INFINITY,
+            d: f64::INFINITY,
+        };
         search(&self.points, 0, q, &mut best);
-        best
+        best.d
     }
 
     /// The distance from each point of `from` to its nearest point here.
@@ -62,19 +65,33 @@ fn build(points: &mut [[f64; 2]], depth: usize) {
     build(&mut right[1..], depth + 1);
 }
 
-/// Distance to the nearest point of the subtree `points`, folded into
-/// `best`. A far side is skipped only when its splitting line lies
-/// further than `best` by a margin that `hypot`'s rounding cannot
-/// cross, so the answer is the brute-force minimum to the bit.
-fn search(points: &[[f64; 2]], depth: usize, q: [f64; 2], best: &mut f64) {
+/// The nearest distance found so far: squared (to prune with) and as
+/// `hypot` measures it (the answer).
+struct Best {
+    d2: f64,
+    d: f64,
+}
+
+/// A relative margin far above the rounding of a squared distance: a point
+/// whose squared distance is within it of the best is measured by `hypot`.
+const TIE: f64 = 1e-12;
+
+/// Folds the nearest point of the subtree `points` into `best`. Points are
+/// compared by squared distance, and `hypot` is taken for those within
+/// [`TIE`] of the best, so the answer is the brute-force minimum of
+/// `hypot` to the bit (the two orders differ only among such near-ties);
+/// a far side is skipped only beyond that margin.
+fn search(points: &[[f64; 2]], depth: usize, q: [f64; 2], best: &mut Best) {
     if points.is_empty() {
         return;
     }
     let mid = points.len() / 2;
     let p = points[mid];
-    let d = (p[0] - q[0]).hypot(p[1] - q[1]);
-    if d < *best {
-        *best = d;
+    let (dx, dz) = (p[0] - q[0], p[1] - q[1]);
+    let d2 = dx * dx + dz * dz;
+    if d2 <= best.d2 * (1.0 + TIE) {
+        best.d = best.d.min(dx.hypot(dz));
+        best.d2 = best.d2.min(d2);
     }
     let axis = depth % 2;
     let delta = q[axis] - p[axis];
@@ -84,7 +101,7 @@ fn search(points: &[[f64; 2]], depth: usize, q: [f64; 2], best: &mut f64) {
         (&points[mid + 1..], &points[..mid])
     };
     search(near, depth + 1, q, best);
-    if delta.abs() <= *best * (1.0 + 1e-12) {
+    if delta * delta <= best.d2 * (1.0 + TIE) {
         search(far, depth + 1, q, best);
     }
 }
