@@ -123,6 +123,9 @@ pub struct Analysis {
     /// The pitch study that chose `setup.pitch`, when one did (set by the
     /// caller: [`crate::harness::choose_pitch`]).
     pub pitch_choice: Option<crate::summary::PitchChoice>,
+    /// The sample check against the exact oracle, when one was run or
+    /// declined (set by the caller: [`crate::harness::check_analysis`]).
+    pub sample_check: Option<crate::summary::SampleCheck>,
     /// The working memory estimated before the run.
     pub memory: MemoryEstimate,
     /// Seconds per stage (`write_s` and `total_s` are the writer's).
@@ -379,6 +382,7 @@ impl Analysis {
             blind_spots: blind,
             warnings,
             pitch_choice: None,
+            sample_check: None,
             memory,
             timings: Timings {
                 sample_s,
@@ -495,6 +499,7 @@ impl Analysis {
             composite_area_mm2: composite_nodes as f64 * area,
             blind_depth_mm: setup.blind_depth,
             pitch_study: self.pitch_choice.clone(),
+            sample_check: self.sample_check.clone(),
             memory_estimate_mib: self.memory.mib(),
             peak_rss_mib: None,
             blind_spots: self.blind_spots.len(),

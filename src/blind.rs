@@ -236,7 +236,7 @@ pub fn resolving_pitch(pitch: f64, width: f64) -> f64 {
 /// The height the grid sampled for the cell `(i, j)`: the lowest of its
 /// finite corners, or, where none is on the part, of the finite nodes of
 /// the cells around it; `None` where the grid has sampled nothing near.
-fn reference_height(grid: &HeightGrid, i: usize, j: usize) -> Option<f64> {
+pub(crate) fn reference_height(grid: &HeightGrid, i: usize, j: usize) -> Option<f64> {
     let lowest = |i0: usize, i1: usize, j0: usize, j1: usize| {
         (j0..=j1)
             .flat_map(|jj| (i0..=i1).map(move |ii| (ii, jj)))

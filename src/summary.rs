@@ -59,9 +59,13 @@ pub struct Timings {
     /// Finding the blind spots.
     #[serde(default)]
     pub blind_s: f64,
+    /// The sample check against the exact oracle (0 without one).
+    #[serde(default)]
+    pub check_s: f64,
     /// Writing the output files.
     pub write_s: f64,
-    /// Every stage above, the blind spots' included.
+    /// Every stage above, the blind spots' and the sample check's
+    /// included.
     pub total_s: f64,
 }
 
@@ -173,6 +177,12 @@ pub struct Summary {
     /// chose `pitch_mm`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pitch_study: Option<PitchChoice>,
+    /// The sample check: the exact oracle on a few seeded starts of this
+    /// analysis, compared with its grid as `verify` does, so the result
+    /// carries its measured accuracy; or why it was not run. Absent in
+    /// runs of earlier versions, and in merged shards.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sample_check: Option<SampleCheck>,
     /// The working memory estimated before the run (MiB,
     /// [`crate::memory::MemoryEstimate`]). Absent in runs of earlier
     /// versions.
@@ -351,6 +361,173 @@ pub const DECIDED_METRICS: [&str; 6] = [
 
 // The pitch study of `--pitch auto` ([`crate::harness::choose_pitch`]),
 // as `summary.json` records it.
+
+/// Whether an analysis's sample check ran.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CheckStatus {
+    /// Run: its figures are in the record.
+    Checked,
+    /// Skipped by the user (`--no-check`).
+    Skipped,
+    /// Not run: the record's `note` says why.
+    NotRun,
+}
+
+/// The sample check of an analysis (`summary.json`'s `sample_check`): the
+/// exact oracle on a seeded sample of the analysis's own starts at three
+/// of its angles, compared with its grid as `kneeform verify` does. A
+/// sample, not the evidence: `verify` gives that.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SampleCheck {
+    /// Run, skipped or not run.
+    pub status: CheckStatus,
+    /// What was checked, or why not, in one sentence.
+    pub note: String,
+    /// Starts in the sample: grid nodes on the part (each placed at every
+    /// angle).
+    pub starts: usize,
+    /// Their positions `[x, z]` (mm, the analysis grid's frame), so that
+    /// `verify` can be run on the same pairs.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub start_positions: Vec<[f64; 2]>,
+    /// The angles checked (degrees): the first, middle and last analysed.
+    pub angles_deg: Vec<f64>,
+    /// The sample's seed.
+    pub seed: u64,
+    /// Start-angle pairs placed by both the grid and the oracle.
+    pub compared_pairs: usize,
+    /// Pairs whose exact query failed (the check then fails).
+    pub oracle_failed: usize,
+    /// The largest distance from a decided exact strike to the grid's
+    /// strikes of the same start (mm, xz); `null` with no decided exact
+    /// strike, or none matched.
+    pub miss_distance_decided_mm: Option<f64>,
+    /// The largest distance from a grid strike to the exact contacts that
+    /// may strike (mm, xz); `null` with no grid strike.
+    pub false_alarm_distance_decided_mm: Option<f64>,
+    /// The same, over grid strikes beyond the bound of the grid's level
+    /// error (those within it are false alarms on the safe side); `null`
+    /// with none.
+    pub false_alarm_unexplained_mm: Option<f64>,
+    /// Exact strikes with no grid strike in their start, decided.
+    pub unmatched_exact_decided: usize,
+    /// Grid strikes beyond the level error's bound with no possible exact
+    /// strike in their start.
+    #[serde(default)]
+    pub unmatched_grid_decided: usize,
+    /// The tolerance the figures are held to (mm): `verify`'s default,
+    /// sqrt 2 pitches (a point of the part lies up to that far from its
+    /// nearest node).
+    pub tolerance_mm: f64,
+    /// Whether a decided miss or a false alarm beyond the level error's
+    /// bound exceeds `tolerance_mm`, or a decided exact strike has no grid
+    /// strike in its start, or an exact query failed: the analysis is
+    /// then warned about.
+    pub exceeds_tolerance: bool,
+}
+
+impl SampleCheck {
+    /// A check that did not run, and why.
+    pub fn not_run(status: CheckStatus, note: impl Into<String>) -> SampleCheck {
+        SampleCheck {
+            status,
+            note: note.into(),
+            starts: 0,
+            start_positions: Vec::new(),
+            angles_deg: Vec::new(),
+            seed: 0,
+            compared_pairs: 0,
+            oracle_failed: 0,
+            miss_distance_decided_mm: None,
+            false_alarm_distance_decided_mm: None,
+            false_alarm_unexplained_mm: None,
+            unmatched_exact_decided: 0,
+            unmatched_grid_decided: 0,
+            tolerance_mm: 0.0,
+            exceeds_tolerance: false,
+        }
+    }
+
+    /// This check with `exceeds_tolerance` decided from its figures: a
+    /// decided miss, or a false alarm the level error does not explain,
+    /// further than `tolerance_mm`, or any disagreement no distance
+    /// measures (a decided strike on one side only, a failed exact query).
+    pub fn judged(mut self) -> SampleCheck {
+        let tolerance = self.tolerance_mm;
+        let far = |v: Option<f64>| v.is_some_and(|v| v > tolerance);
+        self.exceeds_tolerance = far(self.miss_distance_decided_mm)
+            || far(self.false_alarm_unexplained_mm)
+            || self.unmatched_exact_decided + self.unmatched_grid_decided + self.oracle_failed > 0;
+        self
+    }
+
+    /// The shards' checks of one run (each at its own angles) as the whole
+    /// run's: the figures' largest, the counts' sums, the angles in the
+    /// run's order (`angles_deg`, the run's). `None` without any.
+    pub fn merged(parts: &[SampleCheck], angles_deg: &[f64]) -> Option<SampleCheck> {
+        let first = parts.first()?;
+        if first.status != CheckStatus::Checked {
+            return Some(first.clone());
+        }
+        let max = |f: fn(&SampleCheck) -> Option<f64>| parts.iter().filter_map(f).reduce(f64::max);
+        let sum = |f: fn(&SampleCheck) -> usize| parts.iter().map(f).sum();
+        let mut angles: Vec<f64> = parts.iter().flat_map(|p| p.angles_deg.clone()).collect();
+        let rank = |a: &f64| angles_deg.iter().position(|b| b.to_bits() == a.to_bits());
+        angles.sort_by_key(rank);
+        Some(
+            SampleCheck {
+                angles_deg: angles,
+                compared_pairs: sum(|p| p.compared_pairs),
+                oracle_failed: sum(|p| p.oracle_failed),
+                miss_distance_decided_mm: max(|p| p.miss_distance_decided_mm),
+                false_alarm_distance_decided_mm: max(|p| p.false_alarm_distance_decided_mm),
+                false_alarm_unexplained_mm: max(|p| p.false_alarm_unexplained_mm),
+                unmatched_exact_decided: sum(|p| p.unmatched_exact_decided),
+                unmatched_grid_decided: sum(|p| p.unmatched_grid_decided),
+                ..first.clone()
+            }
+            .judged(),
+        )
+    }
+
+    /// The check in one line, as the console and the report say it.
+    pub fn line(&self) -> String {
+        let mm = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3} mm"));
+        match self.status {
+            CheckStatus::Checked => format!(
+                "sample check against the exact oracle ({} starts x {} angles, seed {}, {} pairs compared{}): decided misses within {}, decided false alarms within {} ({} beyond the level error's bound){}; {} the tolerance of {} mm (sqrt 2 pitches)",
+                self.starts,
+                self.angles_deg.len(),
+                self.seed,
+                self.compared_pairs,
+                if self.oracle_failed > 0 {
+                    format!(", {} oracle failures", self.oracle_failed)
+                } else {
+                    String::new()
+                },
+                mm(self.miss_distance_decided_mm),
+                mm(self.false_alarm_distance_decided_mm),
+                mm(self.false_alarm_unexplained_mm),
+                if self.unmatched_exact_decided > 0 {
+                    format!(
+                        "; {} decided exact strikes in starts where the grid strikes nothing",
+                        self.unmatched_exact_decided
+                    )
+                } else {
+                    String::new()
+                },
+                if self.exceeds_tolerance {
+                    "BEYOND"
+                } else {
+                    "within"
+                },
+                crate::limits::short(self.tolerance_mm),
+            ),
+            CheckStatus::Skipped | CheckStatus::NotRun => format!("sample check: {}", self.note),
+        }
+    }
+}
 
 /// One pitch of the study (`summary.json`'s `pitch_study`).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]

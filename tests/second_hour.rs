@@ -461,3 +461,58 @@ fn csvs_and_messages_carry_no_float_noise() {
         assert!(rows > 0 || file.contains("blind"), "{file} is empty");
     }
 }
+
+/// Issue 26, item 5: every analysis states its measured accuracy. The
+/// bump at 4 mm: the console line, `summary.json`'s `sample_check` (5
+/// starts at the first, middle and last angle, within sqrt 2 pitches) and
+/// its time, and the report's line; `--no-check` says it was skipped.
+#[test]
+fn an_analysis_states_its_sample_check_or_that_it_was_skipped() {
+    let dir = scratch_dir("second-hour-sample-check");
+    let out = dir.join("run");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "analyze",
+            "scenarios/bump.toml",
+            "--angles=-30,-10,10,30",
+            "--pitch",
+            "4",
+            "--force",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = kneeform_in(Path::new(env!("CARGO_MANIFEST_DIR")), &args);
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert!(o.status.success(), "{err}");
+        (err, summary(&out))
+    };
+    let (err, s) = run(&["--report"]);
+    assert!(
+        err.contains("kneeform: sample check against the exact oracle (5 starts x 3 angles, seed 1, 15 pairs compared): decided misses within"),
+        "{err}"
+    );
+    assert!(err.contains("within the tolerance of 5.656855 mm"), "{err}");
+    assert!(!err.contains("warning: the sample check"), "{err}");
+    let check = &s["sample_check"];
+    assert_eq!(check["status"], "checked");
+    assert_eq!(check["angles_deg"], serde_json::json!([-30.0, 10.0, 30.0]));
+    assert_eq!(check["start_positions"].as_array().unwrap().len(), 5);
+    assert!(check["miss_distance_decided_mm"].as_f64().unwrap() <= 5.656855);
+    assert_eq!(check["exceeds_tolerance"], false);
+    assert!(s["timings"]["check_s"].as_f64().unwrap() > 0.0);
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(
+        report.contains("id=\"sample-check\""),
+        "no sample check in the report"
+    );
+    assert!(report.contains("Measured accuracy of this analysis"));
+
+    let (err, s) = run(&["--no-check"]);
+    assert!(
+        err.contains("kneeform: sample check: skipped (--no-check)"),
+        "{err}"
+    );
+    assert_eq!(s["sample_check"]["status"], "skipped");
+    assert!(s["timings"]["check_s"].as_f64().unwrap() < 0.01);
+}

@@ -10,6 +10,7 @@ use kneeform::harness::{self, AutoPitch};
 use kneeform::output;
 use kneeform::partition::Shard;
 use kneeform::shard::ShardError;
+use kneeform::summary::{CheckStatus, SampleCheck};
 
 use super::args::{AnalyzeArgs, PitchArg};
 use super::progress::Bars;
@@ -95,6 +96,20 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
     let only = shard.map(|s| s.angle_indices(setup.angles.len()));
     let mut analysis = Analysis::of_source_at(&source, &setup, only.as_deref(), &bars)?;
     analysis.pitch_choice = choice;
+    // The sample check (a shard checks its own angles: the merge puts the
+    // checks together as the whole run's).
+    let t = std::time::Instant::now();
+    analysis.sample_check = Some(if args.no_check {
+        SampleCheck::not_run(
+            CheckStatus::Skipped,
+            "skipped (--no-check): this analysis carries no measured accuracy; `kneeform verify` measures it",
+        )
+    } else {
+        let triangles = analysis.input.part.triangles.len();
+        analysis.memory.add_sample_check(triangles);
+        harness::check_analysis(&analysis, only.as_deref(), &bars).map_err(super::harness_error)?
+    });
+    analysis.timings.check_s = t.elapsed().as_secs_f64();
     if let Some(shard) = shard {
         kneeform::shard::write_shard(&out, &analysis, shard)?;
         out.commit()
@@ -154,6 +169,9 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
             }
         );
     }
+    if let Some(check) = &analysis.sample_check {
+        print_check(check);
+    }
     if args.report {
         // From the committed run, so the analysis stands whatever the
         // report meets; report.html itself appears whole or not at all.
@@ -174,4 +192,16 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The sample check's line, and its warning where it found the grid beyond
+/// its tolerance.
+pub fn print_check(check: &SampleCheck) {
+    eprintln!("kneeform: {}", check.line());
+    if check.exceeds_tolerance {
+        eprintln!(
+            "kneeform: warning: the sample check found the grid's colliding area further than sqrt 2 pitches ({} mm, `verify`'s default tolerance) from the exact knee-form's; run `kneeform verify` on this part with the same flags for the evidence, or choose a finer pitch (`--pitch auto --tolerance MM`)",
+            kneeform::limits::short(check.tolerance_mm)
+        );
+    }
 }

@@ -82,5 +82,8 @@ fn merge_analysis(args: &MergeArgs, out: OutputDir) -> anyhow::Result<ExitCode> 
         summary.composite_area_mm2,
         args.out.display()
     );
+    if let Some(check) = &summary.sample_check {
+        super::analyze::print_check(check);
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -48,15 +48,11 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
     Ok(super::study::print_verification(&result, &args.out))
 }
 
-/// `verify`'s default tolerance: sqrt 2 pitches (mm), rounded up to the
-/// micrometre, the grid's sampling error at the pitch under test (a
-/// point of the part lies up to that far from its nearest node). Under
+/// `verify`'s default tolerance ([`harness::sampling_tolerance`]). Under
 /// `--pitch auto`, refused later, 1 mm.
 fn sampling_tolerance(study: &super::args::StudyArgs) -> f64 {
     match study.setup.pitch {
-        super::args::PitchArg::Mm(p) if p.is_finite() && p > 0.0 => {
-            (std::f64::consts::SQRT_2 * p * 1e6).ceil() / 1e6
-        }
+        super::args::PitchArg::Mm(p) if p.is_finite() && p > 0.0 => harness::sampling_tolerance(p),
         _ => 1.0,
     }
 }

@@ -41,7 +41,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::blind::{CellDepths, cell_depths};
+use crate::blind::{BlindSpot, cell_depths, reference_height};
 use crate::grid::{GridSpec, HeightGrid};
 use crate::mesh::Triangle;
 
@@ -55,13 +55,15 @@ const CELL_TOL: f64 = 1e-6;
 /// node under the knee-form may lie ([`Cells::rise_near`]).
 pub const RISE_REACH: f64 = std::f64::consts::SQRT_2;
 
-/// What the harness knows of a grid's cells: the depth each hides between
-/// its sampled corners, and which are flagged blind spots.
+/// What the harness knows of a grid's cells: which are flagged blind spots
+/// (the mesh sticks out past their sampled corners by more than the
+/// analysis's `--blind-depth`), and the grid's heights.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Cells {
     spec: GridSpec,
-    depths: CellDepths,
-    threshold: f64,
+    /// The blind spots' cells `(i, j)`, sorted, each with its reference
+    /// height (the lowest sampled corner, mm).
+    blind: Vec<((usize, usize), f64)>,
     /// The grid's heights (mm), row-major.
     heights: Vec<f64>,
 }
@@ -70,10 +72,31 @@ impl Cells {
     /// The cells of `grid` (sampled from `triangles`), blind spots being
     /// those deeper than `threshold` mm (the analysis's `--blind-depth`).
     pub fn of(triangles: &[Triangle], grid: &HeightGrid, threshold: f64) -> Cells {
+        let depths = cell_depths(triangles, grid);
+        let cx = depths.cx;
+        let blind = (0..depths.cells.len())
+            .map(|n| (n % cx, n / cx))
+            .filter(|&(i, j)| depths.depth(i, j) > threshold)
+            .collect();
+        Cells::with_blind(grid, blind)
+    }
+
+    /// The cells of `grid` whose blind spots are `spots` (an analysis's:
+    /// found by [`crate::blind::blind_spots`] on the same grid, at its
+    /// threshold), without finding them again.
+    pub fn of_blind_spots(grid: &HeightGrid, spots: &[BlindSpot]) -> Cells {
+        Cells::with_blind(grid, spots.iter().map(|s| (s.i, s.j)).collect())
+    }
+
+    fn with_blind(grid: &HeightGrid, mut cells: Vec<(usize, usize)>) -> Cells {
+        cells.sort_unstable();
+        let blind = cells
+            .into_iter()
+            .map(|(i, j)| ((i, j), reference_height(grid, i, j).unwrap_or(f64::NAN)))
+            .collect();
         Cells {
             spec: grid.spec,
-            depths: cell_depths(triangles, grid),
-            threshold,
+            blind,
             heights: grid.h.clone(),
         }
     }
@@ -97,8 +120,7 @@ impl Cells {
                 lo as usize..hi as usize + 1
             }
         };
-        let has_cells = !self.depths.cells.is_empty();
-        let (cx, cz) = if has_cells {
+        let (cx, cz) = if spec.nx >= 2 && spec.nz >= 2 {
             (spec.nx - 1, spec.nz - 1)
         } else {
             (0, 0)
@@ -113,9 +135,13 @@ impl Cells {
     /// feature itself or its foot, anywhere the mesh stands out past the
     /// grid's samples).
     pub fn touches_blind_spot(&self, p: [f64; 3]) -> bool {
+        if self.blind.is_empty() {
+            return false;
+        }
         self.around(p[0], p[2]).any(|(i, j)| {
-            self.depths.depth(i, j) > self.threshold
-                && p[1] < self.depths.reference(i, j) - CELL_TOL
+            self.blind
+                .binary_search_by(|(cell, _)| cell.cmp(&(i, j)))
+                .is_ok_and(|k| p[1] < self.blind[k].1 - CELL_TOL)
         })
     }
 

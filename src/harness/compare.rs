@@ -544,11 +544,23 @@ pub(crate) fn compare_grid_with(
     fault: Option<Fault>,
 ) -> Result<Comparison, HarnessError> {
     let t = Instant::now();
-    let results = pair_results(triangles, grid, footprints, starts, traces, options, fault)?;
+    let given = GridSide { cells: None, fault };
+    let results = pair_results(triangles, grid, footprints, starts, traces, options, given)?;
     let grid_s = t.elapsed().as_secs_f64();
     let band = TieBand::new(options.rule.sigma, grid.spec.pitch, options.tie_band_per_mm);
     let angles: Vec<f64> = footprints.iter().map(|fp| fp.angle_deg).collect();
     Ok(assemble(results, &angles, band, grid_s))
+}
+
+/// What a comparison's grid side may be handed: the grid's blind spots
+/// when an analysis found them already (else they are found again), and a
+/// deliberate mistake (tests only).
+#[derive(Default, Clone, Copy)]
+pub(crate) struct GridSide<'a> {
+    /// The grid's cells and blind spots.
+    pub(crate) cells: Option<&'a Cells>,
+    /// A mistake the harness must catch.
+    pub(crate) fault: Option<Fault>,
 }
 
 /// Every start-angle pair of `starts` (positions in mm, nodes of `grid`,
@@ -561,8 +573,9 @@ pub(crate) fn pair_results(
     starts: &[[f64; 2]],
     traces: &[StartTrace],
     options: &CompareOptions,
-    fault: Option<Fault>,
+    given: GridSide,
 ) -> Result<Vec<PairResult>, HarnessError> {
+    let GridSide { cells, fault } = given;
     crate::engine::assert_same_pitch(grid, footprints);
     let spec = grid.spec;
     let band = TieBand::new(options.rule.sigma, spec.pitch, options.tie_band_per_mm);
@@ -581,7 +594,16 @@ pub(crate) fn pair_results(
             expected: footprints.len() * nodes.len(),
         });
     }
-    let cells = Cells::of(triangles, grid, options.blind_depth);
+    // The blind spots: the analysis's where it found them, else found
+    // here.
+    let owned;
+    let cells = match cells {
+        Some(cells) => cells,
+        None => {
+            owned = Cells::of(triangles, grid, options.blind_depth);
+            &owned
+        }
+    };
     let pairs: Vec<(usize, usize)> = (0..footprints.len())
         .flat_map(|a| (0..nodes.len()).map(move |s| (a, s)))
         .collect();
@@ -592,7 +614,7 @@ pub(crate) fn pair_results(
             let fp = &footprints[a];
             let trace = &traces[a * nodes.len() + s];
             let g = grid_trace(grid, fp, i, j, &options.rule, fault);
-            let mut cmp = compare(&g, trace, &band, ExactRule::of(&options.rule), &cells);
+            let mut cmp = compare(&g, trace, &band, ExactRule::of(&options.rule), cells);
             // An inside miss beyond the pitch's sampling error is tested
             // by refinement; one that halves is set apart as sampling.
             let reach = super::causes::RISE_REACH * spec.pitch;

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::HarnessError;
 use super::compare::{
-    CompareOptions, Comparison, PairResult, StartSelection, assemble, pair_results,
+    CompareOptions, Comparison, GridSide, PairResult, StartSelection, assemble, pair_results,
 };
 use super::metrics::{METRICS, TieBand};
 use super::sharded::{Pairs, PitchPart};
@@ -391,7 +391,7 @@ impl<'a> Ladder<'a> {
             &self.starts,
             &self.traces,
             &self.compare,
-            None,
+            GridSide::default(),
         );
         let grid_s = t.elapsed().as_secs_f64();
         progress.end();

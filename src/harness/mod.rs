@@ -5,6 +5,8 @@
 //! * [`verify()`]: one pitch, a part's starts compared with the oracle
 //!   ([`Verification`]: the per-start rows, the metrics, `verify.json`'s
 //!   summary);
+//! * [`check_analysis`]: the sample check every analysis carries (the
+//!   oracle on a few of its own starts);
 //! * [`converge()`]: the same starts at several pitches, the fitted order
 //!   of convergence and the pitch to choose ([`Convergence`]);
 //! * [`compare`]: start selection, the oracle's traces, one grid's
@@ -28,6 +30,7 @@
 
 pub mod auto;
 pub mod causes;
+pub mod check;
 pub mod compare;
 pub mod converge;
 pub mod direct;
@@ -41,6 +44,7 @@ pub mod verify;
 mod fault_tests;
 
 pub use auto::{AutoPitch, choose_pitch};
+pub use check::check_analysis;
 pub use compare::{
     AreaDistance, CompareOptions, Comparison, Counts, PairResult, StartSelection, VerifyRow,
     assemble, compare_grid, exact_traces, select_starts,
@@ -61,7 +65,7 @@ pub use sharded::{
 pub use trace::{GridContact, GridTrace};
 pub use verify::{
     Verification, VerifyOptions, VerifySummary, VerifyTimings, WorstStart, oracle_options,
-    tie_band_rule, verify,
+    sampling_tolerance, tie_band_rule, verify,
 };
 
 use serde::{Deserialize, Serialize};

@@ -26,7 +26,7 @@
 use std::time::Instant;
 
 use super::HarnessError;
-use super::compare::{PairResult, StartSelection, assemble, pair_results};
+use super::compare::{GridSide, PairResult, StartSelection, assemble, pair_results};
 use super::converge::{ConvergeOptions, ConvergeSummary, Convergence, Ladder, PitchResult};
 use super::direct::{
     DirectConvergeSummary, DirectConvergence, DirectPair, DirectPitchResult, DirectVerification,
@@ -216,7 +216,7 @@ pub fn verify_shard(
             &starts,
             &traces,
             &compare,
-            None,
+            GridSide::default(),
         )
     })?;
     let grid_s = t.elapsed().as_secs_f64();

@@ -103,6 +103,14 @@ pub fn oracle_options(knee: &KneeForm, pitch: f64, x_min: f64) -> OracleOptions 
     }
 }
 
+/// `verify`'s default tolerance at `pitch` (mm): sqrt 2 pitches, rounded
+/// up to the micrometre, the grid's sampling error at that pitch (a point
+/// of the part lies up to that far from its nearest node). The sample
+/// check of every analysis warns beyond it too.
+pub fn sampling_tolerance(pitch: f64) -> f64 {
+    (std::f64::consts::SQRT_2 * pitch * 1e6).ceil() / 1e6
+}
+
 /// The tie band's rule in words, for the summaries: under the window rule
 /// (`window_mm`) the drop's band ([`super::metrics::ExactRule::Window`]),
 /// under x-slope the rate's ([`TieBand`]).

@@ -153,7 +153,7 @@ pub fn write_results(
     pictures?;
     let t_ = &mut summary.timings;
     t_.write_s = started.elapsed().as_secs_f64();
-    t_.total_s = t_.read_s + t_.sample_s + t_.blind_s + t_.push_slide_s + t_.write_s;
+    t_.total_s = t_.read_s + t_.sample_s + t_.blind_s + t_.push_slide_s + t_.check_s + t_.write_s;
     summary.peak_rss_mib = crate::memory::peak_rss_bytes().map(|b| b / (1024.0 * 1024.0));
     write_json(&out.path(super::SUMMARY_JSON), &summary)?;
     Ok(summary)

@@ -161,6 +161,7 @@ code, .mono { font-family: 'DejaVu Sans Mono', monospace; font-size: 12px; word-
 .assumed { background: #fff3c4; border: 1px solid #c9a100; padding: 1px 6px; font-weight: bold; }
 .pass { background: #dff3df; border: 2px solid #2e7d32; color: #1b5e20; padding: 4px 10px; font-weight: bold; display: inline-block; }
 .fail { background: #fde0dc; border: 2px solid #c62828; color: #b71c1c; padding: 4px 10px; font-weight: bold; display: inline-block; }
+.check { background: #f4f4f4; border-left: 4px solid #777; padding: 4px 10px; }
 .unknown { background: #eee; border: 2px solid #777; padding: 4px 10px; font-weight: bold; display: inline-block; }
 .missing { color: #999; font-style: italic; }
 .note { color: #333; font-size: 13px; }
@@ -327,6 +328,9 @@ fn result_section(inputs: &Inputs) -> Markup {
                     (verdict_first(k, json, v.verdict(), run.blind_spots.len()))
                 }
             }
+            @if let Some(check) = &s.sample_check {
+                (sample_check(check))
+            }
             p class="headline" {
                 "Area the knee-form can strike at some angle: "
                 b { (cite(SUMMARY, j, "/composite_area_mm2")) " mm" (SUP2) }
@@ -368,6 +372,27 @@ fn result_section(inputs: &Inputs) -> Markup {
             }
             "\n"
             (inputs.view3d)
+        }
+        "\n"
+    }
+}
+
+/// The analysis's own sample check (`summary.json`'s `sample_check`): a
+/// few starts against the exact oracle, said as a sample, never as the
+/// verdict; flagged when it found the grid beyond its tolerance.
+fn sample_check(check: &crate::summary::SampleCheck) -> Markup {
+    let class = if check.exceeds_tolerance {
+        "fail check"
+    } else {
+        "check"
+    };
+    html! {
+        p class=(class) id="sample-check" {
+            "Measured accuracy of this analysis (a sample, not the evidence: "
+            code { "kneeform verify" } " gives that): " (check.line()) "."
+            @if check.exceeds_tolerance {
+                " The grid's area lies further from the exact knee-form's than its tolerance here: verify this part, or choose a finer pitch."
+            }
         }
         "\n"
     }
@@ -1419,6 +1444,7 @@ fn runtime_section(run: &Run) -> Markup {
         ("sample_s", "Sampling the height grid"),
         ("push_slide_s", "Push and slide, every angle"),
         ("blind_s", "Finding the blind spots"),
+        ("check_s", "The sample check against the exact oracle"),
         ("write_s", "Writing the result files"),
         ("total_s", "Total"),
     ];

@@ -428,6 +428,20 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, ShardError> {
         .iter()
         .map(|s| s.record.summary.timings.push_slide_s)
         .sum();
+    t.check_s = shards
+        .iter()
+        .map(|s| s.record.summary.timings.check_s)
+        .sum();
+    // Each shard checked the run's check angles it holds.
+    let checks: Vec<_> = shards
+        .iter()
+        .filter_map(|s| s.record.summary.sample_check.clone())
+        .collect();
+    merged.sample_check = if checks.len() == shards.len() {
+        crate::summary::SampleCheck::merged(&checks, &merged.angles_deg)
+    } else {
+        None
+    };
     merged.run_unix_time = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_secs());
@@ -500,6 +514,7 @@ fn identity(summary: &Summary) -> serde_json::Value {
             "blind_spots_met",
             "memory_estimate_mib",
             "peak_rss_mib",
+            "sample_check",
             "threads",
             "timings",
             "warnings",
