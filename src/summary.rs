@@ -495,6 +495,23 @@ impl SampleCheck {
     pub fn line(&self) -> String {
         let mm = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3} mm"));
         match self.status {
+            CheckStatus::Checked
+                if self.miss_distance_decided_mm.is_none()
+                    && self.false_alarm_distance_decided_mm.is_none() =>
+            {
+                format!(
+                    "sample check against the exact oracle ({} starts x {} angles, seed {}, {} pairs compared{}): neither side strikes anything decided on these pairs, so it measured nothing here; `kneeform verify` measures the part",
+                    self.starts,
+                    self.angles_deg.len(),
+                    self.seed,
+                    self.compared_pairs,
+                    if self.oracle_failed > 0 {
+                        format!(", {} oracle failures", self.oracle_failed)
+                    } else {
+                        String::new()
+                    },
+                )
+            }
             CheckStatus::Checked => format!(
                 "sample check against the exact oracle ({} starts x {} angles, seed {}, {} pairs compared{}): decided misses within {}, decided false alarms within {} ({} beyond the level error's bound){}; {} the tolerance of {} mm (sqrt 2 pitches)",
                 self.starts,
