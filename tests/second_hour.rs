@@ -295,8 +295,8 @@ fn study(dir: &Path, common: &[&str], out: &str, extra: &[&str]) -> std::process
 /// Issue 26, item 4: the study `common`, 40 starts, is refused under a
 /// budget its prediction exceeds, naming the `--shard` count that would
 /// fit, before it writes anything; run with `free` (no budget, or a
-/// generous one) into `free/`, it prints its prediction from one start in
-/// twenty.
+/// generous one) into `free/`, it prints its prediction from one pair in
+/// twenty, spread over the starts and angles (6 of 40 x 3).
 fn holds_to_its_budget(dir: &Path, common: &[&str], free: &[&str]) {
     let o = study(dir, common, "refused", &["--budget-s", "0.000001"]);
     let err = String::from_utf8_lossy(&o.stderr);
@@ -310,14 +310,14 @@ fn holds_to_its_budget(dir: &Path, common: &[&str], free: &[&str]) {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
     assert!(
-        err.contains("predicted from 2 of the 40 starts at every angle"),
+        err.contains("predicted from 6 of them spread over the starts and angles"),
         "{err}"
     );
 }
 
 /// Issue 26, item 4: `verify` printed nothing about how long its oracle
-/// would take. One start in twenty is traced first, at every angle; its
-/// time predicts the rest (printed), and a prediction beyond `--budget-s`
+/// would take. One start-angle pair in twenty is traced first, spread over
+/// the starts and angles; its time predicts the rest (printed), and a prediction beyond `--budget-s`
 /// is refused before the rest is traced, naming the `--shard` count that
 /// would fit. The sample's traces are kept: a run with a generous budget
 /// writes what one without a budget writes.

@@ -32,12 +32,6 @@ pub fn evaluate_reporting(
     options: &OracleOptions,
     traced: &(dyn Fn() + Sync),
 ) -> Result<Vec<StartTrace>, OracleError> {
-    options.validate()?;
-    if let Some(bad) = angles_deg.iter().find(|a| !a.is_finite()) {
-        return Err(OracleError::InvalidOptions(format!(
-            "angle {bad} is not finite"
-        )));
-    }
     if let Some(bad) = starts
         .iter()
         .find(|s| !(s[0].is_finite() && s[1].is_finite()))
@@ -46,15 +40,45 @@ pub fn evaluate_reporting(
             "start {bad:?} is not finite"
         )));
     }
+    let n = starts.len();
+    let pairs: Vec<(usize, usize)> = (0..angles_deg.len() * n).map(|k| (k % n, k / n)).collect();
+    evaluate_pairs(part, starts, angles_deg, &pairs, options, traced)
+}
+
+/// The traces of the start-angle `pairs` (`(start, angle)`, indices into
+/// `starts` and `angles_deg`), in their order, in parallel on rayon's
+/// current thread pool, calling `traced` as each is done: any subset of
+/// [`evaluate`]'s pairs, each trace the same.
+pub fn evaluate_pairs(
+    part: &Part,
+    starts: &[[f64; 2]],
+    angles_deg: &[f64],
+    pairs: &[(usize, usize)],
+    options: &OracleOptions,
+    traced: &(dyn Fn() + Sync),
+) -> Result<Vec<StartTrace>, OracleError> {
+    options.validate()?;
+    if let Some(bad) = angles_deg.iter().find(|a| !a.is_finite()) {
+        return Err(OracleError::InvalidOptions(format!(
+            "angle {bad} is not finite"
+        )));
+    }
+    if let Some(&(s, a)) = pairs
+        .iter()
+        .find(|&&(s, a)| s >= starts.len() || a >= angles_deg.len())
+    {
+        return Err(OracleError::InvalidOptions(format!(
+            "pair ({s}, {a}) is not a start and angle given"
+        )));
+    }
     let knees: Vec<KneeForm> = angles_deg
         .iter()
         .map(|&angle| KneeForm::new(options.knee_form, angle))
         .collect();
-    let n = starts.len();
-    Ok((0..knees.len() * n)
-        .into_par_iter()
-        .map(|k| {
-            let trace = trace_validated(part, &knees[k / n], starts[k % n], options);
+    Ok(pairs
+        .par_iter()
+        .map(|&(s, a)| {
+            let trace = trace_validated(part, &knees[a], starts[s], options);
             traced();
             trace
         })

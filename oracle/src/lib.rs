@@ -75,7 +75,7 @@ mod sweep;
 mod trace;
 mod window;
 
-pub use batch::{evaluate, evaluate_reporting};
+pub use batch::{evaluate, evaluate_pairs, evaluate_reporting};
 pub use direct::{
     DirectContact, DirectOptions, DirectStatus, DirectTrace, direct_contact, evaluate_direct,
 };

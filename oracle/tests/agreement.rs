@@ -102,3 +102,37 @@ fn the_skip_changes_no_trace_on_the_real_meshes() {
     }
     assert!(compared >= 5, "{compared} meshes compared");
 }
+
+/// `evaluate_pairs` traces any subset of `evaluate`'s pairs, in the order
+/// asked, each trace the same to the bit (`verify` predicts its time from
+/// such a subset, then traces the rest).
+#[test]
+fn any_pairs_trace_as_the_whole_product_does() {
+    let read = kneeform::read_part(
+        &repo().join("scenarios/bump.toml"),
+        1.0,
+        kneeform::Side::Left,
+    )
+    .unwrap();
+    let part = Part::from_triangles(&read.part.triangles).unwrap();
+    let starts = util::starts_over(&part, 3, 2);
+    let angles = [-30.0, 0.0, 30.0];
+    let options = OracleOptions {
+        witness_tolerance: 0.4,
+        ..OracleOptions::default()
+    };
+    let all = evaluate(&part, &starts, &angles, &options).unwrap();
+    let pairs = [(5, 2), (0, 0), (3, 1), (2, 2), (1, 0)];
+    let some =
+        kneeform_oracle::evaluate_pairs(&part, &starts, &angles, &pairs, &options, &|| {}).unwrap();
+    assert_eq!(some.len(), pairs.len());
+    for (trace, &(s, a)) in some.iter().zip(&pairs) {
+        assert!(
+            same(trace, &all[a * starts.len() + s]),
+            "start {s}, angle {a}"
+        );
+    }
+    assert!(some.iter().any(|t| !t.contacts.is_empty()));
+    let bad = kneeform_oracle::evaluate_pairs(&part, &starts, &angles, &[(6, 0)], &options, &|| {});
+    assert!(bad.is_err(), "a start index beyond the starts given");
+}

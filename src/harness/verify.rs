@@ -147,12 +147,12 @@ pub(super) fn start_positions(
     Ok(starts)
 }
 
-/// The share of the starts traced first, at every angle, to predict the
-/// oracle's time: one in twenty (at least one start).
+/// The share of the start-angle pairs traced first to predict the
+/// oracle's time: one in twenty, spread over the starts and angles.
 const SAMPLE_EVERY: usize = 20;
 
 /// The oracle's traces of `starts` at `angles`, reported as one stage,
-/// angle-major. A sample of the starts is traced first, at every angle:
+/// angle-major. A sample of the pairs is traced first, spread over the starts and angles:
 /// its time predicts the whole (said as a note), and a prediction beyond
 /// `budget_s` is refused before the rest is traced.
 pub(super) fn run_oracle(
@@ -172,20 +172,30 @@ pub(super) fn run_oracle(
     super::in_stage(progress, &what, Some(pairs as u64), || {
         let t = Instant::now();
         let part = kneeform_oracle::Part::from_triangles(triangles)?;
-        let trace = |starts: &[[f64; 2]]| {
-            kneeform_oracle::evaluate_reporting(&part, starts, angles, options, &|| progress.step())
+        let trace = |pairs: &[(usize, usize)]| {
+            kneeform_oracle::evaluate_pairs(&part, starts, angles, pairs, options, &|| {
+                progress.step()
+            })
         };
-        let sampled = starts.len().div_ceil(SAMPLE_EVERY);
-        let (first, rest) = starts.split_at(sampled);
-        let sample = trace(first)?;
+        // One pair in SAMPLE_EVERY, spread over the starts and the angles
+        // (start s at angle a when (s + a) is a multiple of it: every
+        // start at about one angle in twenty). The first starts alone (the
+        // lowest start rows) predicted the console's 167 s as 44 s, every
+        // twentieth start at every angle as 317 s: a trace's cost varies
+        // more between starts than between angles.
+        let n = starts.len();
+        let is_sampled = |(s, a): (usize, usize)| (s + a) % SAMPLE_EVERY == 0;
+        let (first, rest): (Vec<_>, Vec<_>) = (0..pairs)
+            .map(|k| (k % n, k / n))
+            .partition(|&p| is_sampled(p));
+        let sample = trace(&first)?;
         let sample_s = t.elapsed().as_secs_f64();
-        let predicted_s = sample_s * starts.len() as f64 / sampled.max(1) as f64;
+        let predicted_s = sample_s * pairs as f64 / first.len().max(1) as f64;
         if !rest.is_empty() {
             progress.note(&format!(
-                "exact oracle: about {} for {pairs} start-angle pairs (predicted from {} of the {} starts at every angle, {:.1} s)",
+                "exact oracle: about {} for {pairs} start-angle pairs (predicted from {} of them spread over the starts and angles, {:.1} s)",
                 crate::limits::duration_words(predicted_s),
-                sampled,
-                starts.len(),
+                first.len(),
                 sample_s
             ));
         }
@@ -199,16 +209,18 @@ pub(super) fn run_oracle(
                 shards: ((predicted_s / budget_s).ceil() as usize).clamp(2, starts.len().max(2)),
             });
         }
-        let rest = trace(rest)?;
-        // Angle-major over every start: each angle's sampled starts, then
-        // the rest of them.
-        let (m, r) = (sampled, starts.len() - sampled);
-        let mut traces = Vec::with_capacity(pairs);
+        let rest = trace(&rest)?;
+        // Angle-major over every start, as `evaluate` orders them.
         let (mut sample, mut rest) = (sample.into_iter(), rest.into_iter());
-        for _ in angles {
-            traces.extend(sample.by_ref().take(m));
-            traces.extend(rest.by_ref().take(r));
-        }
+        let traces = (0..pairs)
+            .filter_map(|k| {
+                if is_sampled((k % n, k / n)) {
+                    sample.next()
+                } else {
+                    rest.next()
+                }
+            })
+            .collect();
         Ok((traces, t.elapsed().as_secs_f64()))
     })
 }
