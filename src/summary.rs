@@ -494,35 +494,29 @@ impl SampleCheck {
     /// The check in one line, as the console and the report say it.
     pub fn line(&self) -> String {
         let mm = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3} mm"));
+        let head = format!(
+            "sample check against the exact oracle ({} starts x {} angles, seed {}, {} pairs compared{})",
+            self.starts,
+            self.angles_deg.len(),
+            self.seed,
+            self.compared_pairs,
+            if self.oracle_failed > 0 {
+                format!(", {} oracle failures", self.oracle_failed)
+            } else {
+                String::new()
+            },
+        );
         match self.status {
             CheckStatus::Checked
                 if self.miss_distance_decided_mm.is_none()
                     && self.false_alarm_distance_decided_mm.is_none() =>
             {
                 format!(
-                    "sample check against the exact oracle ({} starts x {} angles, seed {}, {} pairs compared{}): neither side strikes anything decided on these pairs, so it measured nothing here; `kneeform verify` measures the part",
-                    self.starts,
-                    self.angles_deg.len(),
-                    self.seed,
-                    self.compared_pairs,
-                    if self.oracle_failed > 0 {
-                        format!(", {} oracle failures", self.oracle_failed)
-                    } else {
-                        String::new()
-                    },
+                    "{head}: neither side strikes anything decided on these pairs, so it measured nothing here; `kneeform verify` measures the part"
                 )
             }
             CheckStatus::Checked => format!(
-                "sample check against the exact oracle ({} starts x {} angles, seed {}, {} pairs compared{}): decided misses within {}, decided false alarms within {} ({} beyond the level error's bound){}; {} the tolerance of {} mm (sqrt 2 pitches)",
-                self.starts,
-                self.angles_deg.len(),
-                self.seed,
-                self.compared_pairs,
-                if self.oracle_failed > 0 {
-                    format!(", {} oracle failures", self.oracle_failed)
-                } else {
-                    String::new()
-                },
+                "{head}: decided misses within {}, decided false alarms within {} ({} beyond the level error's bound){}; {} the tolerance of {} mm (sqrt 2 pitches)",
                 mm(self.miss_distance_decided_mm),
                 mm(self.false_alarm_distance_decided_mm),
                 mm(self.false_alarm_unexplained_mm),
