@@ -516,10 +516,16 @@ impl SampleCheck {
                 )
             }
             CheckStatus::Checked => format!(
-                "{head}: decided misses within {}, decided false alarms within {} ({} beyond the level error's bound){}; {} the tolerance of {} mm (sqrt 2 pitches)",
+                "{head}: decided misses within {}, decided false alarms within {} ({}){}; {} the tolerance of {} mm (sqrt 2 pitches)",
                 mm(self.miss_distance_decided_mm),
                 mm(self.false_alarm_distance_decided_mm),
-                mm(self.false_alarm_unexplained_mm),
+                match self.false_alarm_unexplained_mm {
+                    Some(v) if v > 0.0 => format!(
+                        "{} among those beyond the bound of the grid's level error",
+                        mm(Some(v))
+                    ),
+                    _ => "each within the bound of the grid's level error: the safe side".into(),
+                },
                 if self.unmatched_exact_decided > 0 {
                     format!(
                         "; {} decided exact strikes in starts where the grid strikes nothing",
