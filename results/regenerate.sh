@@ -9,6 +9,9 @@
 #     bash results/regenerate.sh converge-direct  # the direct approach's studies only
 #     bash results/regenerate.sh ab REV     # results/ab.md: this tree against
 #                                           # the commit REV, end to end, in one run
+#     bash results/regenerate.sh strip      # results/converge-strip/: the wave's
+#                                           # study over a whole strip of 21 start
+#                                           # rows, every start (about 1.5 minutes)
 #     bash results/regenerate.sh pitch      # results/pitch.md: the bundled console
 #                                           # at 0.5 mm (61 angles) and 0.25 mm
 #                                           # (3 angles), about 6 minutes
@@ -46,6 +49,14 @@ if [[ "$what" == all || "$what" == converge || "$what" == converge-direct ]]; th
       --pitches 4,2,1,0.5 --angles=-30,0,30 --starts 60 --seed 1 \
       --tolerance 1 --out "results/converge-direct/$name"
   done
+fi
+
+if [[ "$what" == all || "$what" == strip ]]; then
+  # SPEC's area distance over every start of a strip (issue 26, item 3):
+  # the wave's 21 start rows z in [-40, 40] mm at the coarsest pitch, all
+  # 4,851 of their starts, the same pitches and angles as the sampled study.
+  "$bin" converge scenarios/wave.toml --pitches 4,2,1,0.5 --angles=-30,0,30 \
+    --starts strip:-40:40 --tolerance 1 --out results/converge-strip/wave
 fi
 
 if [[ "$what" == all || "$what" == bench ]]; then
