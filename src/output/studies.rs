@@ -13,9 +13,7 @@ use crate::harness::{Convergence, DirectConvergence, DirectVerification, Verific
 /// Writes `verify.csv` (one row per start and angle) and `verify.json`
 /// into `dir`, which appears with both or is left as it was.
 pub fn write_verification(dir: &Path, verification: &Verification) -> Result<(), WriteError> {
-    let out = stage(dir)?;
-    write_verification_files(&out, verification)?;
-    commit(out, dir)
+    staged(dir, |out| write_verification_files(out, verification))
 }
 
 /// Writes [`write_verification`]'s files into the staged directory `out`
@@ -33,9 +31,7 @@ pub fn write_verification_files(
 /// `converge.json` and the plots; `dir` appears with all of them or is
 /// left as it was.
 pub fn write_convergence(dir: &Path, convergence: &Convergence) -> Result<(), WriteError> {
-    let out = stage(dir)?;
-    write_convergence_files(&out, convergence)?;
-    commit(out, dir)
+    staged(dir, |out| write_convergence_files(out, convergence))
 }
 
 /// Writes [`write_convergence`]'s files into the staged directory `out`
@@ -90,9 +86,9 @@ pub fn write_direct_verification(
     dir: &Path,
     verification: &DirectVerification,
 ) -> Result<(), WriteError> {
-    let out = stage(dir)?;
-    write_direct_verification_files(&out, verification)?;
-    commit(out, dir)
+    staged(dir, |out| {
+        write_direct_verification_files(out, verification)
+    })
 }
 
 /// Writes [`write_direct_verification`]'s files into the staged directory
@@ -112,9 +108,7 @@ pub fn write_direct_convergence(
     dir: &Path,
     convergence: &DirectConvergence,
 ) -> Result<(), WriteError> {
-    let out = stage(dir)?;
-    write_direct_convergence_files(&out, convergence)?;
-    commit(out, dir)
+    staged(dir, |out| write_direct_convergence_files(out, convergence))
 }
 
 /// Writes [`write_direct_convergence`]'s files into the staged directory
@@ -178,12 +172,19 @@ pub fn write_direct_convergence_files(
     write_json(&out.path("converge.json"), &convergence.summary)
 }
 
-/// Stages `dir` for a verification's or a convergence study's files.
-fn stage(dir: &Path) -> Result<OutputDir, WriteError> {
-    OutputDir::stage(dir).map_err(|source| WriteError::Commit {
+/// Stages `dir`, has `write` fill it and commits it: `dir` appears with
+/// every file or is left as it was.
+fn staged(
+    dir: &Path,
+    write: impl FnOnce(&OutputDir) -> Result<(), WriteError>,
+) -> Result<(), WriteError> {
+    let commit_error = |source| WriteError::Commit {
         path: dir.to_path_buf(),
         source,
-    })
+    };
+    let out = OutputDir::stage(dir).map_err(commit_error)?;
+    write(&out)?;
+    out.commit().map(drop).map_err(commit_error)
 }
 
 /// Writes serialisable rows as CSV with a header.
@@ -197,11 +198,4 @@ fn write_rows(path: &Path, rows: &[impl serde::Serialize]) -> Result<(), WriteEr
         Ok(())
     })()
     .map_err(WriteError::at(path))
-}
-
-fn commit(out: OutputDir, dir: &Path) -> Result<(), WriteError> {
-    out.commit().map(drop).map_err(|source| WriteError::Commit {
-        path: dir.to_path_buf(),
-        source,
-    })
 }
