@@ -133,60 +133,6 @@ pub fn blind_spots(triangles: &[Triangle], grid: &HeightGrid, threshold: f64) ->
     spots
 }
 
-/// Every cell's sampled reference height and the mesh's lowest point in it:
-/// what a blind spot is judged by, for all cells, flagged or not.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CellDepths {
-    /// Cells per row (`nx - 1`).
-    pub cx: usize,
-    /// Per cell, row-major: the reference height (the lowest sampled
-    /// corner, as [`blind_spots`] takes it) and the mesh's lowest y in the
-    /// cell's closed square (mm); `NaN` where either is missing.
-    pub cells: Vec<(f64, f64)>,
-}
-
-impl CellDepths {
-    /// The depth missed of cell `(i, j)`: how far the mesh sticks out past
-    /// the cell's reference height (mm; `NaN` where unknown).
-    pub fn depth(&self, i: usize, j: usize) -> f64 {
-        let (reference, lowest) = self.cells[j * self.cx + i];
-        reference - lowest
-    }
-
-    /// The reference height of cell `(i, j)` (mm; `NaN` where unknown).
-    pub fn reference(&self, i: usize, j: usize) -> f64 {
-        self.cells[j * self.cx + i].0
-    }
-}
-
-/// The reference height and lowest mesh point of every cell of `grid`
-/// (sampled from `triangles`): the blind-spot test before its threshold.
-pub fn cell_depths(triangles: &[Triangle], grid: &HeightGrid) -> CellDepths {
-    let spec = grid.spec;
-    if spec.nx < 2 || spec.nz < 2 {
-        return CellDepths {
-            cx: spec.nx.saturating_sub(1),
-            cells: Vec::new(),
-        };
-    }
-    let rows = bin_by_cell_row(triangles, grid);
-    let lowest = lowest_points(triangles, grid, &rows);
-    let cells = lowest
-        .iter()
-        .enumerate()
-        .flat_map(|(j, row)| {
-            row.iter().enumerate().map(move |(i, &(y, _))| {
-                let reference = reference_height(grid, i, j).unwrap_or(f64::NAN);
-                (reference, if y.is_finite() { y } else { f64::NAN })
-            })
-        })
-        .collect();
-    CellDepths {
-        cx: spec.nx - 1,
-        cells,
-    }
-}
-
 /// Per cell row, the lowest mesh point `(y, [x, z])` of each cell (`+inf`
 /// where no triangle meets the cell), in parallel over the rows.
 fn lowest_points(

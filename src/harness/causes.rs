@@ -41,7 +41,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::blind::{BlindSpot, cell_depths, reference_height};
+use crate::blind::{BlindSpot, blind_spots, reference_height};
 use crate::grid::{GridSpec, HeightGrid};
 use crate::mesh::Triangle;
 
@@ -72,28 +72,23 @@ impl Cells {
     /// The cells of `grid` (sampled from `triangles`), blind spots being
     /// those deeper than `threshold` mm (the analysis's `--blind-depth`).
     pub fn of(triangles: &[Triangle], grid: &HeightGrid, threshold: f64) -> Cells {
-        let depths = cell_depths(triangles, grid);
-        let cx = depths.cx;
-        let blind = (0..depths.cells.len())
-            .map(|n| (n % cx, n / cx))
-            .filter(|&(i, j)| depths.depth(i, j) > threshold)
-            .collect();
-        Cells::with_blind(grid, blind)
+        Cells::of_blind_spots(grid, &blind_spots(triangles, grid, threshold))
     }
 
     /// The cells of `grid` whose blind spots are `spots` (an analysis's:
-    /// found by [`crate::blind::blind_spots`] on the same grid, at its
-    /// threshold), without finding them again.
+    /// found by [`blind_spots`] on the same grid, at its threshold),
+    /// without finding them again.
     pub fn of_blind_spots(grid: &HeightGrid, spots: &[BlindSpot]) -> Cells {
-        Cells::with_blind(grid, spots.iter().map(|s| (s.i, s.j)).collect())
-    }
-
-    fn with_blind(grid: &HeightGrid, mut cells: Vec<(usize, usize)>) -> Cells {
-        cells.sort_unstable();
-        let blind = cells
-            .into_iter()
-            .map(|(i, j)| ((i, j), reference_height(grid, i, j).unwrap_or(f64::NAN)))
+        let mut blind: Vec<((usize, usize), f64)> = spots
+            .iter()
+            .map(|s| {
+                (
+                    (s.i, s.j),
+                    reference_height(grid, s.i, s.j).unwrap_or(f64::NAN),
+                )
+            })
             .collect();
+        blind.sort_unstable_by_key(|&(cell, _)| cell);
         Cells {
             spec: grid.spec,
             blind,
