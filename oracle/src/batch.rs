@@ -32,14 +32,6 @@ pub fn evaluate_reporting(
     options: &OracleOptions,
     traced: &(dyn Fn() + Sync),
 ) -> Result<Vec<StartTrace>, OracleError> {
-    if let Some(bad) = starts
-        .iter()
-        .find(|s| !(s[0].is_finite() && s[1].is_finite()))
-    {
-        return Err(OracleError::InvalidOptions(format!(
-            "start {bad:?} is not finite"
-        )));
-    }
     let n = starts.len();
     let pairs: Vec<(usize, usize)> = (0..angles_deg.len() * n).map(|k| (k % n, k / n)).collect();
     evaluate_pairs(part, starts, angles_deg, &pairs, options, traced)
@@ -61,6 +53,14 @@ pub fn evaluate_pairs(
     if let Some(bad) = angles_deg.iter().find(|a| !a.is_finite()) {
         return Err(OracleError::InvalidOptions(format!(
             "angle {bad} is not finite"
+        )));
+    }
+    if let Some(bad) = starts
+        .iter()
+        .find(|s| !(s[0].is_finite() && s[1].is_finite()))
+    {
+        return Err(OracleError::InvalidOptions(format!(
+            "start {bad:?} is not finite"
         )));
     }
     if let Some(&(s, a)) = pairs

@@ -58,6 +58,20 @@ pub struct CompareOptions {
     pub blind_depth: f64,
 }
 
+impl CompareOptions {
+    /// The options of a comparison of an analysis by `setup` (its
+    /// knee-form, strike rule and blind depth), with the tie band's growth
+    /// `tie_band_per_mm`.
+    pub fn of(setup: &crate::setup::Setup, tie_band_per_mm: f64) -> CompareOptions {
+        CompareOptions {
+            knee: setup.knee,
+            rule: setup.rule,
+            tie_band_per_mm,
+            blind_depth: setup.blind_depth,
+        }
+    }
+}
+
 /// SplitMix64, for seeded start samples (same sample on every machine).
 pub(crate) struct SplitMix(pub(crate) u64);
 
@@ -529,11 +543,13 @@ pub fn compare_grid(
     traces: &[StartTrace],
     options: &CompareOptions,
 ) -> Result<Comparison, HarnessError> {
-    compare_grid_with(triangles, grid, footprints, starts, traces, options, None)
+    let given = GridSide::default();
+    compare_grid_with(triangles, grid, footprints, starts, traces, options, given)
 }
 
-/// [`compare_grid`] with an optional deliberate mistake on the grid side:
-/// the harness's own tests show it catches a broken engine.
+/// [`compare_grid`] with what the grid side may be handed: the blind
+/// spots an analysis found, a deliberate mistake (the harness's own tests
+/// show it catches a broken engine).
 pub(crate) fn compare_grid_with(
     triangles: &[Triangle],
     grid: &HeightGrid,
@@ -541,10 +557,9 @@ pub(crate) fn compare_grid_with(
     starts: &[[f64; 2]],
     traces: &[StartTrace],
     options: &CompareOptions,
-    fault: Option<Fault>,
+    given: GridSide,
 ) -> Result<Comparison, HarnessError> {
     let t = Instant::now();
-    let given = GridSide { cells: None, fault };
     let results = pair_results(triangles, grid, footprints, starts, traces, options, given)?;
     let grid_s = t.elapsed().as_secs_f64();
     let band = TieBand::new(options.rule.sigma, grid.spec.pitch, options.tie_band_per_mm);

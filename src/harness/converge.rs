@@ -304,12 +304,7 @@ impl<'a> Ladder<'a> {
             all_starts,
             traces,
             oracle_s,
-            compare: CompareOptions {
-                knee: setup.knee,
-                rule: setup.rule,
-                tie_band_per_mm,
-                blind_depth: setup.blind_depth,
-            },
+            compare: CompareOptions::of(setup, tie_band_per_mm),
         })
     }
 

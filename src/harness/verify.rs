@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::HarnessError;
 use super::compare::{
-    AreaDistance, CompareOptions, Comparison, Counts, StartSelection, compare_grid_with,
+    AreaDistance, CompareOptions, Comparison, Counts, GridSide, StartSelection, compare_grid_with,
     select_starts,
 };
 use super::metrics::{Stats, TieBand};
@@ -152,9 +152,9 @@ pub(super) fn start_positions(
 const SAMPLE_EVERY: usize = 20;
 
 /// The oracle's traces of `starts` at `angles`, reported as one stage,
-/// angle-major. A sample of the pairs is traced first, spread over the starts and angles:
-/// its time predicts the whole (said as a note), and a prediction beyond
-/// `budget_s` is refused before the rest is traced.
+/// angle-major. A sample of the pairs, spread over the starts and angles,
+/// is traced first: its time predicts the whole (said as a note), and a
+/// prediction beyond `budget_s` is refused before the rest is traced.
 pub(super) fn run_oracle(
     triangles: &[Triangle],
     starts: &[[f64; 2]],
@@ -265,7 +265,7 @@ pub(crate) fn verify_with(
             starts,
             traces,
             compare,
-            fault,
+            GridSide { cells: None, fault },
         )
     })?;
     let summary = VerifySummary::new(
@@ -341,12 +341,7 @@ impl Traced {
             all,
             starts,
             traces,
-            compare: CompareOptions {
-                knee: setup.knee,
-                rule: setup.rule,
-                tie_band_per_mm: options.tie_band_per_mm,
-                blind_depth: setup.blind_depth,
-            },
+            compare: CompareOptions::of(setup, options.tie_band_per_mm),
             sample_s,
             oracle_s,
         })
