@@ -13,9 +13,14 @@
 #[derive(Debug, Clone)]
 pub struct PointSet {
     /// The points, reordered into a balanced 2-d tree: the median of each
-    /// range (split on x at even depths, z at odd) sits at its middle.
+    /// range longer than [`LEAF`] (split on x at even depths, z at odd)
+    /// sits at its middle; shorter ranges are leaves, scanned in full.
     points: Vec<[f64; 2]>,
 }
+
+/// The longest range the tree leaves unsplit: scanning a few points costs
+/// less than descending to each.
+const LEAF: usize = 8;
 
 impl PointSet {
     /// Builds the tree over `points`.
@@ -32,29 +37,63 @@ impl PointSet {
     /// The distance from `q` to the nearest point of the set, `+inf` when
     /// the set is empty.
     pub fn distance(&self, q: [f64; 2]) -> f64 {
-        let mut best = Best {
-            d2: f64::INFINITY,
-            d: f64::INFINITY,
-        };
-        search(&self.points, 0, q, &mut best);
-        best.d
+        self.nearest(q, None, 0.0).distance()
     }
 
     /// The distance from each point of `from` to its nearest point here.
     pub fn distances(&self, from: &[[f64; 2]]) -> Vec<f64> {
-        from.iter().map(|&q| self.distance(q)).collect()
+        // Consecutive queries (a trace's contacts) lie close together: the
+        // previous answer's point starts each search with a near bound.
+        let mut hint = None;
+        from.iter()
+            .map(|&q| {
+                let best = self.nearest(q, hint, 0.0);
+                hint = best.point;
+                best.distance()
+            })
+            .collect()
     }
 
     /// The directed Hausdorff distance from `from` to this set: the largest
     /// distance from a point of `from` to its nearest point here (0 when
     /// `from` is empty, `+inf` when only this set is).
     pub fn hausdorff_from(&self, from: &[[f64; 2]]) -> f64 {
-        from.iter().map(|&q| self.distance(q)).fold(0.0, f64::max)
+        if self.points.is_empty() {
+            return if from.is_empty() { 0.0 } else { f64::INFINITY };
+        }
+        // A query whose search finds a point clearly nearer than the
+        // largest distance so far cannot raise it: its search stops there.
+        let (mut largest, mut largest_d2) = (0.0f64, 0.0f64);
+        let mut hint = None;
+        for &q in from {
+            let best = self.nearest(q, hint, largest_d2 * (1.0 - TIE));
+            hint = best.point;
+            if best.d2 >= largest_d2 * (1.0 - TIE) {
+                let d = best.distance();
+                if d > largest {
+                    largest = d;
+                }
+                largest_d2 = largest_d2.max(best.d2);
+            }
+        }
+        largest
+    }
+
+    /// The nearest point to `q`, the search seeded with `hint` (a point of
+    /// the set) and stopped as soon as a point nearer than `stop_d2`
+    /// (squared) is found.
+    fn nearest(&self, q: [f64; 2], hint: Option<[f64; 2]>, stop_d2: f64) -> Best {
+        let mut best = Best::new();
+        if let Some(p) = hint {
+            best.offer(p, q);
+        }
+        search(&self.points, 0, q, stop_d2, &mut best);
+        best
     }
 }
 
 fn build(points: &mut [[f64; 2]], depth: usize) {
-    if points.len() <= 1 {
+    if points.len() <= LEAF {
         return;
     }
     let axis = depth % 2;
@@ -65,34 +104,77 @@ fn build(points: &mut [[f64; 2]], depth: usize) {
     build(&mut right[1..], depth + 1);
 }
 
-/// The nearest distance found so far: squared (to prune with) and as
-/// `hypot` measures it (the answer).
-struct Best {
-    d2: f64,
-    d: f64,
-}
-
-/// A relative margin far above the rounding of a squared distance: a point
-/// whose squared distance is within it of the best is measured by `hypot`.
+/// A relative margin far above the rounding of a squared distance: points
+/// whose squared distances are within it of each other are near-ties,
+/// which only `hypot` orders as a brute-force scan does.
 const TIE: f64 = 1e-12;
 
-/// Folds the nearest point of the subtree `points` into `best`. Points are
-/// compared by squared distance, and `hypot` is taken for those within
-/// [`TIE`] of the best, so the answer is the brute-force minimum of
-/// `hypot` to the bit (the two orders differ only among such near-ties);
-/// a far side is skipped only beyond that margin.
-fn search(points: &[[f64; 2]], depth: usize, q: [f64; 2], best: &mut Best) {
-    if points.is_empty() {
+/// The search's state: the smallest squared distance found, its point,
+/// and the smallest `hypot` among the near-ties met beside it.
+///
+/// The answer, the brute-force minimum of `hypot` to the bit, is the
+/// smallest `hypot` among the points whose squared distance is within
+/// [`TIE`] of the smallest: any point beyond that margin is farther by far
+/// more than `hypot`'s rounding. `hypot` is taken only for near-ties and
+/// once at the end, not at every improvement.
+struct Best {
+    d2: f64,
+    dx: f64,
+    dz: f64,
+    point: Option<[f64; 2]>,
+    /// `min hypot` over the near-ties met so far, other than `point`
+    /// (possibly including some that later fell beyond the margin: they
+    /// are farther, so the minimum is unchanged).
+    ties: f64,
+}
+
+impl Best {
+    fn new() -> Best {
+        Best {
+            d2: f64::INFINITY,
+            dx: f64::INFINITY,
+            dz: 0.0,
+            point: None,
+            ties: f64::INFINITY,
+        }
+    }
+
+    fn offer(&mut self, p: [f64; 2], q: [f64; 2]) {
+        let (dx, dz) = (p[0] - q[0], p[1] - q[1]);
+        let d2 = dx * dx + dz * dz;
+        if d2 < self.d2 {
+            if self.d2 <= d2 * (1.0 + TIE) {
+                self.ties = self.ties.min(self.dx.hypot(self.dz));
+            } else {
+                self.ties = f64::INFINITY;
+            }
+            (self.d2, self.dx, self.dz, self.point) = (d2, dx, dz, Some(p));
+        } else if d2 <= self.d2 * (1.0 + TIE) {
+            self.ties = self.ties.min(dx.hypot(dz));
+        }
+    }
+
+    fn distance(&self) -> f64 {
+        match self.point {
+            Some(_) => self.dx.hypot(self.dz).min(self.ties),
+            None => f64::INFINITY,
+        }
+    }
+}
+
+/// Folds the nearest point of the subtree `points` into `best`, skipping a
+/// far side only beyond the [`TIE`] margin, and returning early once
+/// `best.d2 < stop_d2`.
+fn search(points: &[[f64; 2]], depth: usize, q: [f64; 2], stop_d2: f64, best: &mut Best) {
+    if points.len() <= LEAF {
+        for &p in points {
+            best.offer(p, q);
+        }
         return;
     }
     let mid = points.len() / 2;
     let p = points[mid];
-    let (dx, dz) = (p[0] - q[0], p[1] - q[1]);
-    let d2 = dx * dx + dz * dz;
-    if d2 <= best.d2 * (1.0 + TIE) {
-        best.d = best.d.min(dx.hypot(dz));
-        best.d2 = best.d2.min(d2);
-    }
+    best.offer(p, q);
     let axis = depth % 2;
     let delta = q[axis] - p[axis];
     let (near, far) = if delta < 0.0 {
@@ -100,9 +182,9 @@ fn search(points: &[[f64; 2]], depth: usize, q: [f64; 2], best: &mut Best) {
     } else {
         (&points[mid + 1..], &points[..mid])
     };
-    search(near, depth + 1, q, best);
-    if delta * delta <= best.d2 * (1.0 + TIE) {
-        search(far, depth + 1, q, best);
+    search(near, depth + 1, q, stop_d2, best);
+    if best.d2 >= stop_d2 && delta * delta <= best.d2 * (1.0 + TIE) {
+        search(far, depth + 1, q, stop_d2, best);
     }
 }
 
@@ -131,6 +213,46 @@ mod tests {
                 .map(|p| (p[0] - q[0]).hypot(p[1] - q[1]))
                 .fold(f64::INFINITY, f64::min);
             assert_eq!(set.distance(q), brute, "{q:?}");
+        }
+    }
+
+    #[test]
+    fn seeded_and_early_stopped_searches_equal_brute_force() {
+        let mut state = 777u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        // Grid nodes (many equidistant near-ties) and a walk of queries
+        // along a curve, as a trace's contacts come.
+        let points: Vec<[f64; 2]> = (0..40)
+            .flat_map(|i| (0..30).map(move |j| [i as f64 * 1.24 + 0.1, j as f64 * 1.24]))
+            .collect();
+        let set = PointSet::new(points.clone());
+        let brute = |q: [f64; 2]| {
+            points
+                .iter()
+                .map(|p| (p[0] - q[0]).hypot(p[1] - q[1]))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let mut queries: Vec<[f64; 2]> = (0..400)
+            .map(|k| {
+                let t = k as f64 * 0.13;
+                [60.0 - t, 20.0 + 8.0 * (t / 7.0).sin()]
+            })
+            .collect();
+        // Midpoints between nodes: exact ties, reached by rounding.
+        queries.extend((0..50).map(|k| [0.72 + 1.24 * (k % 7) as f64, 0.62 + 1.24 * (k / 7) as f64]));
+        queries.extend((0..100).map(|_| [next() * 70.0 - 10.0, next() * 60.0 - 10.0]));
+        let expected: Vec<f64> = queries.iter().map(|&q| brute(q)).collect();
+        assert_eq!(set.distances(&queries), expected);
+        let largest = expected.iter().copied().fold(0.0, f64::max);
+        assert_eq!(set.hausdorff_from(&queries), largest);
+        for window in queries.chunks(37) {
+            let largest = window.iter().map(|&q| brute(q)).fold(0.0, f64::max);
+            assert_eq!(set.hausdorff_from(window), largest);
         }
     }
 
