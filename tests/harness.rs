@@ -3,7 +3,7 @@
 //! honest. (That it catches a broken engine is tested inside the library,
 //! `src/harness/fault_tests.rs`: the faults are in no public API.)
 
-use kneeform::harness::causes::Mechanism;
+use kneeform::harness::Mechanism;
 use kneeform::harness::{
     self, Comparison, ConvergeOptions, StartSelection, TieBand, VerifyOptions,
 };
@@ -78,7 +78,7 @@ fn scenario(name: &str) -> Vec<Triangle> {
 
 #[test]
 fn errors_shrink_with_the_pitch_on_smooth_parts() {
-    use kneeform::harness::converge::fit_power_law;
+    use kneeform::harness::fit_power_law;
     for s in ["growing-wave", "depression"] {
         // The coarsest grid's starts, shared by every pitch (grids nest).
         let options = ConvergeOptions {

@@ -135,7 +135,7 @@ pub fn print_verification(result: &Verification, out: &Path) -> ExitCode {
             });
             // The hint follows the figure's mechanism: a rim or a brief
             // strike is the grid's sampling, not a feature's width.
-            use kneeform::harness::causes::Mechanism;
+            use kneeform::harness::Mechanism;
             let mechanism = s
                 .failures
                 .iter()

@@ -279,7 +279,7 @@ pub enum Mechanism {
     /// the size of error the grid makes at this pitch, which a finer pitch
     /// shrinks where the figure converges (`results/`); beyond it, a
     /// start's miss that halves at half the pitch against the same exact
-    /// trace ([`super::metrics::StartComparison::halves`]), or a brief
+    /// trace (`StartComparison::halves`), or a brief
     /// strike. It fails the verdict: the pitch is too coarse for the
     /// tolerance.
     Sampling,

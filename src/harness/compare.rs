@@ -1,11 +1,11 @@
 //! One grid against the exact oracle's traces on the same starts: start
 //! selection, the oracle's traces, the per-start rows and the metrics of
-//! their difference ([`compare_grid`]).
+//! their difference ([`compare_grid_with`]).
 
 use std::collections::HashSet;
 use std::time::Instant;
 
-use kneeform_oracle::{OracleOptions, StartStatus, StartTrace};
+use kneeform_oracle::{StartStatus, StartTrace};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -157,18 +157,6 @@ fn nearest_node(spec: &crate::grid::GridSpec, x: f64, z: f64) -> Option<(usize, 
 pub(super) fn node_at(spec: &crate::grid::GridSpec, x: f64, z: f64) -> Option<(usize, usize)> {
     let (i, j) = nearest_node(spec, x, z)?;
     ((spec.x(i) - x).abs() < 1e-6 && (spec.z(j) - z).abs() < 1e-6).then_some((i, j))
-}
-
-/// The exact traces of `starts` (mm, analysis frame) at `angles`, in
-/// angle-major order.
-pub fn exact_traces(
-    triangles: &[Triangle],
-    starts: &[[f64; 2]],
-    angles: &[f64],
-    options: &OracleOptions,
-) -> Result<Vec<StartTrace>, HarnessError> {
-    let part = kneeform_oracle::Part::from_triangles(triangles)?;
-    Ok(kneeform_oracle::evaluate(&part, starts, angles, options)?)
 }
 
 /// One row of `verify.csv`.
@@ -534,22 +522,10 @@ pub fn row_of(
 }
 
 /// Compares `grid` (sampled from `triangles`) with `traces` (angle-major
-/// over `starts`, positions in mm that must be nodes of `grid`).
-pub fn compare_grid(
-    triangles: &[Triangle],
-    grid: &HeightGrid,
-    footprints: &[GridFootprint],
-    starts: &[[f64; 2]],
-    traces: &[StartTrace],
-    options: &CompareOptions,
-) -> Result<Comparison, HarnessError> {
-    let given = GridSide::default();
-    compare_grid_with(triangles, grid, footprints, starts, traces, options, given)
-}
-
-/// [`compare_grid`] with what the grid side may be handed: the blind
-/// spots an analysis found, a deliberate mistake (the harness's own tests
-/// show it catches a broken engine).
+/// over `starts`, positions in mm that must be nodes of `grid`), given
+/// what the grid side may be handed: the blind spots an analysis found, a
+/// deliberate mistake (the harness's own tests show it catches a broken
+/// engine).
 pub(crate) fn compare_grid_with(
     triangles: &[Triangle],
     grid: &HeightGrid,
@@ -1224,6 +1200,20 @@ impl Comparison {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use kneeform_oracle::OracleOptions;
+
+    /// The exact traces of `starts` (mm, analysis frame) at `angles`, in
+    /// angle-major order.
+    fn exact_traces(
+        triangles: &[Triangle],
+        starts: &[[f64; 2]],
+        angles: &[f64],
+        options: &OracleOptions,
+    ) -> Result<Vec<StartTrace>, HarnessError> {
+        let part = kneeform_oracle::Part::from_triangles(triangles)?;
+        Ok(kneeform_oracle::evaluate(&part, starts, angles, options)?)
+    }
+
     use crate::harness::verify::oracle_options;
     use crate::scenario::{axis, tessellate};
 

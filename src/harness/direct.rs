@@ -300,22 +300,10 @@ pub const DIRECT_STATUSES: [&str; 5] = [
     "oracle_failed",
 ];
 
-/// Compares the grid's first contacts at `positions` (mm; `(y0, z0)`,
-/// nodes of `grid`, which is in the direct frame) with `traces`
-/// (angle-major, one per position and angle of `footprints`).
-pub fn compare_direct(
-    grid: &HeightGrid,
-    footprints: &[DirectFootprint],
-    positions: &[[f64; 2]],
-    traces: &[DirectTrace],
-    e0: f64,
-) -> Result<DirectComparison, HarnessError> {
-    let (pairs, grid_s) = direct_pairs(grid, footprints, positions, traces, e0)?;
-    Ok(assemble_direct(pairs, grid_s))
-}
-
-/// [`compare_direct`]'s pairs, angle-major, not yet assembled, and the
-/// seconds they took.
+/// The grid's first contacts at `positions` (mm; `(y0, z0)`, nodes of
+/// `grid`, which is in the direct frame) against `traces` (angle-major, one
+/// per position and angle of `footprints`): the pairs, angle-major, not yet
+/// assembled ([`assemble_direct`]), and the seconds they took.
 pub fn direct_pairs(
     grid: &HeightGrid,
     footprints: &[DirectFootprint],

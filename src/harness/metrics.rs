@@ -18,7 +18,7 @@ use super::trace::GridTrace;
 /// ones: what it strikes more); and the grid's level error at its strikes
 /// (`level_error_clearance`: how far a struck node lies from touching the
 /// exact knee-form; `level_error_bound`: the stated bound of the grid's
-/// level error there, see [`compare`]).
+/// level error there, see `compare.rs`).
 pub const METRICS: [&str; 26] = [
     "push_error",
     "first_contact_error",

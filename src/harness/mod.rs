@@ -9,64 +9,52 @@
 //!   oracle on a few of its own starts);
 //! * [`converge()`]: the same starts at several pitches, the fitted order
 //!   of convergence and the pitch to choose ([`Convergence`]);
-//! * [`compare`]: start selection, the oracle's traces, one grid's
+//! * `compare`: start selection, the oracle's traces, one grid's
 //!   comparison;
-//! * [`trace`]: the grid's push and slide of one start, with the travel of
+//! * `trace`: the grid's push and slide of one start, with the travel of
 //!   each colliding node;
-//! * [`causes`]: why a figure fails (blind spots touched, the grid's
+//! * `causes`: why a figure fails (blind spots touched, the grid's
 //!   level error, undecided contacts, oracle failures);
-//! * [`metrics`]: push, first-contact, miss and false-alarm errors, the
+//! * `metrics`: push, first-contact, miss and false-alarm errors, the
 //!   tie band, the area distance;
-//! * [`nearest`]: a 2-d tree for the area distance's nearest points;
-//! * [`sharded`]: a study's starts fanned out over shards
+//! * `nearest`: a 2-d tree for the area distance's nearest points;
+//! * `sharded`: a study's starts fanned out over shards
 //!   (`verify --shard K/N`) and merged back.
 //!
 //! **Invariant:** the harness reads the engine's grid and the oracle's
 //! traces and computes neither side's geometry, with one exception stated
-//! here: [`trace`] re-runs SPEC's push and slide of one start on the
+//! here: `trace` re-runs SPEC's push and slide of one start on the
 //! engine's grid, because the engine's fast path keeps no per-start
 //! travel (it keeps each node's reach). It is a direct transcription of
 //! SPEC, tested equal to the engine's masks on every start.
 
-pub mod auto;
-pub mod causes;
-pub mod check;
-pub mod compare;
-pub mod converge;
-pub mod direct;
-pub mod metrics;
-pub mod nearest;
-pub mod sharded;
-pub mod trace;
-pub mod verify;
+pub(crate) mod auto;
+pub(crate) mod causes;
+pub(crate) mod check;
+pub(crate) mod compare;
+pub(crate) mod converge;
+pub(crate) mod direct;
+pub(crate) mod metrics;
+pub(crate) mod nearest;
+pub(crate) mod sharded;
+pub(crate) mod trace;
+pub(crate) mod verify;
 
 #[cfg(test)]
 mod fault_tests;
 
 pub use auto::{AutoPitch, choose_pitch};
+pub use causes::Mechanism;
 pub use check::check_analysis;
-pub use compare::{
-    AreaDistance, CompareOptions, Comparison, Counts, PairResult, StartSelection, VerifyRow,
-    assemble, compare_grid, exact_traces, select_starts,
-};
-pub use converge::{
-    ConvergeOptions, ConvergeSummary, Convergence, PitchResult, ROUNDING_MM, converge,
-};
+pub use compare::{Comparison, StartSelection};
+pub use converge::{ConvergeOptions, Convergence, ROUNDING_MM, converge, fit_power_law};
 pub use direct::{
-    DIRECT_METRICS, DIRECT_STATUSES, DirectComparison, DirectConvergeSummary, DirectConvergence,
-    DirectCounts, DirectPair, DirectRow, DirectStats, DirectVerification, DirectVerifySummary,
-    converge_direct, converge_direct_shard, verify_direct, verify_direct_shard,
+    DIRECT_METRICS, DirectConvergence, DirectVerification, converge_direct, converge_direct_shard,
+    verify_direct, verify_direct_shard,
 };
-pub use metrics::{DECIDED_METRICS, METRICS, Stats, TieBand};
-pub use sharded::{
-    Pairs, StudyPart, StudySettings, StudySummary, converge_shard, merge_converge,
-    merge_converge_direct, merge_verify, merge_verify_direct, verify_shard,
-};
-pub use trace::{GridContact, GridTrace};
-pub use verify::{
-    Verification, VerifyOptions, VerifySummary, VerifyTimings, WorstStart, oracle_options,
-    sampling_tolerance, tie_band_rule, verify,
-};
+pub use metrics::{DECIDED_METRICS, METRICS, TieBand};
+pub use sharded::{StudyPart, converge_shard, verify_shard};
+pub use verify::{Verification, VerifyOptions, oracle_options, sampling_tolerance, verify};
 
 use serde::{Deserialize, Serialize};
 

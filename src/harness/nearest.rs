@@ -29,18 +29,8 @@ impl PointSet {
         PointSet { points }
     }
 
-    /// Whether the set is empty.
-    pub fn is_empty(&self) -> bool {
-        self.points.is_empty()
-    }
-
-    /// The distance from `q` to the nearest point of the set, `+inf` when
-    /// the set is empty.
-    pub fn distance(&self, q: [f64; 2]) -> f64 {
-        self.nearest(q, None, 0.0).distance()
-    }
-
-    /// The distance from each point of `from` to its nearest point here.
+    /// The distance from each point of `from` to its nearest point here
+    /// (`+inf` when the set is empty).
     pub fn distances(&self, from: &[[f64; 2]]) -> Vec<f64> {
         // Consecutive queries (a trace's contacts) lie close together: the
         // previous answer's point starts each search with a near bound.
@@ -212,7 +202,7 @@ mod tests {
                 .iter()
                 .map(|p| (p[0] - q[0]).hypot(p[1] - q[1]))
                 .fold(f64::INFINITY, f64::min);
-            assert_eq!(set.distance(q), brute, "{q:?}");
+            assert_eq!(set.distances(&[q]), [brute], "{q:?}");
         }
     }
 
@@ -244,7 +234,8 @@ mod tests {
             })
             .collect();
         // Midpoints between nodes: exact ties, reached by rounding.
-        queries.extend((0..50).map(|k| [0.72 + 1.24 * (k % 7) as f64, 0.62 + 1.24 * (k / 7) as f64]));
+        queries
+            .extend((0..50).map(|k| [0.72 + 1.24 * (k % 7) as f64, 0.62 + 1.24 * (k / 7) as f64]));
         queries.extend((0..100).map(|_| [next() * 70.0 - 10.0, next() * 60.0 - 10.0]));
         let expected: Vec<f64> = queries.iter().map(|&q| brute(q)).collect();
         assert_eq!(set.distances(&queries), expected);
@@ -259,8 +250,7 @@ mod tests {
     #[test]
     fn hausdorff_of_empty_sets() {
         let empty = PointSet::new(Vec::new());
-        assert!(empty.is_empty());
-        assert_eq!(empty.distance([0.0, 0.0]), f64::INFINITY);
+        assert_eq!(empty.distances(&[[0.0, 0.0]]), [f64::INFINITY]);
         assert_eq!(empty.hausdorff_from(&[[1.0, 2.0]]), f64::INFINITY);
         let one = PointSet::new(vec![[0.0, 0.0]]);
         assert_eq!(one.hausdorff_from(&[]), 0.0);

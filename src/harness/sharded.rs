@@ -142,7 +142,7 @@ pub struct StudyPart {
     pub pitches: Vec<PitchPart>,
     /// The options.
     pub settings: StudySettings,
-    /// The study's summary as the shard knows it ([`StudySummary`]).
+    /// The study's summary as the shard knows it (a `StudySummary`).
     pub summary: StudySummary,
     /// Seconds sampling the grid (0 for the direct approach, whose
     /// summaries do not report it).

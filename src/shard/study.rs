@@ -2,14 +2,12 @@
 //! --shard K/N` (with `--approach direct` too) write one
 //! [`crate::harness::StudyPart`] as `shard.json` and `shard.bin`;
 //! [`merge_study`] reads N of them, checks that they are every shard of
-//! one study exactly once, and merges them
-//! ([`crate::harness::merge_verify`], [`crate::harness::merge_converge`],
-//! [`crate::harness::merge_verify_direct`],
-//! [`crate::harness::merge_converge_direct`]).
+//! one study exactly once, and merges them (the harness's `merge_verify`,
+//! `merge_converge`, `merge_verify_direct`, `merge_converge_direct`).
 //!
 //! * `shard.json` ([`StudyRecord`]): which shard of how many, the study's
 //!   start count and this shard's start indices, the options
-//!   ([`StudySettings`]), the study's `verify.json` or `converge.json` as
+//!   (`StudySettings`), the study's `verify.json` or `converge.json` as
 //!   the shard knows it (`"study": {"kind": "verify", "summary": ...}`;
 //!   kinds `verify`, `converge`, `verify-direct`, `converge-direct`:
 //!   the part's SHA-256, every parameter and the shard's own timings; no
@@ -36,12 +34,11 @@ use super::codec::{Reader, put_direct_pair, put_f64, put_f64s, put_pair, put_poi
 use super::{Shard, ShardError, check_set, first_difference, hex_sha256};
 use crate::grid::GridSpec;
 use crate::harness::metrics::TieBand;
-use crate::harness::sharded::PitchPart;
-use crate::harness::{
-    Convergence, DirectConvergence, DirectVerification, Pairs, StudyPart, StudySettings,
-    StudySummary, Verification, merge_converge, merge_converge_direct, merge_verify,
-    merge_verify_direct,
+use crate::harness::sharded::{
+    Pairs, PitchPart, StudySettings, StudySummary, merge_converge, merge_converge_direct,
+    merge_verify, merge_verify_direct,
 };
+use crate::harness::{Convergence, DirectConvergence, DirectVerification, StudyPart, Verification};
 use crate::output::{OutputDir, WriteError};
 
 /// `shard.json` of a study's shard.
@@ -310,7 +307,7 @@ fn from_json(text: &[u8]) -> Result<StudyRecord, String> {
             "area_distance": [],
             "metrics": {},
             "area_iou": 0.0,
-            "counts": crate::harness::Counts::default(),
+            "counts": crate::harness::compare::Counts::default(),
             "worst_starts": [],
         }),
         Some("converge") => serde_json::json!({
@@ -322,7 +319,7 @@ fn from_json(text: &[u8]) -> Result<StudyRecord, String> {
         Some("verify-direct") => serde_json::json!({
             "pass": false,
             "metrics": {},
-            "counts": crate::harness::DirectCounts::default(),
+            "counts": crate::harness::direct::DirectCounts::default(),
         }),
         Some("converge-direct") => serde_json::json!({
             "fits": {},
