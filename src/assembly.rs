@@ -48,12 +48,12 @@ impl PartSource {
     }
 
     /// Whether this is one file with nothing disregarded: read exactly as
-    /// [`read_part_placed`] reads it, with no [`Assembly`].
+    /// `read_part_placed` reads it, with no [`Assembly`].
     pub fn is_single(&self) -> bool {
         self.files.len() == 1 && self.ignored.is_empty()
     }
 
-    /// Reads the part: one file as [`read_part_placed`]; several (or any
+    /// Reads the part: one file as `read_part_placed`; several (or any
     /// `--ignore`) merged in order, with an [`Assembly`] saying which file
     /// each triangle came from.
     pub fn read(&self) -> Result<PartFile, MeshError> {
@@ -134,7 +134,7 @@ impl PartSource {
 /// Per file of `assembly`, the composite's nodes whose height that file
 /// set: `node_file` is the grid's attribution, `composite` the count per
 /// node.
-pub fn colliding_nodes_per_file(
+pub(crate) fn colliding_nodes_per_file(
     assembly: &Assembly,
     node_file: &[u32],
     composite: &[u16],

@@ -21,7 +21,7 @@
 //! Whether one matters is the engine's to say: its fast path keeps, for
 //! every node, the highest face level that met it, and a blind spot whose
 //! lowest point sticks out past the level that met one of its cell's
-//! corners would have been a contact ([`crate::engine::Probe`]).
+//! corners would have been a contact (`Probe`).
 //!
 //! **Invariant:** blind spots are a diagnostic beside the grid; they never
 //! change a height, a mask or the composite.
@@ -34,7 +34,7 @@ use crate::mesh::Triangle;
 /// The columns of `blind_spots.csv`, as the writer writes them: the cell
 /// (`i`, `j`), its lowest point in the part's coordinates (`x`, `y`, `z`,
 /// mm), and the rest of [`BlindSpot`].
-pub const CSV_COLUMNS: [&str; 9] = [
+pub(crate) const CSV_COLUMNS: [&str; 9] = [
     "i",
     "j",
     "x",
@@ -48,7 +48,7 @@ pub const CSV_COLUMNS: [&str; 9] = [
 
 /// The columns of `blind_spots.csv` the report reads, by name: every
 /// version's file has them (`y` came later).
-pub const CSV_READ_COLUMNS: [&str; 8] = [
+pub(crate) const CSV_READ_COLUMNS: [&str; 8] = [
     "i",
     "j",
     "x",
@@ -167,7 +167,7 @@ fn lowest_points(
 }
 
 /// The largest `pitch / 2^k` (k >= 1) no larger than `width` mm.
-pub fn resolving_pitch(pitch: f64, width: f64) -> f64 {
+pub(crate) fn resolving_pitch(pitch: f64, width: f64) -> f64 {
     let mut p = pitch / 2.0;
     // 2^-30 of a pitch is below any width a mesh in f32 holds.
     for _ in 0..30 {

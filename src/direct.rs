@@ -9,13 +9,13 @@
 //! In SPEC's analysis frame (the part placed by `--frame` and `--side`)
 //! the knee moves in -x and the analysed surface faces +x. The part is
 //! turned into the **direct frame** by the proper rotation
-//! `D: (x, y, z) -> (x', y', z') = (y, -x, z)` ([`crate::frame::to_direct`]), where the
+//! `D: (x, y, z) -> (x', y', z') = (y, -x, z)` (`to_direct`), where the
 //! knee moves in +y' and the surface faces -y', so that SPEC's height grid
 //! ([`crate::grid::HeightGrid`], the z-buffer from -y) sampled on the
 //! turned part is the depth grid of the direct approach:
 //! `h(x', z') = min y' = -(max x)` over the line, the first surface the
 //! knee meets. Results go back by `D^-1: (x', y', z') -> (-y', x', z')`
-//! ([`crate::frame::from_direct`], exact: only a sign and a swap), then by
+//! (`from_direct`, exact: only a sign and a swap), then by
 //! [`crate::frame::Placement::to_part`].
 //!
 //! # The definition
@@ -31,7 +31,7 @@
 //!
 //! * **Footprint**: the nodes `(i0 + k, j0 + dj)` with `|k| p <= W/2 +
 //!   1e-9` mm and `dj p` within `K_theta`'s z-range (closed within
-//!   [`NODE_TOL`], as SPEC's rows). Nodes off the grid are `+inf`.
+//!   `NODE_TOL`, as SPEC's rows). Nodes off the grid are `+inf`.
 //! * **First contact**: `Y*(i0, j0) = min (h[i][j] + a(dz))` over the
 //!   footprint's nodes (`+inf` heights never win). A position whose
 //!   footprint holds no finite height is **not placed**.
@@ -116,7 +116,7 @@ impl DirectFootprint {
 /// `angles` or its mirror, can reach the box. The box grown by `W/2` in x'
 /// and by the knee-form's z-extent in z, snapped outwards to multiples of
 /// the pitch (as [`crate::kneeform::Footprint::grid_around`] does for the slide).
-pub fn grid_around(bbox: &Bbox, knee: &KneeForm, angles: &[f64], pitch: f64) -> GridSpec {
+pub(crate) fn grid_around(bbox: &Bbox, knee: &KneeForm, angles: &[f64], pitch: f64) -> GridSpec {
     let (mut zl, mut zh) = (0.0f64, 0.0f64);
     for &a in angles {
         for fp in [Footprint::new(knee, a), Footprint::new(knee, -a)] {
@@ -278,7 +278,7 @@ pub fn direct_mask(
 /// angle at a time (each angle's rows in parallel, so the working memory
 /// is three grids' worth whatever the thread count). `on_angle` is called
 /// once per finished angle.
-pub fn direct_masks(
+pub(crate) fn direct_masks(
     grid: &HeightGrid,
     footprints: &[DirectFootprint],
     e0: f64,

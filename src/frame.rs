@@ -79,13 +79,13 @@ impl Approach {
 
 /// A point of SPEC's analysis frame (mm) in the direct frame: `D(x, y, z)
 /// = (y, -x, z)`, a proper rotation.
-pub fn to_direct([x, y, z]: [f64; 3]) -> [f64; 3] {
+pub(crate) fn to_direct([x, y, z]: [f64; 3]) -> [f64; 3] {
     [y, -x, z]
 }
 
 /// A point of the direct frame (mm) in SPEC's analysis frame: `D^-1(x',
 /// y', z') = (-y', x', z')`, the exact inverse of [`to_direct`].
-pub fn from_direct([x, y, z]: [f64; 3]) -> [f64; 3] {
+pub(crate) fn from_direct([x, y, z]: [f64; 3]) -> [f64; 3] {
     [-y, x, z]
 }
 
@@ -93,7 +93,7 @@ pub fn from_direct([x, y, z]: [f64; 3]) -> [f64; 3] {
 /// be (entrywise, and the determinant from 1): a matrix written with 16
 /// significant digits is within 1e-15; 1e-9 also forgives one written with
 /// 10, and still moves a point 1 m from the origin by at most 1 um.
-pub const ROTATION_TOL: f64 = 1e-9;
+pub(crate) const ROTATION_TOL: f64 = 1e-9;
 
 /// A rigid map from a part file's coordinates (mm) into vehicle
 /// coordinates, or none (the file is in vehicle coordinates already).
@@ -179,7 +179,7 @@ impl Frame {
     /// numbers separated by spaces, commas or line breaks; `#` starts a
     /// comment) mapping the part's homogeneous coordinates (mm, after
     /// `--scale`) to vehicle coordinates. Refused unless a proper rotation
-    /// within [`ROTATION_TOL`] with a finite translation.
+    /// within `ROTATION_TOL` with a finite translation.
     pub fn parse(value: &str) -> Result<Frame, FrameError> {
         match value.strip_prefix('@') {
             Some(path) => Frame::from_file(Path::new(path), value),
@@ -367,7 +367,7 @@ pub struct Placement {
     /// Where the part sits in the vehicle.
     pub frame: Frame,
     /// For [`Approach::Direct`], the analysis frame is turned into the
-    /// direct frame last ([`crate::frame::to_direct`]); the slide's is
+    /// direct frame last (`to_direct`); the slide's is
     /// SPEC's.
     pub approach: Approach,
 }

@@ -14,7 +14,7 @@ use crate::zbuffer::{Lattice, Weighting, zbuffer};
 /// (SPEC, "push"), and within which two slide distances form one tie group
 /// (SPEC, "slide"). It only has to absorb floating-point rounding of
 /// coordinates of order 1e3 mm (about 1e-13 mm), so it is far below any pitch.
-pub const NODE_TOL: f64 = 1e-9;
+pub(crate) const NODE_TOL: f64 = 1e-9;
 
 /// Where the grid's nodes are (mm, analysis frame).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -64,12 +64,12 @@ pub enum GridError {
         /// Estimated memory need.
         need_gib: f64,
         /// The least of the machine's memory and its limits
-        /// ([`crate::memory::limit_bytes`]).
+        /// (`limit_bytes`).
         machine_gib: f64,
         /// Which limit, in words.
         what: &'static str,
     },
-    /// The grid has more nodes than [`crate::limits::MAX_GRID_NODES`].
+    /// The grid has more nodes than `MAX_GRID_NODES`.
     #[error(
         "a {nx} x {nz} grid has more than the {} nodes a grid may have; use a coarser --pitch or a smaller --grid-size",
         crate::limits::MAX_GRID_NODES
@@ -141,7 +141,7 @@ impl GridSpec {
     }
 
     /// Checks the grid has at least one node and at most
-    /// [`crate::limits::MAX_GRID_NODES`], before anything is allocated (the
+    /// `MAX_GRID_NODES`, before anything is allocated (the
     /// memory a run needs is [`crate::memory::MemoryEstimate`]'s).
     pub fn check_nodes(&self) -> Result<(), GridError> {
         let (nx, nz) = (self.nx, self.nz);
@@ -172,7 +172,7 @@ impl HeightGrid {
     /// Samples `triangles` (analysis frame) on `spec` with a depth-buffer
     /// rasterizer: each triangle visits only the nodes under its xz
     /// projection. Triangles are closed (edges and vertices count, within
-    /// [`NODE_TOL`]); those with a zero-area projection are skipped.
+    /// `NODE_TOL`); those with a zero-area projection are skipped.
     pub fn sample(triangles: &[Triangle], spec: GridSpec) -> HeightGrid {
         // Seen from -y: x along the columns, z along the rows, y the depth.
         let h = zbuffer(&spec, triangles, |t| (t.map(|v| [v[0], v[2], v[1]]), ())).depth;

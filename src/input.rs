@@ -47,7 +47,7 @@ pub enum MeshError {
         /// The triangle's index in the file.
         index: usize,
     },
-    /// A vertex lies beyond [`crate::limits::MAX_COORD_MM`] once scaled.
+    /// A vertex lies beyond `MAX_COORD_MM` once scaled.
     #[error("{path}: triangle {index} lies {} mm from the origin, beyond the {} mm a part may span (wrong --scale?)", crate::limits::short(*distance), crate::limits::short(crate::limits::MAX_COORD_MM))]
     TooFar {
         /// The file.
@@ -57,7 +57,7 @@ pub enum MeshError {
         /// Its largest coordinate (mm, absolute).
         distance: f64,
     },
-    /// A vertex lies beyond [`crate::limits::MAX_COORD_MM`] once placed by
+    /// A vertex lies beyond `MAX_COORD_MM` once placed by
     /// the part's frame (`--frame`).
     #[error("{path}: triangle {index} lies {} mm from the origin once placed by --frame, beyond the {} mm a part may span (a translation in the wrong unit?)", crate::limits::short(*distance), crate::limits::short(crate::limits::MAX_COORD_MM))]
     PlacedTooFar {
@@ -69,7 +69,7 @@ pub enum MeshError {
         /// non-finite one).
         distance: f64,
     },
-    /// The file holds more triangles than [`crate::limits::MAX_PART_TRIANGLES`].
+    /// The file holds more triangles than `MAX_PART_TRIANGLES`.
     #[error(
         "{path} holds {count} triangles, more than the {} a part may have",
         crate::limits::MAX_PART_TRIANGLES
@@ -151,7 +151,7 @@ impl PartFile {
 }
 
 /// Checks a file-units-to-mm factor: finite, within
-/// [`crate::limits::MAX_SCALE`] of 1 either way.
+/// `MAX_SCALE` of 1 either way.
 pub fn check_scale(scale: f64) -> Result<(), crate::SetupError> {
     let max = crate::limits::MAX_SCALE;
     if scale.is_finite() && (1.0 / max..=max).contains(&scale) {
@@ -170,7 +170,7 @@ pub fn check_scale(scale: f64) -> Result<(), crate::SetupError> {
 /// (`.toml`, tessellated at its own step), scales it by `scale` (to mm)
 /// and maps `side` into the analysis frame; the file's SHA-256 is taken
 /// from the same bytes. The file is sized up before it is read
-/// ([`read_part_bytes_bounded`]).
+/// (`read_part_bytes_bounded`).
 pub fn read_part(path: &Path, scale: f64, side: Side) -> Result<PartFile, MeshError> {
     let bytes = read_part_bytes_bounded(path)?;
     read_part_bytes(path, &bytes, scale, side)
@@ -184,7 +184,7 @@ pub fn read_part(path: &Path, scale: f64, side: Side) -> Result<PartFile, MeshEr
 /// `solid`), so that a large file of something else is refused without
 /// being read. A stream (a pipe, a device) is read up to the size its
 /// binary header gives, or the bound.
-pub fn read_part_bytes_bounded(path: &Path) -> Result<Vec<u8>, MeshError> {
+pub(crate) fn read_part_bytes_bounded(path: &Path) -> Result<Vec<u8>, MeshError> {
     use std::io::Read;
     let name = path.display().to_string();
     let io = |source| MeshError::Io {
@@ -267,7 +267,7 @@ pub fn read_part_bytes_bounded(path: &Path) -> Result<Vec<u8>, MeshError> {
 
 /// A part file's size, known before reading it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct PartSize {
+pub(crate) struct PartSize {
     /// Its bytes (a stream: the most read from one,
     /// [`crate::limits::MAX_STREAM_BYTES`]).
     pub file_bytes: u64,
@@ -282,7 +282,7 @@ pub struct PartSize {
 /// from its size and, for STL, its header's triangle count (binary) or the
 /// most triangles its size can hold (ASCII, [`MIN_ASCII_FACET_BYTES`]
 /// each); a scenario file is parsed for its count.
-pub fn part_size(path: &Path) -> Result<PartSize, MeshError> {
+pub(crate) fn part_size(path: &Path) -> Result<PartSize, MeshError> {
     let name = path.display().to_string();
     let io = |source| MeshError::Io {
         path: name.clone(),
@@ -324,8 +324,8 @@ pub fn part_size(path: &Path) -> Result<PartSize, MeshError> {
 
 /// Checks triangles read from the file `name` (scaled by `scale` to mm)
 /// can be a part: some triangles, at most
-/// [`crate::limits::MAX_PART_TRIANGLES`], every coordinate finite and
-/// within [`crate::limits::MAX_COORD_MM`], and not all of zero area.
+/// `MAX_PART_TRIANGLES`, every coordinate finite and
+/// within `MAX_COORD_MM`, and not all of zero area.
 pub fn check_triangles(name: &str, triangles: &[Triangle], scale: f64) -> Result<(), MeshError> {
     if triangles.is_empty() {
         return Err(MeshError::Empty { path: name.into() });
@@ -368,7 +368,7 @@ pub fn check_triangles(name: &str, triangles: &[Triangle], scale: f64) -> Result
 /// The fewest bytes an ASCII STL facet takes (`facet normal 0 0 0`,
 /// `outer loop`, three `vertex 0 0 0`, `endloop`, `endfacet`, one space
 /// each between words and lines).
-pub const MIN_ASCII_FACET_BYTES: u64 = 80;
+pub(crate) const MIN_ASCII_FACET_BYTES: u64 = 80;
 
 /// The bytes of a binary STL's header: 80 of text, a 4-byte count.
 const STL_HEADER: usize = 84;
@@ -431,7 +431,7 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
 /// [`read_part`] into a [`Placement`]: the file's coordinates (mm, after
 /// `scale`) mapped by its frame, then its side. Without a frame this is
 /// `read_part` itself, to the bit.
-pub fn read_part_placed(
+pub(crate) fn read_part_placed(
     path: &Path,
     scale: f64,
     placement: &Placement,

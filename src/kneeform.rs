@@ -93,7 +93,7 @@ impl Footprint {
 
     /// The interval `[a, b]` (mm, relative to the reference point) in which
     /// the line `z = dz` meets the footprint, or `None` when it misses it by
-    /// more than [`NODE_TOL`]. Rows grazing the top or bottom within the
+    /// more than `NODE_TOL`. Rows grazing the top or bottom within the
     /// tolerance get the tangent point.
     ///
     /// The boundary of a rounded triangle is made of its three vertex arcs
@@ -171,7 +171,7 @@ pub struct GridFootprint {
     /// Indices into `rows`, sorted by `d0` (ties by `dj`).
     pub slide_order: Vec<u32>,
     /// Tie groups as ranges of `slide_order`: consecutive entries whose `d0`
-    /// differ by at most [`NODE_TOL`].
+    /// differ by at most `NODE_TOL`.
     pub groups: Vec<std::ops::Range<usize>>,
 }
 
@@ -232,7 +232,7 @@ impl GridFootprint {
 
 /// Splits sorted distances into tie groups: a new group starts where a value
 /// exceeds its predecessor by more than [`NODE_TOL`].
-pub fn tie_groups(sorted: impl Iterator<Item = f64>) -> Vec<std::ops::Range<usize>> {
+pub(crate) fn tie_groups(sorted: impl Iterator<Item = f64>) -> Vec<std::ops::Range<usize>> {
     let mut groups = Vec::new();
     let mut start = 0;
     let mut prev = f64::NAN;

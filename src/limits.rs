@@ -13,32 +13,32 @@
 /// The longest deflection window (mm): half the knee-form's default
 /// triangle side; a window longer than the knee-form measures a deflection
 /// it has long left behind.
-pub const MAX_WINDOW_MM: f64 = 100.0;
+pub(crate) const MAX_WINDOW_MM: f64 = 100.0;
 
 /// The most pitches a deflection window may span: each start's slide list
 /// under the window rule holds that many columns of its footprint's rows.
-pub const MAX_WINDOW_PITCHES: f64 = 1024.0;
+pub(crate) const MAX_WINDOW_PITCHES: f64 = 1024.0;
 
 /// The finest pitch (mm): 1 um, a hundredth of the finest pitch any study
 /// here needed (0.25 mm).
-pub const MIN_PITCH_MM: f64 = 1e-3;
+pub(crate) const MIN_PITCH_MM: f64 = 1e-3;
 
 /// The coarsest pitch (mm): half a metre, coarser than the knee-form.
-pub const MAX_PITCH_MM: f64 = 500.0;
+pub(crate) const MAX_PITCH_MM: f64 = 500.0;
 
 /// The largest knee-form length (triangle side, radius, thickness) and
 /// blind-spot depth (mm): 10 m.
-pub const MAX_LENGTH_MM: f64 = 1e4;
+pub(crate) const MAX_LENGTH_MM: f64 = 1e4;
 
 /// The largest coordinate a part or grid may have, in absolute value
 /// (mm): 10 km (a 2 m part read in micrometres still reads, to be warned
 /// of), so that a node index `x / pitch` stays below 1e10 at the finest
 /// pitch and is exact as an `f64` and an `i64`.
-pub const MAX_COORD_MM: f64 = 1e7;
+pub(crate) const MAX_COORD_MM: f64 = 1e7;
 
 /// The largest file-units-to-mm factor (`--scale`), and the inverse of the
 /// smallest: 1e6 (from km to mm, from nm to mm).
-pub const MAX_SCALE: f64 = 1e6;
+pub(crate) const MAX_SCALE: f64 = 1e6;
 
 /// The most knee-form angles in one run: every twentieth of a degree over
 /// +-90, far more than the regulation's 61 whole degrees.
@@ -47,7 +47,7 @@ pub const MAX_ANGLES: usize = 3601;
 /// The most nodes a grid may have, whatever the memory allowed: 2^30, a
 /// 33 m x 33 m part at 1 mm or 1 m x 1 m at 0.03 mm. Beyond it, node
 /// counts times bytes per node no longer fit a machine of today.
-pub const MAX_GRID_NODES: usize = 1 << 30;
+pub(crate) const MAX_GRID_NODES: usize = 1 << 30;
 
 /// The most worker threads (`--threads`): more than any machine of today
 /// has CPUs, and few enough to start in a blink.
@@ -61,19 +61,19 @@ pub const MAX_PART_FILE_BYTES: u64 = 8 << 30;
 /// The most bytes read from a part that is not a regular file (a pipe,
 /// `/dev/stdin`), whose size cannot be known before reading: 1 GiB, a
 /// binary STL of 21 million triangles. Save a larger part to a file.
-pub const MAX_STREAM_BYTES: u64 = 1 << 30;
+pub(crate) const MAX_STREAM_BYTES: u64 = 1 << 30;
 
 /// The most triangles a part may have: 170 million, the binary STL that
 /// fills [`MAX_PART_FILE_BYTES`]; 460 times the paper's console.
-pub const MAX_PART_TRIANGLES: usize = 170_000_000;
+pub(crate) const MAX_PART_TRIANGLES: usize = 170_000_000;
 
 /// The largest `summary.json` (or other run JSON file) read: 64 MiB; the
 /// paper workload's is 12 KB.
-pub const MAX_RUN_JSON_BYTES: u64 = 64 << 20;
+pub(crate) const MAX_RUN_JSON_BYTES: u64 = 64 << 20;
 
 /// The largest run table or figure read back by `report`
 /// (`verify.csv`, `converge.csv`, a PNG): 1 GiB.
-pub const MAX_RUN_TABLE_BYTES: u64 = 1 << 30;
+pub(crate) const MAX_RUN_TABLE_BYTES: u64 = 1 << 30;
 
 /// Reads the file at `path` whole, refusing one longer than `max_bytes`:
 /// a regular file by its size, before reading anything; anything else (a
@@ -108,9 +108,9 @@ pub fn read_bounded(path: &std::path::Path, max_bytes: u64) -> std::io::Result<V
 /// The largest text file read whole (bytes): a manifest, a frame's
 /// matrix, a scenario, a batch item's fingerprint; far beyond any such
 /// file, short of the memory `/dev/zero` given as one would take.
-pub const MAX_TEXT_FILE_BYTES: u64 = 16 << 20;
+pub(crate) const MAX_TEXT_FILE_BYTES: u64 = 16 << 20;
 
-/// The text of the file at `path`, at most [`MAX_TEXT_FILE_BYTES`] long
+/// The text of the file at `path`, at most `MAX_TEXT_FILE_BYTES` long
 /// ([`read_bounded`]), as UTF-8.
 pub fn read_text_bounded(path: &std::path::Path) -> std::io::Result<String> {
     let bytes = read_bounded(path, MAX_TEXT_FILE_BYTES)?;
@@ -119,7 +119,10 @@ pub fn read_text_bounded(path: &std::path::Path) -> std::io::Result<String> {
 
 /// The file at `path` opened for streaming, when it is a regular file of
 /// at most `max_bytes` (a link to `/dev/zero` would be read for ever).
-pub fn open_bounded(path: &std::path::Path, max_bytes: u64) -> std::io::Result<std::fs::File> {
+pub(crate) fn open_bounded(
+    path: &std::path::Path,
+    max_bytes: u64,
+) -> std::io::Result<std::fs::File> {
     let file = std::fs::File::open(path)?;
     let meta = file.metadata()?;
     if !meta.is_file() {
@@ -143,7 +146,7 @@ pub fn open_bounded(path: &std::path::Path, max_bytes: u64) -> std::io::Result<s
 /// `len` copies of `value`, or an error where the allocation fails,
 /// rather than the abort of `vec![value; len]`: for buffers sized by a
 /// file or a user's number.
-pub fn try_filled<T: Clone>(len: usize, value: T) -> Result<Vec<T>, OutOfMemory> {
+pub(crate) fn try_filled<T: Clone>(len: usize, value: T) -> Result<Vec<T>, OutOfMemory> {
     let mut v = Vec::new();
     v.try_reserve_exact(len).map_err(|_| OutOfMemory {
         bytes: len.saturating_mul(std::mem::size_of::<T>()),

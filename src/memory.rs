@@ -12,18 +12,18 @@
 //!   thresholds, and the push's tables: the window minima `4 (L - 1) Nr`
 //!   (level 0 is the ranks themselves) and the group bounds (these and the
 //!   two items below are the engine's own figures,
-//!   [`crate::engine::working_bytes`]);
+//!   `working_bytes`);
 //! * per band task running (at most `T`, and at most the bands there
 //!   are): its reach window, strikes and probe-corner bits (`5.125 Nw`;
 //!   the paper path's band mask `Np` where that is larger);
 //! * per angle in flight (at most `min(T, A)`): its mask (`N`);
 //! * every finished angle's mask (`A N`, with the allocator's holes
-//!   between them: [`MASK_BYTES_PER_NODE`]) and the composite (`2 N`);
+//!   between them: `MASK_BYTES_PER_NODE`) and the composite (`2 N`);
 //! * the writers' buffers (the colliding-area surface, the images), at most
-//!   [`WRITE_BYTES_PER_NODE`] per node;
+//!   `WRITE_BYTES_PER_NODE` per node;
 //! * with `analyze`'s sample check, the oracle's mesh, `143 n`
 //!   ([`MemoryEstimate::add_sample_check`]);
-//! * the program itself, [`BASE_BYTES`].
+//! * the program itself, `BASE_BYTES`.
 //!
 //! The figures were checked against the measured peak (`VmHWM`) on runs
 //! from 40 MiB to 1.3 GiB (`tests/hostile.rs` holds the bound test).
@@ -33,25 +33,25 @@ use crate::kneeform::GridFootprint;
 use crate::strike::StrikeRule;
 
 /// The program before any part is read: code, the font, the thread pool.
-pub const BASE_BYTES: f64 = 10.0 * MIB;
+pub(crate) const BASE_BYTES: f64 = 10.0 * MIB;
 
 /// Bytes per grid node the writers may hold at once (the colliding-area
 /// surface's vertices and faces, the images' pixels) beyond the
 /// analysis's own buffers.
-pub const WRITE_BYTES_PER_NODE: f64 = 4.0;
+pub(crate) const WRITE_BYTES_PER_NODE: f64 = 4.0;
 
 /// Bytes a finished angle's mask holds per grid node: one, and the
 /// allocator's holes between the masks, where each angle's larger padded
 /// buffers were freed (measured 1.27 on 1801 angles at 2 and 4 mm).
-pub const MASK_BYTES_PER_NODE: f64 = 1.4;
+pub(crate) const MASK_BYTES_PER_NODE: f64 = 1.4;
 
 /// Bytes held per triangle of the part.
-pub const BYTES_PER_TRIANGLE: f64 = 72.0;
+pub(crate) const BYTES_PER_TRIANGLE: f64 = 72.0;
 
 /// Bytes the exact oracle's copy of the part holds per triangle (parry's
 /// mesh and its BVH): measured 143 on the wave's 90,000 triangles (the
 /// peak of `analyze` with and without its sample check, 2 mm, 2 threads).
-pub const ORACLE_BYTES_PER_TRIANGLE: f64 = 143.0;
+pub(crate) const ORACLE_BYTES_PER_TRIANGLE: f64 = 143.0;
 
 const MIB: f64 = 1024.0 * 1024.0;
 
@@ -91,7 +91,7 @@ impl MemoryEstimate {
 
     /// Adds the sample check's working memory (`analyze`'s check against
     /// the exact oracle, after the analysis): the oracle's mesh and its
-    /// BVH, [`ORACLE_BYTES_PER_TRIANGLE`] per triangle. Its copy of the
+    /// BVH, `ORACLE_BYTES_PER_TRIANGLE` per triangle. Its copy of the
     /// grid's heights and its per-pair buffers fit in what the engine's
     /// buffers freed by then (measured: on the console at 2 mm the check
     /// raised no peak).
@@ -132,7 +132,7 @@ pub fn peak_rss_bytes() -> Option<f64> {
 
 /// The machine's physical memory (bytes), where the system says
 /// (`/proc/meminfo`, `MemTotal`).
-pub fn physical_bytes() -> Option<f64> {
+pub(crate) fn physical_bytes() -> Option<f64> {
     proc_field("/proc/meminfo", "MemTotal:")
 }
 
@@ -142,7 +142,7 @@ pub fn physical_bytes() -> Option<f64> {
 /// `memory.limit_in_bytes`: a Slurm job's or a Kubernetes pod's) and the
 /// address space `ulimit -v` leaves (`RLIMIT_AS` less what this process
 /// has mapped already). `None` where the system says none of them.
-pub fn limit_bytes() -> Option<(f64, &'static str)> {
+pub(crate) fn limit_bytes() -> Option<(f64, &'static str)> {
     let mut limits: Vec<(f64, &'static str)> = Vec::new();
     if let Some(b) = physical_bytes() {
         limits.push((b, "this machine's memory"));

@@ -1,10 +1,10 @@
 //! Sanity checks of a run's inputs and result: the mistakes a new user
 //! makes that would otherwise end in exit 0 with a wrong answer.
 //!
-//! * [`part_warnings`]: a part far smaller or larger than a knee-form (its
+//! * `part_warnings`: a part far smaller or larger than a knee-form (its
 //!   units: `--scale`), a surface that faces the other way (`--side`);
-//! * [`angle_warnings`]: angles outside the regulation's -30..+30 degrees;
-//! * [`result_warnings`]: a result with no colliding node at all.
+//! * `angle_warnings`: angles outside the regulation's -30..+30 degrees;
+//! * `result_warnings`: a result with no colliding node at all.
 //!
 //! Each is a [`Warning`], one line of text, printed by the CLI before the
 //! work it concerns and recorded in `summary.json` (`warnings`), so that a
@@ -20,32 +20,32 @@ use crate::mesh::Part;
 
 /// The regulation's knee-form angles: -30..+30 degrees (SPEC, "The
 /// knee-form").
-pub const REGULATION_ANGLE_DEG: f64 = 30.0;
+pub(crate) const REGULATION_ANGLE_DEG: f64 = 30.0;
 
 /// A part whose larger xz extent is below the knee-form's divided by this
 /// is "much smaller than a knee-form". The knee-form's default footprint
 /// is about 320 mm across, so this is 16 mm: a console side read in metres
 /// (1.5 "mm") is caught, a small real switch or trim part (30 mm and up) is
 /// not.
-pub const SMALL_FACTOR: f64 = 20.0;
+pub(crate) const SMALL_FACTOR: f64 = 20.0;
 
 /// A part whose larger xz extent is above the knee-form's times this is
 /// "much larger than a knee-form": with the default knee-form, 9.6 m, more
 /// than any car's interior (a part in micrometres, or scaled twice).
-pub const LARGE_FACTOR: f64 = 30.0;
+pub(crate) const LARGE_FACTOR: f64 = 30.0;
 
 /// The part "faces +y" when the area of its triangles facing +y (by their
 /// winding, the STL convention) is more than this times the area facing
 /// -y. A closed solid has as much of each (ratio 1) and is not flagged; an
 /// open surface exported for the analysis is nearly all one way.
-pub const FACING_RATIO: f64 = 3.0;
+pub(crate) const FACING_RATIO: f64 = 3.0;
 
 /// The part is "edge-on" when the area its triangles present along x or
 /// along z (area-weighted normals) is more than this times the area they
 /// present along y, the push axis: a plate lying flat, a panel modelled
 /// facing sideways. A console side or a closed solid presents about as
 /// much or more along y and is not flagged.
-pub const EDGE_ON_RATIO: f64 = 2.0;
+pub(crate) const EDGE_ON_RATIO: f64 = 2.0;
 
 /// One finding, as one line of text.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -131,7 +131,7 @@ pub enum Warning {
         /// Its z (mm).
         z: f64,
         /// Which pitch resolves every one of them, in words
-        /// ([`resolving_phrase`]).
+        /// (`resolving_phrase`).
         resolves: String,
     },
     /// Nothing is struck.
@@ -143,7 +143,7 @@ pub enum Warning {
 
 /// The knee-form footprint's larger extent in x or z at angle 0 (mm):
 /// `L sqrt(3)/2 + 2R` by `L + 2R`.
-pub fn knee_extent(knee: &KneeForm) -> f64 {
+pub(crate) fn knee_extent(knee: &KneeForm) -> f64 {
     let fp = Footprint::new(knee, 0.0);
     let (x0, x1) = fp.x_range();
     let (z0, z1) = fp.z_range();
@@ -157,7 +157,7 @@ pub fn knee_extent(knee: &KneeForm) -> f64 {
 /// Mirroring the right side (y -> -y) reverses a triangle's winding as it
 /// mirrors it, so the y component of the winding normal is the same in the
 /// analysis frame as in the part's: the sums read the part as it is.
-pub fn facing_areas(part: &Part) -> (f64, f64) {
+pub(crate) fn facing_areas(part: &Part) -> (f64, f64) {
     axis_facing_areas(part)[1]
 }
 
@@ -183,7 +183,7 @@ fn axis_facing_areas(part: &Part) -> [(f64, f64); 3] {
 
 /// The checks of a part read for `side` against `knee`: its size and its
 /// facing (see [`SMALL_FACTOR`], [`LARGE_FACTOR`], [`FACING_RATIO`]).
-pub fn part_warnings(part: &Part, side: Side, knee: &KneeForm) -> Vec<Warning> {
+pub(crate) fn part_warnings(part: &Part, side: Side, knee: &KneeForm) -> Vec<Warning> {
     let mut warnings = Vec::new();
     let bbox = part.bbox();
     let extent_mm = (bbox.max[0] - bbox.min[0]).max(bbox.max[2] - bbox.min[2]);
@@ -222,7 +222,7 @@ pub fn part_warnings(part: &Part, side: Side, knee: &KneeForm) -> Vec<Warning> {
 /// for a surface met edge-on ([`EDGE_ON_RATIO`]), with the `--frame` that
 /// would face it, as the part's own axes, where `framed` is false (no
 /// `--frame` given); with one, the advice is to check it.
-pub fn facing_axis_warning(part: &Part, framed: bool) -> Option<Warning> {
+pub(crate) fn facing_axis_warning(part: &Part, framed: bool) -> Option<Warning> {
     let facing = axis_facing_areas(part);
     let area = facing.map(|(plus, minus)| plus + minus);
     let total: f64 = area.iter().sum();
@@ -260,7 +260,7 @@ pub fn facing_axis_warning(part: &Part, framed: bool) -> Option<Warning> {
 }
 
 /// The angles (degrees) beyond the regulation's range, as one warning.
-pub fn angle_warnings(angles_deg: &[f64]) -> Vec<Warning> {
+pub(crate) fn angle_warnings(angles_deg: &[f64]) -> Vec<Warning> {
     // Within rounding of a range's step arithmetic, 30 is 30.
     let mut outside: Vec<f64> = angles_deg
         .iter()
@@ -293,7 +293,7 @@ pub fn angle_warnings(angles_deg: &[f64]) -> Vec<Warning> {
 /// The blind spots the knee-form meets (contacts the grid cannot see), as
 /// one warning; where they are is said in the part's coordinates, through
 /// `placement` (the spots lie in the analysis grid's frame).
-pub fn blind_spot_warnings(
+pub(crate) fn blind_spot_warnings(
     spots: &[crate::blind::BlindSpot],
     placement: &crate::frame::Placement,
 ) -> Vec<Warning> {
@@ -328,7 +328,7 @@ pub fn blind_spot_warnings(
 /// not resolve them), or, below [`crate::limits::MIN_PITCH_MM`], that none
 /// does (a feature narrower than that: an edge seen edge-on, a sheet of no
 /// thickness).
-pub fn resolving_phrase(pitch: f64) -> String {
+pub(crate) fn resolving_phrase(pitch: f64) -> String {
     let min = crate::limits::MIN_PITCH_MM;
     if pitch.is_nan() || pitch < min {
         return format!(
@@ -364,7 +364,7 @@ fn angle_list(sorted: &[f64]) -> String {
 
 /// The checks of a result: `composite_nodes` is the number of nodes
 /// struck at some angle.
-pub fn result_warnings(composite_nodes: usize) -> Vec<Warning> {
+pub(crate) fn result_warnings(composite_nodes: usize) -> Vec<Warning> {
     if composite_nodes == 0 {
         vec![Warning::NothingStruck]
     } else {

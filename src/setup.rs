@@ -119,11 +119,11 @@ pub enum SetupError {
     #[error("e0 must be a number of mm in [0, 0.01] (it only absorbs rounding), got {}", short(*.0))]
     E0(f64),
     /// The explicit grid's origin is not finite, or beyond
-    /// [`crate::limits::MAX_COORD_MM`].
+    /// `MAX_COORD_MM`.
     #[error("the grid origin must be two numbers of mm within +-{}, got {},{}", short(crate::limits::MAX_COORD_MM), short(.0[0]), short(.0[1]))]
     GridOrigin([f64; 2]),
     /// The explicit grid has no node, or more than
-    /// [`crate::limits::MAX_GRID_NODES`].
+    /// `MAX_GRID_NODES`.
     #[error("the grid size must be from 1,1 to {} nodes in all, got {},{}", crate::limits::MAX_GRID_NODES, .0[0], .0[1])]
     GridSize([usize; 2]),
 }

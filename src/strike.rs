@@ -209,7 +209,7 @@ impl Default for StrikeRule {
 /// paper-literal path, the harness's trace, the fast path's scalar
 /// slides) share. `L` is a level: a height in mm or its rank.
 #[derive(Debug, Clone, Default)]
-pub struct LevelHistory<L = f64> {
+pub(crate) struct LevelHistory<L = f64> {
     /// `(travel, level after the group)` per group so far.
     groups: Vec<(f64, L)>,
     /// How many of `groups` lie at least `W` behind the last group asked.

@@ -2,7 +2,7 @@
 //! and collect the colliding mask `C_theta`; then the composite count.
 //!
 //! Work is split across angles and, within an angle, across bands of
-//! [`BAND_ROWS`] start rows, each band deciding the strikes in the window of
+//! `BAND_ROWS` start rows, each band deciding the strikes in the window of
 //! rows its slides reach and ORing them into the angle's mask. OR is
 //! order-independent, so the masks are identical whatever the thread count.
 //!
@@ -23,7 +23,7 @@ use rayon::prelude::*;
 use crate::engine::band::{BandResult, Fast, fast_window};
 use crate::engine::padded::PaddedGrid;
 use crate::engine::paper::{PaperCounts, PaperScratch, paper_row};
-pub use crate::engine::probe::Probe;
+pub(crate) use crate::engine::probe::Probe;
 use crate::engine::push::{PushRows, WindowMin, push_block};
 use crate::engine::ranked::{Rank, RankedGrid};
 use crate::engine::slide::window_depth;
@@ -103,14 +103,14 @@ const LANES: usize = 16;
 /// against 4.91 for 128 (wall 2.77 s against 2.88), the window's passes
 /// being fewer; 1024 was a little faster again but held 401 MiB at 16
 /// threads (issue 11 allows 400), 512 held 311.
-pub const BAND_ROWS: usize = 512;
+pub(crate) const BAND_ROWS: usize = 512;
 
 /// Runs push and slide for every footprint (one per angle) on `grid`.
 /// `on_angle` is called once per finished angle (for a progress bar).
 ///
 /// Angles run in parallel; when there are fewer angles than threads, the
 /// bands of start rows within an angle do too. At most one task per
-/// thread holds a reach window ([`BAND_ROWS`]), and at most
+/// thread holds a reach window (`BAND_ROWS`), and at most
 /// `min(threads, angles)` angles hold an unfinished mask.
 ///
 /// # Panics
@@ -274,7 +274,7 @@ pub fn push_levels(grid: &HeightGrid, fp: &GridFootprint) -> Vec<f64> {
 /// [`push_levels`] at every angle of `footprints` in turn, handed to
 /// `each` in their order: the padded grid, its ranks and the push table
 /// are built once for all of them.
-pub fn for_each_push_levels(
+pub(crate) fn for_each_push_levels(
     grid: &HeightGrid,
     footprints: &[GridFootprint],
     mut each: impl FnMut(Vec<f64>),
@@ -325,7 +325,7 @@ pub fn composite(masks: &[AngleMask]) -> Vec<u16> {
 /// engine owns these figures because it owns the buffers;
 /// [`crate::memory::MemoryEstimate::analysis`] adds the part, the masks
 /// and the writers.
-pub fn working_bytes(
+pub(crate) fn working_bytes(
     spec: &GridSpec,
     footprints: &[GridFootprint],
     rule: &StrikeRule,

@@ -10,11 +10,11 @@ use crate::kneeform::GridFootprint;
 
 /// Extra margin columns on each side, so that a whole block of starts may
 /// run past the active range without leaving the padding.
-pub const LANE_SLACK: usize = 128;
+pub(crate) const LANE_SLACK: usize = 128;
 
 /// A height grid with padded rows and columns.
 #[derive(Debug)]
-pub struct PaddedGrid {
+pub(crate) struct PaddedGrid {
     /// The grid's nodes.
     pub spec: GridSpec,
     /// Padding columns before column 0.
@@ -32,7 +32,7 @@ pub struct PaddedGrid {
 /// The range of start columns, real and virtual, whose first layer (the
 /// first node in front in each footprint row) can fall inside the grid:
 /// from the last virtual start past the -x edge up to the last real start.
-pub fn start_lanes(fp: &GridFootprint, nx: usize) -> std::ops::Range<i64> {
+pub(crate) fn start_lanes(fp: &GridFootprint, nx: usize) -> std::ops::Range<i64> {
     let kf_max = fp.rows.iter().map(|r| r.kf).max().unwrap_or(0);
     (-i64::from(kf_max)).min(0)..nx as i64
 }
@@ -40,7 +40,7 @@ pub fn start_lanes(fp: &GridFootprint, nx: usize) -> std::ops::Range<i64> {
 /// The padding [`PaddedGrid::new`] gives a grid for some footprints,
 /// known before anything is allocated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Padding {
+pub(crate) struct Padding {
     /// Padding columns before column 0.
     pub pad_lo: usize,
     /// Padding rows before row 0 (and after the last).
@@ -180,6 +180,6 @@ impl PaddedGrid {
 /// it compile to packed `min` instructions (`f64::min` handles NaN, which
 /// heights never are, and does not vectorise as well).
 #[inline(always)]
-pub fn fmin(a: f64, b: f64) -> f64 {
+pub(crate) fn fmin(a: f64, b: f64) -> f64 {
     if b < a { b } else { a }
 }

@@ -40,7 +40,7 @@ struct Entry {
 /// Marks of the nodes found in the current start row: a node is found when
 /// its stamp equals the row's.
 #[derive(Debug, Default)]
-pub struct PaperScratch {
+pub(crate) struct PaperScratch {
     found: Vec<u32>,
     stamp: u32,
     list: Vec<Entry>,
@@ -48,7 +48,7 @@ pub struct PaperScratch {
 
 /// Work counters of the paper algorithm, for the benchmark.
 #[derive(Debug, Default, Clone, Copy)]
-pub struct PaperCounts {
+pub(crate) struct PaperCounts {
     /// Merged-list entries visited by slides.
     pub visited: u64,
     /// Slides cancelled at an already-found point.
@@ -58,7 +58,7 @@ pub struct PaperCounts {
 /// Pushes and slides every start of start row `j0` literally and ORs the
 /// colliding nodes into `mask` (padded like `grid`). Returns the number of
 /// placed starts.
-pub fn paper_row(
+pub(crate) fn paper_row(
     grid: &PaddedGrid,
     fp: &GridFootprint,
     j0: usize,

@@ -40,7 +40,7 @@ use crate::kneeform::GridFootprint;
 /// footprint rows that fall on them. That keeps the table at `levels - 1`
 /// copies of the real rows, the largest item of an analysis's memory.
 #[derive(Debug)]
-pub struct WindowMin<'a> {
+pub(crate) struct WindowMin<'a> {
     /// The padded grid's real rows' ranks: level 0.
     heights: &'a [Rank],
     /// `levels[l - 1][row * stride + x]` = min of the ranks over
@@ -219,7 +219,7 @@ impl GroupMin {
 /// A level of [`WindowMin`]: the minimum over a fixed number of
 /// consecutive nodes of a real row, from any node.
 #[derive(Debug, Clone, Copy)]
-pub struct WindowOf<'a> {
+pub(crate) struct WindowOf<'a> {
     minima: &'a [Rank],
     first: usize,
 }
@@ -241,7 +241,7 @@ type PushRow = (isize, u32, u32);
 /// The push rows of one footprint, ready for [`push_block`]: each row
 /// with nodes inside, in `dj` order.
 #[derive(Debug, Clone)]
-pub struct PushRows {
+pub(crate) struct PushRows {
     rows: Vec<PushRow>,
     /// Each row's `dj`, ascending.
     dj: Vec<i32>,
@@ -316,7 +316,7 @@ impl PushRows {
 /// first-level cache; and group by group, lowest bound first, until no
 /// group left can lower a level (the module's doc).
 #[inline(always)]
-pub fn push_tile<const W: usize, const T: usize>(
+pub(crate) fn push_tile<const W: usize, const T: usize>(
     table: &WindowMin,
     rows: &PushRows,
     j0: usize,
@@ -383,7 +383,7 @@ pub fn push_tile<const W: usize, const T: usize>(
 /// `base`: the minimum height over the nodes inside each footprint,
 /// [`OFF`] where none is finite. [`push_tile`] of one start row.
 #[inline(always)]
-pub fn push_block<const W: usize>(
+pub(crate) fn push_block<const W: usize>(
     table: &WindowMin,
     rows: &PushRows,
     j0: usize,
@@ -396,7 +396,12 @@ pub fn push_block<const W: usize>(
 
 /// The paper's push for one start, literally: the minimum over every node
 /// inside the footprint.
-pub fn push_start_literal(grid: &PaddedGrid, fp: &GridFootprint, i0: usize, j0: usize) -> f64 {
+pub(crate) fn push_start_literal(
+    grid: &PaddedGrid,
+    fp: &GridFootprint,
+    i0: usize,
+    j0: usize,
+) -> f64 {
     let mut yr = f64::INFINITY;
     for row in &fp.rows {
         let Some(j) = grid.row_of(j0, row.dj) else {

@@ -25,18 +25,18 @@ use crate::strike::{Meeting, RateEstimate, StrikeRule};
 
 /// A height's rank: `NEVER` below every height, `1..=n` for the grid's `n`
 /// distinct finite heights in increasing order, [`OFF`] for `+inf`.
-pub type Rank = u32;
+pub(crate) type Rank = u32;
 
 /// The rank of `-inf`: a node no face level met, a start not placed.
-pub const NEVER: Rank = 0;
+pub(crate) const NEVER: Rank = 0;
 
 /// The rank of `+inf`: off the part. Also the threshold of a node no level
 /// strikes (no level is finite and that high).
-pub const OFF: Rank = Rank::MAX;
+pub(crate) const OFF: Rank = Rank::MAX;
 
 /// The ranks of a padded grid's heights, and the heights they stand for.
 #[derive(Debug)]
-pub struct RankedGrid {
+pub(crate) struct RankedGrid {
     /// `ranks[n]` is the rank of `padded.h[n]`, same layout.
     pub ranks: Vec<Rank>,
     /// The distinct finite heights in increasing order: rank `k` stands

@@ -36,7 +36,7 @@ use crate::strike::{LevelHistory, StrikeRule};
 /// slide order, and the tie groups (runs of that order whose distances
 /// agree within [`NODE_TOL`]).
 #[derive(Debug, Clone)]
-pub struct LayerRows {
+pub(crate) struct LayerRows {
     offsets: Vec<isize>,
     /// Each offset's tie group, numbered in slide order: a group is the
     /// run of offsets with one number.
@@ -132,7 +132,7 @@ impl LayerRows {
 /// Its reach stays as it was, so a caller that reads the reach at levels
 /// below the nodes (the engine's probes) passes `None`.
 #[inline(always)]
-pub fn slide_block<const W: usize>(
+pub(crate) fn slide_block<const W: usize>(
     h: &[Rank],
     reach: &mut [Rank],
     layer: &LayerRows,
@@ -193,7 +193,7 @@ pub(crate) fn ones(mut word: u64) -> impl Iterator<Item = usize> {
 /// `carry` of the start on its +x side, over its first layer; returns the
 /// level it carries on. A layer with no finite height (past the part's
 /// edge) is not slid over: no node of it exists to be met.
-pub fn slide_carried(
+pub(crate) fn slide_carried(
     h: &[Rank],
     reach: &mut [Rank],
     layer: &LayerRows,
@@ -223,13 +223,13 @@ pub fn slide_carried(
 /// `W` and a pitch (the newer start's window must look back past its own
 /// entry), and a pitch to spare for where its first nodes in front lie
 /// (`d0 <= p`) and for rounding.
-pub fn window_reach(window: f64, pitch: f64) -> f64 {
+pub(crate) fn window_reach(window: f64, pitch: f64) -> f64 {
     window + 2.0 * pitch
 }
 
 /// Columns beyond the first layer that [`WindowLayers`] reach: what the
 /// padding must add before column 0 for the virtual starts' deepest nodes.
-pub fn window_depth(rule: &StrikeRule, pitch: f64) -> usize {
+pub(crate) fn window_depth(rule: &StrikeRule, pitch: f64) -> usize {
     match rule.window_mm() {
         Some(window) => (window_reach(window, pitch) / pitch).ceil() as usize + 1,
         None => 0,
@@ -246,7 +246,7 @@ pub fn window_depth(rule: &StrikeRule, pitch: f64) -> usize {
 /// So each placed start slides this far, and further where the starts to
 /// its -x are not placed ([`Extension`]).
 #[derive(Debug, Clone)]
-pub struct WindowLayers {
+pub(crate) struct WindowLayers {
     /// Each entry's offset from the start's node, in slide order.
     offsets: Vec<isize>,
     /// Each entry's tie group, numbered in slide order.
@@ -414,7 +414,7 @@ fn row_below(
 }
 
 /// What [`slide_block_window`] reads and writes besides the heights.
-pub struct WindowSlide<'a> {
+pub(crate) struct WindowSlide<'a> {
     /// Per node, the lowest level (rank) at which it is a contact.
     pub contact: &'a [Rank],
     /// Per node, the lowest level (rank) `W` back at which it passes the
@@ -456,7 +456,7 @@ pub struct WindowSlide<'a> {
 /// found with wider minima: fewer loads for the rows no lane slides.)
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-pub fn slide_block_window<const S: usize>(
+pub(crate) fn slide_block_window<const S: usize>(
     h: &[Rank],
     out: &mut WindowSlide,
     layers: &WindowLayers,
@@ -570,7 +570,7 @@ pub fn slide_block_window<const S: usize>(
 /// there, so it slides on, one column's first layer at a time, until the
 /// first placed start past them has itself travelled [`window_reach`].
 #[derive(Debug, Clone)]
-pub struct Extension {
+pub(crate) struct Extension {
     /// The start's column.
     pub column: i64,
     level: Rank,

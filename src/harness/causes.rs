@@ -53,13 +53,13 @@ const CELL_TOL: f64 = 1e-6;
 
 /// How far from a touched mesh point (in pitches, xz) the grid's nearest
 /// node under the knee-form may lie ([`Cells::rise_near`]).
-pub const RISE_REACH: f64 = std::f64::consts::SQRT_2;
+pub(crate) const RISE_REACH: f64 = std::f64::consts::SQRT_2;
 
 /// What the harness knows of a grid's cells: which are flagged blind spots
 /// (the mesh sticks out past their sampled corners by more than the
 /// analysis's `--blind-depth`), and the grid's heights.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Cells {
+pub(crate) struct Cells {
     spec: GridSpec,
     /// The blind spots' cells `(i, j)`, sorted, each with its reference
     /// height (the lowest sampled corner, mm).

@@ -19,10 +19,10 @@ use crate::frame::Approach;
 use crate::summary::{CheckStatus, SampleCheck};
 
 /// Starts in the sample.
-pub const CHECK_STARTS: usize = 5;
+pub(crate) const CHECK_STARTS: usize = 5;
 
 /// The sample's seed: the same starts on every machine and run.
-pub const CHECK_SEED: u64 = 1;
+pub(crate) const CHECK_SEED: u64 = 1;
 
 /// The angles checked among `angles` (degrees): the first, the middle and
 /// the last, without repeats.

@@ -46,7 +46,7 @@ pub enum StartSelection {
 
 /// How to compare.
 #[derive(Debug, Clone, PartialEq)]
-pub struct CompareOptions {
+pub(crate) struct CompareOptions {
     /// The knee-form.
     pub knee: KneeForm,
     /// SPEC's strike rule, on both sides.
@@ -90,7 +90,7 @@ impl SplitMix {
 /// placed at one of `footprints` at least, all, a strip or a seeded sample;
 /// for [`StartSelection::At`], the given starts that are nodes, in the
 /// order given.
-pub fn select_starts(
+pub(crate) fn select_starts(
     grid: &HeightGrid,
     footprints: &[GridFootprint],
     selection: &StartSelection,
@@ -459,7 +459,7 @@ pub struct PairResult {
 }
 
 /// The statuses of a row, in the order a shard's file numbers them.
-pub const STATUSES: [&str; 5] = [
+pub(crate) const STATUSES: [&str; 5] = [
     "compared",
     "grid_not_placed",
     "oracle_not_placed",
@@ -475,7 +475,7 @@ fn to_micrometre(v: f64) -> f64 {
 
 /// The row of `verify.csv` of the pair at node `(i, j)` and `angle_deg`
 /// whose status is `status` (one of [`STATUSES`]) and comparison `cmp`.
-pub fn row_of(
+pub(crate) fn row_of(
     i: usize,
     j: usize,
     angle_deg: f64,
@@ -701,7 +701,7 @@ fn inside_miss_at_half_pitch(
 /// band `band` and `grid_s` seconds spent on the grid side. Its
 /// statistics, counts and area distances depend on the pairs and their
 /// order alone.
-pub fn assemble(
+pub(crate) fn assemble(
     results: Vec<PairResult>,
     angles_deg: &[f64],
     band: TieBand,

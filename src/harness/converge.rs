@@ -87,7 +87,7 @@ pub fn fit_power_law(points: &[(f64, f64)]) -> Option<Fit> {
 }
 
 /// The fits of every metric's max error over `results`.
-pub fn fits(results: &[PitchResult]) -> Vec<(String, Option<Fit>)> {
+pub(crate) fn fits(results: &[PitchResult]) -> Vec<(String, Option<Fit>)> {
     METRICS
         .iter()
         .enumerate()
@@ -103,7 +103,7 @@ pub fn fits(results: &[PitchResult]) -> Vec<(String, Option<Fit>)> {
 
 /// The coarsest pitch whose comparison passes `tolerance` (measured, not
 /// extrapolated).
-pub fn recommended_pitch(results: &[PitchResult], tolerance: f64) -> Option<&PitchResult> {
+pub(crate) fn recommended_pitch(results: &[PitchResult], tolerance: f64) -> Option<&PitchResult> {
     results
         .iter()
         .filter(|r| r.comparison.passes(tolerance))

@@ -63,7 +63,7 @@ pub const DIRECT_METRICS: [&str; 2] = ["level_error", "contact_distance"];
 
 /// The part in the direct frame ([`to_direct`]: a proper rotation, the
 /// winding and the outward side kept), as the analysis samples it.
-pub fn to_direct_frame(triangles: &[Triangle]) -> Part {
+pub(crate) fn to_direct_frame(triangles: &[Triangle]) -> Part {
     Part {
         triangles: triangles.iter().map(|t| t.map(to_direct)).collect(),
         file_triangles: triangles.len(),
@@ -74,7 +74,7 @@ pub fn to_direct_frame(triangles: &[Triangle]) -> Part {
 
 /// The grid's first contact of one position (direct frame).
 #[derive(Debug, Clone, PartialEq)]
-pub struct GridDirectContact {
+pub(crate) struct GridDirectContact {
     /// `Y*` (mm): the level of the knee-form's reference point along y'.
     pub level: f64,
     /// The contacted nodes `(i, j)`: `h + a <= Y* + e0`.
@@ -84,7 +84,7 @@ pub struct GridDirectContact {
 /// The grid's first contact of the position at node `(i0, j0)` of `grid`
 /// (direct frame), or `None` when no node of the footprint has a finite
 /// height. `e0` (mm) is SPEC's rounding tolerance, which makes ties.
-pub fn grid_first_contact(
+pub(crate) fn grid_first_contact(
     grid: &HeightGrid,
     fp: &DirectFootprint,
     (i0, j0): (usize, usize),
@@ -292,7 +292,7 @@ pub struct DirectPair {
 }
 
 /// The statuses of a [`DirectRow`].
-pub const DIRECT_STATUSES: [&str; 5] = [
+pub(crate) const DIRECT_STATUSES: [&str; 5] = [
     "both",
     "grid_only",
     "exact_only",
@@ -304,7 +304,7 @@ pub const DIRECT_STATUSES: [&str; 5] = [
 /// `grid`, which is in the direct frame) against `traces` (angle-major, one
 /// per position and angle of `footprints`): the pairs, angle-major, not yet
 /// assembled ([`assemble_direct`]), and the seconds they took.
-pub fn direct_pairs(
+pub(crate) fn direct_pairs(
     grid: &HeightGrid,
     footprints: &[DirectFootprint],
     positions: &[[f64; 2]],
@@ -392,7 +392,7 @@ pub fn direct_pairs(
 /// statistics, in their order; `grid_s` the seconds they took. A merge of
 /// shards assembles the pairs in the unsharded order with this function,
 /// as the unsharded study does.
-pub fn assemble_direct(pairs: Vec<DirectPair>, grid_s: f64) -> DirectComparison {
+pub(crate) fn assemble_direct(pairs: Vec<DirectPair>, grid_s: f64) -> DirectComparison {
     let mut counts = DirectCounts {
         compared: pairs.len(),
         ..DirectCounts::default()
@@ -430,7 +430,7 @@ pub fn assemble_direct(pairs: Vec<DirectPair>, grid_s: f64) -> DirectComparison 
 }
 
 /// The oracle's options for `knee` and rounding tolerance `e0` (mm).
-pub fn direct_oracle_options(knee: &KneeForm, e0: f64) -> DirectOptions {
+pub(crate) fn direct_oracle_options(knee: &KneeForm, e0: f64) -> DirectOptions {
     DirectOptions {
         knee_form: KneeFormDims {
             length: knee.triangle_side,

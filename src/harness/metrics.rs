@@ -51,7 +51,7 @@ pub const METRICS: [&str; 26] = [
 pub use crate::summary::DECIDED_METRICS;
 
 /// The index of `name` in [`METRICS`].
-pub fn metric_index(name: &str) -> usize {
+pub(crate) fn metric_index(name: &str) -> usize {
     METRICS
         .iter()
         .position(|m| *m == name)
@@ -172,7 +172,7 @@ impl TieBand {
 /// traced level curve, or (under `--rate x-slope`) the traced deflection
 /// rate against `sigma`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum ExactRule {
+pub(crate) enum ExactRule {
     /// `rate > sigma`, decided against [`TieBand`].
     Rate,
     /// SPEC's window rule: `f*(s - W) - f*(s) > sigma W`, the curve read
@@ -224,7 +224,7 @@ const JUMP_TOLERANCE: f64 = 1e-6;
 /// An exact contact's standing: a strike by SPEC's rule, and its decision
 /// against the tie band.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ExactStrike {
+pub(crate) struct ExactStrike {
     /// The contact.
     pub contact: ContactPoint,
     /// A strike by the rule (`rate > sigma`, or the window drop above
@@ -541,7 +541,7 @@ fn xz(p: [f64; 3]) -> [f64; 2] {
 /// on the safe side, SPEC's "What the window does not fix"), and the grid's
 /// window drop may exceed the exact one by up to the bound at `s - W` (the
 /// tie band's grid term, [`ExactRule::Window`]).
-pub struct LevelErrorBound<'a> {
+pub(crate) struct LevelErrorBound<'a> {
     curve: LevelCurve<'a>,
     travels: Vec<f64>,
     rises: Vec<f64>,
@@ -664,7 +664,7 @@ const LEVEL_TOL: f64 = 1e-6;
 /// later (where the knee-form's outline runs almost along the slide, a
 /// crease crossing its rounded corner: 3 mm later for a node 0.11 mm from
 /// the touched point on the console at 0.5 mm) judges another contact.
-pub const MEETING_REACH: f64 = RISE_REACH;
+pub(crate) const MEETING_REACH: f64 = RISE_REACH;
 
 /// Whether the exact contact `k` of `contacts` (a start's, in travel
 /// order) is brief at pitch `pitch`: the run of contacts around it whose
@@ -715,7 +715,7 @@ fn brief(contacts: &[ContactPoint], k: usize, pitch: f64) -> bool {
 /// miss the true highest point), the grid strikes, just after the push, the
 /// point the exact knee-form rests on. It does not count for misses: the
 /// grid's push contact is, by SPEC, not a colliding point.
-pub fn compare(
+pub(crate) fn compare(
     grid: &GridTrace,
     exact: &StartTrace,
     band: &TieBand,

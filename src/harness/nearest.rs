@@ -11,7 +11,7 @@
 
 /// A point set in the plane that answers nearest-distance queries.
 #[derive(Debug, Clone)]
-pub struct PointSet {
+pub(crate) struct PointSet {
     /// The points, reordered into a balanced 2-d tree: the median of each
     /// range longer than [`LEAF`] (split on x at even depths, z at odd)
     /// sits at its middle; shorter ranges are leaves, scanned in full.

@@ -397,7 +397,7 @@ fn oracle_s(parts: &[StudyPart]) -> f64 {
 /// The verification of the shares `parts`: every shard of one study
 /// exactly once, in shard order (as [`crate::shard::study`] checks), each
 /// holding every pair of its starts.
-pub fn merge_verify(parts: &[StudyPart]) -> Option<Verification> {
+pub(crate) fn merge_verify(parts: &[StudyPart]) -> Option<Verification> {
     let first = parts.first()?;
     let StudySummary::Verify(summary) = &first.summary else {
         return None;
@@ -415,7 +415,7 @@ pub fn merge_verify(parts: &[StudyPart]) -> Option<Verification> {
 }
 
 /// The convergence study of the shares `parts` (as [`merge_verify`]).
-pub fn merge_converge(parts: &[StudyPart]) -> Option<Convergence> {
+pub(crate) fn merge_converge(parts: &[StudyPart]) -> Option<Convergence> {
     let first = parts.first()?;
     let StudySummary::Converge(summary) = &first.summary else {
         return None;
@@ -434,7 +434,7 @@ pub fn merge_converge(parts: &[StudyPart]) -> Option<Convergence> {
 }
 
 /// The direct verification of the shares `parts` (as [`merge_verify`]).
-pub fn merge_verify_direct(parts: &[StudyPart]) -> Option<DirectVerification> {
+pub(crate) fn merge_verify_direct(parts: &[StudyPart]) -> Option<DirectVerification> {
     let first = parts.first()?;
     let StudySummary::VerifyDirect(summary) = &first.summary else {
         return None;
@@ -450,7 +450,7 @@ pub fn merge_verify_direct(parts: &[StudyPart]) -> Option<DirectVerification> {
 
 /// The direct convergence study of the shares `parts` (as
 /// [`merge_verify`]).
-pub fn merge_converge_direct(parts: &[StudyPart]) -> Option<DirectConvergence> {
+pub(crate) fn merge_converge_direct(parts: &[StudyPart]) -> Option<DirectConvergence> {
     let first = parts.first()?;
     let StudySummary::ConvergeDirect(summary) = &first.summary else {
         return None;

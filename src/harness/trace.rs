@@ -28,7 +28,7 @@ pub(crate) enum Fault {
 
 /// A colliding node of one start.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GridContact {
+pub(crate) struct GridContact {
     /// Column and row of the node.
     pub node: (usize, usize),
     /// The node as a point: `(x, h, z)` in mm, analysis frame.
@@ -39,7 +39,7 @@ pub struct GridContact {
 
 /// The grid's push and slide of one start.
 #[derive(Debug, Clone, PartialEq)]
-pub struct GridTrace {
+pub(crate) struct GridTrace {
     /// The face level after the push (mm), `+inf` when not placed.
     pub yr: f64,
     /// The colliding nodes in the order they are met.
@@ -50,7 +50,7 @@ pub struct GridTrace {
 
 /// One row of a start's footprint at the push.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FootprintSpan {
+pub(crate) struct FootprintSpan {
     /// The grid row.
     pub j: usize,
     /// The columns under the knee-form at the push, `lo..=hi` (inclusive,

@@ -114,7 +114,7 @@ pub fn sampling_tolerance(pitch: f64) -> f64 {
 /// The tie band's rule in words, for the summaries: under the window rule
 /// (`window_mm`) the drop's band ([`super::metrics::ExactRule::Window`]),
 /// under x-slope the rate's ([`TieBand`]).
-pub fn tie_band_rule(per_mm: f64, window_mm: Option<f64>) -> String {
+pub(crate) fn tie_band_rule(per_mm: f64, window_mm: Option<f64>) -> String {
     match window_mm {
         Some(w) => format!(
             "an exact contact is a decided strike when its drop over the last {w} mm exceeds sigma x {w} mm by more than its stated error plus how far the lowest node within sqrt 2 pitches of the touched point that the slide met by sqrt 2 pitches more of travel lies above it (the grid judges those nodes; none: undecided), a decided non-strike when it falls short by more than its error plus the bound of the grid's level error {w} mm back (the exact level's fall over the pitch before that travel plus the rise of the surface within sqrt 2 pitches of the exact contacts in force, unbounded where the slide met no node that near: the grid's level is deeper by at most that, which only ever adds strikes), undecided otherwise; a grid strike whose node lies within that bound of touching the exact knee-form, and whose drop the bound can explain, is the level error's (a false alarm on the safe side); disagreements from the exact knee-form's first touch of a flagged blind spot on are blind"

@@ -189,7 +189,8 @@ fn push_micrometres_exact(s: &mut String, v: f64) {
 /// takes angle `a` as `(int(mask, 16) >> a) & 1` (Python's `int` takes the
 /// `0x`); the prefix keeps pandas and polars from reading a mask of decimal
 /// digits as a number.
-pub fn angle_mask(masks: &[AngleMask], k: usize) -> String {
+#[cfg(test)]
+fn angle_mask(masks: &[AngleMask], k: usize) -> String {
     let mut row = Row::default();
     row.mask(masks, k);
     row.text

@@ -2,12 +2,12 @@
 //! CSV, the colliding area as a binary STL surface, and the height grid and
 //! the composite as PNG images.
 //!
-//! * [`write_composite`]: a CSV table, one row per colliding node with its
+//! * `write_composite`: a CSV table, one row per colliding node with its
 //!   count and set of angles, in the part's own coordinates (mm, to 1 um);
-//!   [`write_colliding_points`]: one row per node and angle (on request);
-//! * [`write_colliding_area`]: the composite area as a triangle surface in
+//!   `write_colliding_points`: one row per node and angle (on request);
+//! * `write_colliding_area`: the composite area as a triangle surface in
 //!   the part's coordinates (mm), facing the knee;
-//! * [`write_depth_png`], [`write_composite_png`]: images with mm axes, the
+//! * `write_depth_png`, `write_composite_png`: images with mm axes, the
 //!   vehicle front (-x) on the left and z up;
 //! * [`OutputDir`]: every file of a run is written into a staging directory
 //!   and moved under its final name only when the run succeeds, so a reader
@@ -33,21 +33,20 @@ mod stl;
 mod studies;
 mod surface;
 
-pub use self::csv::{
-    MICROMETRE_DIGITS, angle_mask, micrometres, write_colliding_points, write_composite,
-};
+pub use self::csv::micrometres;
+pub(crate) use self::csv::{write_colliding_points, write_composite};
 #[cfg(feature = "harness")]
-pub use self::plot::write_plots;
-pub use self::ply::write_colliding_area_ply;
+pub(crate) use self::plot::write_plots;
+pub(crate) use self::ply::write_colliding_area_ply;
 pub(crate) use self::png::count_colour;
 #[cfg(feature = "harness")]
 pub(crate) use self::png::register_font;
-pub use self::png::{
-    BLIND_COLOUR, CROP_MARGIN, NO_PART, PngError, RING_BELOW, RING_COLOUR, Window, composite_key,
-    crop_window, depth_bar_ends, view_line, write_composite_png, write_depth_png,
-};
-pub use self::results::{RunResults, WriteOptions, write_analysis, write_results};
-pub use self::stl::{write_colliding_area, write_stl};
+pub use self::png::{BLIND_COLOUR, NO_PART};
+pub(crate) use self::png::{PngError, write_composite_png, write_depth_png};
+pub(crate) use self::results::{RunResults, write_results};
+pub use self::results::{WriteOptions, write_analysis};
+pub(crate) use self::stl::write_colliding_area;
+pub use self::stl::write_stl;
 #[cfg(feature = "harness")]
 pub use self::studies::{
     write_convergence, write_convergence_files, write_direct_convergence,
@@ -62,7 +61,7 @@ pub const SUMMARY_JSON: &str = "summary.json";
 /// The files kneeform writes into a result directory: a run's, a
 /// verification's, a convergence study's, a shard's, the report, and a
 /// batch item's fingerprint.
-pub const OWN_FILES: [&str; 18] = [
+pub(crate) const OWN_FILES: [&str; 18] = [
     SUMMARY_JSON,
     "composite.csv",
     "colliding_points.csv",
@@ -85,7 +84,7 @@ pub const OWN_FILES: [&str; 18] = [
 
 /// Whether `name` is a file kneeform writes into a result directory
 /// ([`OWN_FILES`], or a study's `verify_<pitch>mm.csv`).
-pub fn is_own_file(name: &str) -> bool {
+pub(crate) fn is_own_file(name: &str) -> bool {
     OWN_FILES.contains(&name)
         || name
             .strip_prefix("verify_")

@@ -25,14 +25,14 @@ use super::views::{Figure, LARGE_WIDTH, OBLIQUE_Y_TOL_PITCHES, run_camera, run_o
 /// at different nodes, up to a pitch apart along a face and half a
 /// diagonal across one; two pitches takes in both, and is far less than
 /// the knee-form (120 mm wide).
-pub const MATCH_PITCHES: f64 = 2.0;
+pub(crate) const MATCH_PITCHES: f64 = 2.0;
 
 /// Colour of what only push-and-slide strikes.
-pub const SLIDE_ONLY: Rgb = [230, 97, 1];
+pub(crate) const SLIDE_ONLY: Rgb = [230, 97, 1];
 /// Colour of what only the direct approach touches.
-pub const DIRECT_ONLY: Rgb = [33, 102, 172];
+pub(crate) const DIRECT_ONLY: Rgb = [33, 102, 172];
 /// Colour of what both find.
-pub const BOTH: Rgb = [118, 42, 131];
+pub(crate) const BOTH: Rgb = [118, 42, 131];
 
 /// The comparison of the report's run with another run of the same part.
 #[derive(Debug)]

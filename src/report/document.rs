@@ -41,15 +41,15 @@ use super::views::{ANGLE_COLOUR, Figure, Views, composite_colour, ramp_len};
 pub const MAIN_BORDER: [u8; 3] = [0, 90, 181];
 
 /// The file name the report cites the run's summary as.
-pub const SUMMARY: &str = crate::output::SUMMARY_JSON;
+pub(crate) const SUMMARY: &str = crate::output::SUMMARY_JSON;
 
 /// The citation prefix of the `k`-th verification directory's files.
-pub fn verify_label(k: usize, file: &str) -> String {
+pub(crate) fn verify_label(k: usize, file: &str) -> String {
     format!("verify[{k}]/{file}")
 }
 
 /// Everything the page is made of.
-pub struct Inputs<'a> {
+pub(crate) struct Inputs<'a> {
     /// The run.
     pub run: &'a Run,
     /// The interactive 3D view's figure ([`super::view3d`]).
@@ -74,7 +74,7 @@ const VERSION: &str = env!("CARGO_PKG_VERSION");
 /// The whole page. The template writes no whitespace of its own: the line
 /// breaks (`"\n"`) are the page's, one after each block, so that its
 /// source reads line by line.
-pub fn document(inputs: &Inputs) -> String {
+pub(crate) fn document(inputs: &Inputs) -> String {
     let run = inputs.run;
     let s = &run.summary;
     let j = &run.summary_json;

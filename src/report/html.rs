@@ -14,20 +14,20 @@ use serde_json::Value;
 
 /// `&middot;`: the page's text keeps the character references it always
 /// wrote, so that it stays ASCII where it can and byte-identical.
-pub const MIDDOT: PreEscaped<&str> = PreEscaped("&middot;");
+pub(crate) const MIDDOT: PreEscaped<&str> = PreEscaped("&middot;");
 /// `&nbsp;`.
-pub const NBSP: PreEscaped<&str> = PreEscaped("&nbsp;");
+pub(crate) const NBSP: PreEscaped<&str> = PreEscaped("&nbsp;");
 /// `&sup2;`.
-pub const SUP2: PreEscaped<&str> = PreEscaped("&sup2;");
+pub(crate) const SUP2: PreEscaped<&str> = PreEscaped("&sup2;");
 /// `&times;`.
-pub const TIMES: PreEscaped<&str> = PreEscaped("&times;");
+pub(crate) const TIMES: PreEscaped<&str> = PreEscaped("&times;");
 /// `&asymp;`.
-pub const ASYMP: PreEscaped<&str> = PreEscaped("&asymp;");
+pub(crate) const ASYMP: PreEscaped<&str> = PreEscaped("&asymp;");
 
 /// A number for reading: whole numbers in full, others to six significant
 /// digits with trailing zeros dropped (`1234.57`, `0.0123457`), so a value
 /// shown differs from the file's by at most 5e-6 relative.
-pub fn fmt_num(v: f64) -> String {
+pub(crate) fn fmt_num(v: f64) -> String {
     if !v.is_finite() {
         return v.to_string();
     }
@@ -48,7 +48,7 @@ pub fn fmt_num(v: f64) -> String {
 /// The text of a JSON value: numbers by [`fmt_num`], strings as they are,
 /// booleans as `yes`/`no`, arrays of numbers joined by `, `; plain text,
 /// for the template to escape.
-pub fn value_text(v: &Value) -> String {
+pub(crate) fn value_text(v: &Value) -> String {
     match v {
         Value::Number(n) => n.as_f64().map_or_else(|| n.to_string(), fmt_num),
         Value::String(s) => s.clone(),
@@ -62,7 +62,7 @@ pub fn value_text(v: &Value) -> String {
 /// The value at `pointer` in `json` (the contents of `file`), cited:
 /// `<span data-src="file#pointer">text</span>`; a missing value shows as
 /// "not in file", uncited.
-pub fn cite(file: &str, json: &Value, pointer: &str) -> Markup {
+pub(crate) fn cite(file: &str, json: &Value, pointer: &str) -> Markup {
     match json.pointer(pointer) {
         Some(v) => html! { span data-src={ (file) "#" (pointer) } { (value_text(v)) } },
         None => html! { span class="missing" { "not in file" } },
@@ -72,7 +72,7 @@ pub fn cite(file: &str, json: &Value, pointer: &str) -> Markup {
 /// An empty SVG element closed as SVG writes it, `<name key="value"/>`
 /// (a template's `name;` would leave it open, and the HTML parser would
 /// nest what follows inside it); the values escaped.
-pub fn svg_empty(name: &str, attributes: &[(&str, &dyn Render)]) -> Markup {
+pub(crate) fn svg_empty(name: &str, attributes: &[(&str, &dyn Render)]) -> Markup {
     let mut out = String::from("<");
     out.push_str(name);
     for (key, value) in attributes {
@@ -87,7 +87,7 @@ pub fn svg_empty(name: &str, attributes: &[(&str, &dyn Render)]) -> Markup {
 }
 
 /// Standard base64 (RFC 4648, with padding).
-pub fn base64(bytes: &[u8]) -> String {
+pub(crate) fn base64(bytes: &[u8]) -> String {
     const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
     for chunk in bytes.chunks(3) {
@@ -109,13 +109,13 @@ pub fn base64(bytes: &[u8]) -> String {
 }
 
 /// A PNG as a `data:` URI.
-pub fn png_uri(png: &[u8]) -> String {
+pub(crate) fn png_uri(png: &[u8]) -> String {
     format!("data:image/png;base64,{}", base64(png))
 }
 
 /// Seconds since the Unix epoch as `YYYY-MM-DD hh:mm:ss UTC` (proleptic
 /// Gregorian calendar; Howard Hinnant's `civil_from_days`).
-pub fn utc_date(unix: u64) -> String {
+pub(crate) fn utc_date(unix: u64) -> String {
     let days = (unix / 86_400) as i64;
     let secs = unix % 86_400;
     let z = days + 719_468;

@@ -28,12 +28,12 @@ const EDGE_TOL: f64 = 1e-9;
 const AMBIENT: f64 = 0.35;
 
 /// An 8-bit sRGB colour.
-pub type Rgb = [u8; 3];
+pub(crate) type Rgb = [u8; 3];
 
 /// An orthographic camera: an orthonormal right-handed basis `right`, `up`,
 /// `forward` (the direction of view), all in the part's frame (mm).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Camera {
+pub(crate) struct Camera {
     /// Screen x grows along this.
     pub right: Vector3<f64>,
     /// Screen rows grow against this (row 0 is the top).
@@ -62,7 +62,7 @@ impl Camera {
 /// `u = u_left + (c + 0.5) * mm_per_px` along [`Camera::right`] and
 /// `v = v_top - (r + 0.5) * mm_per_px` along [`Camera::up`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct View {
+pub(crate) struct View {
     /// The camera.
     pub camera: Camera,
     /// `u` of the image's left edge (mm).
@@ -134,7 +134,7 @@ impl View {
 /// nearest surface (`+inf` where none) and its Lambert shade in
 /// `[AMBIENT, 1]`.
 #[derive(Debug, Clone)]
-pub struct DepthImage {
+pub(crate) struct DepthImage {
     /// The view it was rendered for.
     pub view: View,
     /// Depth along the camera's forward axis (mm).
@@ -154,7 +154,7 @@ impl DepthImage {
 /// Z-buffers `triangles` (part frame, mm) into `view`, shading each by the
 /// angle between its normal and a light above the camera (two-sided: an STL
 /// may wind its triangles either way).
-pub fn rasterize(triangles: &[Triangle], view: &View) -> DepthImage {
+pub(crate) fn rasterize(triangles: &[Triangle], view: &View) -> DepthImage {
     let cam = view.camera;
     let light = (-cam.forward + cam.up * 0.4 - cam.right * 0.2).normalize();
     // Screen coordinates: (column, row, depth), pixel centres at k + 0.5.
@@ -230,7 +230,7 @@ fn centres_within(n: usize, lo: f64, hi: f64) -> Option<(usize, usize)> {
 
 /// An RGB image, row-major from the top, 3 bytes per pixel.
 #[derive(Debug, Clone, PartialEq)]
-pub struct RgbImage {
+pub(crate) struct RgbImage {
     /// Width (pixels).
     pub width: usize,
     /// Height (pixels).
@@ -249,15 +249,18 @@ impl RgbImage {
 }
 
 /// Colour of the background (no part under the pixel).
-pub const BACKGROUND: Rgb = [255, 255, 255];
+pub(crate) const BACKGROUND: Rgb = [255, 255, 255];
 /// Colour of the part where nothing is painted, before shading: a neutral
 /// grey (equal channels) so any painted colour stands out.
-pub const PART_GREY: Rgb = [205, 205, 205];
+pub(crate) const PART_GREY: Rgb = [205, 205, 205];
 
 /// Colours every covered pixel: `paint(surface point)` when it returns a
 /// colour, else [`PART_GREY`], either times the pixel's shade; uncovered
 /// pixels are [`BACKGROUND`].
-pub fn paint(image: &DepthImage, paint: impl Fn([f64; 3]) -> Option<Rgb> + Sync) -> RgbImage {
+pub(crate) fn paint(
+    image: &DepthImage,
+    paint: impl Fn([f64; 3]) -> Option<Rgb> + Sync,
+) -> RgbImage {
     let view = &image.view;
     let w = view.width;
     let mut pixels = vec![0u8; 3 * w * view.height];

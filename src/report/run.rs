@@ -20,7 +20,7 @@ use super::ReportError;
 /// The counts of one run's grid nodes (composite or one angle's mask) with
 /// the heights the run reported, for painting the part.
 #[derive(Debug, Clone)]
-pub struct NodeCounts {
+pub(crate) struct NodeCounts {
     /// The run's grid (part frame x, z; mm).
     pub spec: GridSpec,
     /// Per node, row-major by z (`j * nx + i`): number of angles (or 1/0).
@@ -89,7 +89,7 @@ impl NodeCounts {
 
 /// Every node's set of striking angles ([`Run::angle_bits`]).
 #[derive(Debug, Clone)]
-pub struct AngleBits {
+pub(crate) struct AngleBits {
     /// Bytes per node: `ceil(angles / 8)`.
     pub bytes: usize,
     /// `bytes` per node, row-major by z; bit `a % 8` of byte `a / 8` is
@@ -99,7 +99,7 @@ pub struct AngleBits {
 
 /// A run directory, read.
 #[derive(Debug)]
-pub struct Run {
+pub(crate) struct Run {
     /// The directory.
     pub dir: PathBuf,
     /// `summary.json`, typed.
@@ -130,7 +130,7 @@ pub struct Run {
 /// ([`crate::direct`]) it is the direct frame, column coordinate the
 /// analysed y (vehicle y, mirrored for the right side), depth `-x`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GridAxes {
+pub(crate) struct GridAxes {
     /// The run's approach.
     pub approach: Approach,
     /// The run's side.
@@ -150,7 +150,7 @@ impl GridAxes {
 
 /// One row of `blind_spots.csv`.
 #[derive(Debug, Clone, PartialEq)]
-pub struct BlindRow {
+pub(crate) struct BlindRow {
     /// The cell's first corner node.
     pub i: usize,
     /// Its row.
@@ -392,18 +392,18 @@ pub fn grid_spec(s: &Summary) -> Option<GridSpec> {
 /// ([`NodeCounts::at`]): far above the rounding of a rendered surface
 /// point (a few units in the last place of its coordinates, about 1e-13
 /// mm on a part of a metre), far below a pixel of any view.
-pub const CELL_TOL: f64 = 1e-6;
+pub(crate) const CELL_TOL: f64 = 1e-6;
 
 /// How far (relative to the coordinate, or to the pitch near 0) a grid
 /// coordinate read back from a file may be from the node it names: a few
 /// units in the last place of an f64 (2.2e-16 each), far below the 1e-6
 /// relative spacing of nodes of any grid of fewer than a million nodes.
-pub const ORIGIN_TOL: f64 = 1e-12;
+pub(crate) const ORIGIN_TOL: f64 = 1e-12;
 
 /// Whether the coordinate `v` (mm) read from a run file is the grid
 /// coordinate `node` (mm), within [`ORIGIN_TOL`] relative to the larger of
 /// the coordinate and `pitch`.
-pub fn same_coordinate(v: f64, node: f64, pitch: f64) -> bool {
+pub(crate) fn same_coordinate(v: f64, node: f64, pitch: f64) -> bool {
     (v - node).abs() <= ORIGIN_TOL * node.abs().max(pitch)
 }
 
@@ -411,7 +411,7 @@ pub fn same_coordinate(v: f64, node: f64, pitch: f64) -> bool {
 /// from its node (mm): it was rounded to 1 um, half a micrometre per
 /// coordinate, and through a `--frame` rotation up to sqrt(3) times that
 /// in one vehicle coordinate (0.87 um); 1 um bounds both.
-pub const ROUNDED_TOL_MM: f64 = 1e-3;
+pub(crate) const ROUNDED_TOL_MM: f64 = 1e-3;
 
 /// The directory's identity (device and inode), where the system has one.
 fn dir_identity(dir: &Path) -> Option<(u64, u64)> {

@@ -15,7 +15,7 @@ use super::ReportError;
 use crate::limits::{MAX_RUN_JSON_BYTES, MAX_RUN_TABLE_BYTES};
 
 /// The figures a verification directory may hold, in the order shown.
-pub const VERIFY_FIGURES: [&str; 2] = ["error_vs_pitch.png", "time_vs_pitch.png"];
+pub(crate) const VERIFY_FIGURES: [&str; 2] = ["error_vs_pitch.png", "time_vs_pitch.png"];
 
 /// One verification directory, read.
 #[derive(Debug, Clone)]
@@ -36,7 +36,7 @@ pub struct Verification {
 
 /// The verdict of a `verify` run against its tolerance.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Verdict {
+pub(crate) enum Verdict {
     /// The file says the run passed.
     Pass,
     /// The file says the run failed.
@@ -289,7 +289,7 @@ fn optional_text(path: &Path, max_bytes: u64) -> Result<Option<String>, ReportEr
 /// Every scalar (number, string, bool) under `value`, depth first in the
 /// map's key order, as `(label, JSON pointer, value)`; the label joins the
 /// keys with `.`. Arrays of numbers are kept whole, as one entry.
-pub fn scalars<'a>(
+pub(crate) fn scalars<'a>(
     value: &'a Value,
     pointer: &str,
     label: &str,
@@ -327,7 +327,7 @@ fn walk<'a>(
 }
 
 /// A key as a JSON pointer token (RFC 6901: `~` as `~0`, `/` as `~1`).
-pub fn escape_pointer(key: &str) -> String {
+pub(crate) fn escape_pointer(key: &str) -> String {
     key.replace('~', "~0").replace('/', "~1")
 }
 

@@ -39,11 +39,14 @@ use super::views::{OBLIQUE_Y_TOL_PITCHES, composite_colour, ramp_len, run_obliqu
 pub const MAX_TRIANGLES: usize = 400_000;
 /// The most grid nodes the page carries: WebGL 2 guarantees textures of
 /// 2048 x 2048 only, and most browsers allow 8192 or more.
-pub const MAX_NODES: usize = 8192 * 8192;
+pub(crate) const MAX_NODES: usize = 8192 * 8192;
 
 /// The 3D view's figure: a canvas, its controls' help, the readout of a
 /// picked point, and the data; or a note saying why there is none.
-pub fn view3d_figure(run: &Run, angle_bits: Option<&AngleBits>) -> Result<Markup, ReportError> {
+pub(crate) fn view3d_figure(
+    run: &Run,
+    angle_bits: Option<&AngleBits>,
+) -> Result<Markup, ReportError> {
     let triangles = &run.part.triangles;
     let spec = run.spec;
     if triangles.len() > MAX_TRIANGLES || spec.len() > MAX_NODES {

@@ -25,22 +25,22 @@ use super::render::{Camera, Rgb, RgbImage, View, paint, rasterize};
 use super::run::{GridAxes, NodeCounts, Run};
 
 /// Width of the large views (pixels): sharp on a printed A4 page.
-pub const LARGE_WIDTH: usize = 1100;
+pub(crate) const LARGE_WIDTH: usize = 1100;
 /// Width of each small multiple (pixels).
-pub const SMALL_WIDTH: usize = 560;
+pub(crate) const SMALL_WIDTH: usize = 560;
 /// Empty border around the part (pixels).
 const MARGIN: usize = 8;
 /// Colour of a single angle's colliding area in the small multiples: a red
 /// that no grey shade of the part can take.
-pub const ANGLE_COLOUR: Rgb = [215, 48, 39];
+pub(crate) const ANGLE_COLOUR: Rgb = [215, 48, 39];
 /// In the oblique view, a surface point is painted only within this many
 /// pitches of its node's y: enough for the slope across a cell of any face
 /// the knee can strike, far less than a console's depth.
-pub const OBLIQUE_Y_TOL_PITCHES: f64 = 2.0;
+pub(crate) const OBLIQUE_Y_TOL_PITCHES: f64 = 2.0;
 
 /// One rendered picture.
 #[derive(Debug, Clone)]
-pub struct Figure {
+pub(crate) struct Figure {
     /// The pixels.
     pub image: RgbImage,
     /// How pixels map to the part.
@@ -49,7 +49,7 @@ pub struct Figure {
 
 /// Every picture of the report.
 #[derive(Debug, Clone)]
-pub struct Views {
+pub(crate) struct Views {
     /// The analysed side, face on, painted with the composite.
     pub side: Figure,
     /// The oblique view, painted with the composite.
@@ -61,19 +61,19 @@ pub struct Views {
 }
 
 /// The camera of the side view: along the knee's push, z up.
-pub fn side_camera(side: Side) -> Camera {
+pub(crate) fn side_camera(side: Side) -> Camera {
     Camera::looking(Vector3::new(0.0, side.to_part(1.0), 0.0), Vector3::z())
 }
 
 /// The camera of the oblique view: from the analysed side, in front of the
 /// part (towards -x) and above it, looking back at it.
-pub fn oblique_camera(side: Side) -> Camera {
+pub(crate) fn oblique_camera(side: Side) -> Camera {
     Camera::looking(Vector3::new(0.55, side.to_part(1.0), -0.45), Vector3::z())
 }
 
 /// The face-on camera of a run: [`side_camera`] for push-and-slide; along
 /// the knee's motion (-x, z up) for the direct approach.
-pub fn run_camera(axes: GridAxes) -> Camera {
+pub(crate) fn run_camera(axes: GridAxes) -> Camera {
     match axes.approach {
         Approach::Slide => side_camera(axes.side),
         Approach::Direct => Camera::looking(-Vector3::x(), Vector3::z()),
@@ -83,7 +83,7 @@ pub fn run_camera(axes: GridAxes) -> Camera {
 /// The oblique camera of a run: [`oblique_camera`] for push-and-slide;
 /// for the direct approach from behind the knee (+x), beside the analysed
 /// side and above, looking along its motion.
-pub fn run_oblique_camera(axes: GridAxes) -> Camera {
+pub(crate) fn run_oblique_camera(axes: GridAxes) -> Camera {
     match axes.approach {
         Approach::Slide => oblique_camera(axes.side),
         Approach::Direct => Camera::looking(
@@ -113,7 +113,7 @@ const MAX_ASPECT: f64 = 1.5;
 
 /// The number of colours of the composite's ramp: the angles analysed (or
 /// the largest count, if a file had more).
-pub fn ramp_len(run: &Run) -> usize {
+pub(crate) fn ramp_len(run: &Run) -> usize {
     let max = run.composite.count.iter().copied().max().unwrap_or(0);
     run.summary.angles_deg.len().max(usize::from(max)).max(1)
 }
@@ -127,14 +127,14 @@ pub const BLIND_COLOUR: Rgb = [
 ];
 
 /// The colour of composite count `c` (of [`ramp_len`]).
-pub fn composite_colour(c: u16, n: usize) -> Rgb {
+pub(crate) fn composite_colour(c: u16, n: usize) -> Rgb {
     let rgb = count_colour(usize::from(c), n);
     [rgb.0, rgb.1, rgb.2]
 }
 
 /// Renders every view of `run`, the small multiples from `masks` (angle in
 /// degrees and its mask).
-pub fn render_views(run: &Run, masks: &[(f64, NodeCounts)]) -> Views {
+pub(crate) fn render_views(run: &Run, masks: &[(f64, NodeCounts)]) -> Views {
     let started = std::time::Instant::now();
     let tris = &run.part.triangles;
     let n = ramp_len(run);
@@ -205,7 +205,7 @@ pub fn render_views(run: &Run, masks: &[(f64, NodeCounts)]) -> Views {
 /// The angles of the small multiples: the analysed angles nearest to -30,
 /// 0 and +30 degrees (the paper's Figure 12), each once, in increasing
 /// order.
-pub fn small_multiple_angles(angles: &[f64]) -> Vec<f64> {
+pub(crate) fn small_multiple_angles(angles: &[f64]) -> Vec<f64> {
     let mut chosen: Vec<f64> = [-30.0, 0.0, 30.0]
         .iter()
         .filter_map(|&want: &f64| {

@@ -125,7 +125,8 @@ pub fn parse(text: &str, path: &Path) -> Result<ScenarioFile, ScenarioError> {
 
 /// Loads the scenario file at `path` and tessellates it
 /// ([`ScenarioFile::triangulate`]).
-pub fn triangles_from_file(
+#[cfg(test)]
+fn triangles_from_file(
     path: &Path,
     min_triangles: Option<usize>,
 ) -> Result<Vec<Triangle>, ScenarioError> {

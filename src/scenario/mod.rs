@@ -38,12 +38,11 @@ mod primitive;
 mod library_tests;
 
 pub use builtin::{PAPER_TRIANGLES, builtin, builtin_names};
-pub use file::{
-    Extent, MAX_TRIANGLES, ScenarioError, ScenarioFile, is_scenario_file, load, parse,
-    triangles_from_file,
-};
-pub use lattice::{axis, tessellate};
-pub use primitive::{Boss, Bump, Console, Feature, Groove, Plane, Rib, Ridge, Step, Wave};
+pub use file::ScenarioError;
+pub use file::{Extent, MAX_TRIANGLES, ScenarioFile, is_scenario_file, load, parse};
+#[cfg(test)]
+pub(crate) use lattice::axis;
+pub use lattice::tessellate;
 
 #[cfg(test)]
 mod tests {

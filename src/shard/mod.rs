@@ -146,7 +146,7 @@ pub struct ShardRecord {
 }
 
 /// The format [`write_shard`] writes and [`merge`] reads.
-pub const FORMAT: u32 = 2;
+pub(crate) const FORMAT: u32 = 2;
 
 const MAGIC: &[u8; 16] = b"kneeform shard 2";
 

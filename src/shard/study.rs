@@ -44,7 +44,7 @@ use crate::output::{OutputDir, WriteError};
 /// `shard.json` of a study's shard.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StudyRecord {
-    /// The format of the shard's files ([`FORMAT`]; 4: pairs carry their
+    /// The format of the shard's files (`FORMAT`; 4: pairs carry their
     /// miss at half the pitch and the points it sets apart).
     pub format: u32,
     /// Which shard of how many.
@@ -72,7 +72,7 @@ pub struct StudyRecord {
 }
 
 /// The format [`write_study_shard`] writes and [`merge_study`] reads.
-pub const FORMAT: u32 = 4;
+pub(crate) const FORMAT: u32 = 4;
 
 const MAGIC: &[u8; 16] = b"kneeform study 4";
 
