@@ -7,7 +7,7 @@
 //! the knee has a smaller y**.
 //!
 //! The scenario files are the only definition of the parts: the library in
-//! `scenarios/*.toml`, one part per file, each a sum of named [`Feature`]
+//! `scenarios/*.toml`, one part per file, each a sum of named `Feature`
 //! primitives (plane, wave, bump, boss, ridge, groove, rib, step, console)
 //! over an [`Extent`] with its tessellation step and a one-line
 //! description. This module offers:
