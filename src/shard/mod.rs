@@ -303,20 +303,8 @@ struct Header {
 /// Reads the shard directories `dirs` (one per shard, in any order) and
 /// merges them into the whole run's results.
 pub fn merge(dirs: &[PathBuf]) -> Result<Merged, ShardError> {
-    let shards = dirs
-        .iter()
-        .map(|d| read_shard(d))
-        .collect::<Result<Vec<_>, _>>()?;
-    let first = shards
-        .first()
-        .ok_or_else(|| ShardError::Mismatch("no shard directory given".into()))?;
-    let identity = identity(&first.record.summary);
-    let sets: Vec<(Shard, &Path)> = shards
-        .iter()
-        .map(|s| (s.record.shard, s.dir.as_path()))
-        .collect();
-    check_set(&sets, "run", |k| {
-        let s = &shards[k];
+    let shards = read_set(dirs, "run", read_shard, |first, s| {
+        let identity = identity(&first.record.summary);
         if let Some(key) = first_difference(&identity, &self::identity(&s.record.summary)) {
             return Err(ShardError::Mismatch(format!(
                 "{} and {} are shards of different runs (their summaries' `{key}` differ)",
@@ -333,6 +321,7 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, ShardError> {
         }
         Ok(())
     })?;
+    let first = &shards[0];
     let summary = &first.record.summary;
     let angles = &summary.angles_deg;
     let header = first.header;
@@ -454,6 +443,42 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, ShardError> {
         blind_spots,
         summary: merged,
     })
+}
+
+/// A shard directory as a merge has read it.
+pub(crate) trait ShardDir {
+    /// Which shard it holds.
+    fn shard(&self) -> Shard;
+    /// Where it was read from.
+    fn dir(&self) -> &Path;
+}
+
+impl ShardDir for ShardFiles {
+    fn shard(&self) -> Shard {
+        self.record.shard
+    }
+    fn dir(&self) -> &Path {
+        &self.dir
+    }
+}
+
+/// Reads the shard directories `dirs` (one per shard, in any order) with
+/// `read` and checks that they are every shard of one `set` (a run, a
+/// study) exactly once: one shard count N, each index once, and each
+/// directory `same` as the first (`same(first, other)`).
+pub(crate) fn read_set<T: ShardDir>(
+    dirs: &[PathBuf],
+    set: &str,
+    read: impl Fn(&Path) -> Result<T, ShardError>,
+    same: impl Fn(&T, &T) -> Result<(), ShardError>,
+) -> Result<Vec<T>, ShardError> {
+    let shards = dirs
+        .iter()
+        .map(|d| read(d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let sets: Vec<(Shard, &Path)> = shards.iter().map(|s| (s.shard(), s.dir())).collect();
+    check_set(&sets, set, |k| same(&shards[0], &shards[k]))?;
+    Ok(shards)
 }
 
 /// Checks that `shards` (each one's K/N and directory; the first is the

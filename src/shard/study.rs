@@ -31,7 +31,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::codec::{Reader, put_direct_pair, put_f64, put_f64s, put_pair, put_points, put_u64};
-use super::{Shard, ShardError, check_set, first_difference, hex_sha256};
+use super::{Shard, ShardDir, ShardError, first_difference, hex_sha256, read_set};
 use crate::grid::GridSpec;
 use crate::harness::metrics::TieBand;
 use crate::harness::sharded::{
@@ -207,33 +207,32 @@ struct StudyFiles {
     part: StudyPart,
 }
 
+impl ShardDir for StudyFiles {
+    fn shard(&self) -> Shard {
+        self.record.shard
+    }
+    fn dir(&self) -> &Path {
+        &self.dir
+    }
+}
+
 /// Reads the study shard directories `dirs` (one per shard, in any
 /// order) and merges them into the whole study, as the unsharded command
 /// computes it (clock readings aside).
 pub fn merge_study(dirs: &[PathBuf]) -> Result<MergedStudy, ShardError> {
-    let shards = dirs
-        .iter()
-        .map(|d| read_study(d))
-        .collect::<Result<Vec<_>, _>>()?;
-    let first = shards
-        .first()
-        .ok_or_else(|| ShardError::Mismatch("no shard directory given".into()))?;
-    let identity = identity(&first.record);
-    let sets: Vec<(Shard, &Path)> = shards
-        .iter()
-        .map(|s| (s.record.shard, s.dir.as_path()))
-        .collect();
-    check_set(&sets, "study", |k| {
-        let s = &shards[k];
-        match first_difference(&identity, &self::identity(&s.record)) {
+    let shards = read_set(
+        dirs,
+        "study",
+        read_study,
+        |first, s| match first_difference(&identity(&first.record), &identity(&s.record)) {
             Some(key) => Err(ShardError::Mismatch(format!(
                 "{} and {} are shards of different studies (their `{key}` differ)",
                 first.dir.display(),
                 s.dir.display()
             ))),
             None => Ok(()),
-        }
-    })?;
+        },
+    )?;
     // In shard order: shard K's share is parts[K - 1].
     let mut shards = shards;
     shards.sort_by_key(|s| s.record.shard.index);
