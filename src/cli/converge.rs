@@ -5,7 +5,6 @@
 use std::process::ExitCode;
 
 use anyhow::Context;
-use kneeform::Approach;
 use kneeform::harness::{self, ConvergeOptions};
 use kneeform::output;
 
@@ -36,39 +35,32 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
         tolerance: args.tolerance,
         budget_s: args.budget_s,
     };
-    let shard = super::study_shard(&args.study)?;
-    let (input, setup) = super::study_inputs(&args.study, options.validate())?;
-    if setup.approach == Approach::Direct {
-        if args.budget_s.is_some() {
-            // The direct study casts once per position: no sample predicts it.
+    let command = super::StudyCommand {
+        slide_shard: harness::converge_shard,
+        direct_shard: harness::converge_direct_shard,
+        slide: &|input, setup| {
+            let study = harness::converge(input, setup, &options, &Bars::default())
+                .map_err(super::harness_error)?;
             eprintln!(
-                "kneeform: warning: --budget-s is not applied with --approach direct (one cast per knee position; --shard fans it out)"
+                "exact oracle: {} starts x {} angles in {:.1} s",
+                study.summary.starts,
+                setup.angles.len(),
+                study.oracle_s
             );
-        }
-        if let Some(shard) = shard {
-            let part =
-                harness::converge_direct_shard(&input, &setup, &options, shard, &Bars::default())
-                    .map_err(super::harness_error)?;
-            return super::write_study_shard(&args.out, &part);
-        }
-        return run_direct(args, &input, &setup, &options);
-    }
-    if let Some(shard) = shard {
-        let part = harness::converge_shard(&input, &setup, &options, shard, &Bars::default())
-            .map_err(super::harness_error)?;
-        return super::write_study_shard(&args.out, &part);
-    }
-    let study = harness::converge(&input, &setup, &options, &Bars::default())
-        .map_err(super::harness_error)?;
-    eprintln!(
-        "exact oracle: {} starts x {} angles in {:.1} s",
-        study.summary.starts,
-        setup.angles.len(),
-        study.oracle_s
-    );
-    output::write_convergence(&args.out, &study)?;
-    super::study::print_convergence(&study, &args.out);
-    Ok(ExitCode::SUCCESS)
+            output::write_convergence(&args.out, &study)?;
+            super::study::print_convergence(&study, &args.out);
+            Ok(ExitCode::SUCCESS)
+        },
+        direct: &|input, setup| run_direct(args, input, setup, &options),
+    };
+    super::run_study(
+        &args.study,
+        &args.out,
+        &options,
+        options.validate(),
+        args.budget_s,
+        command,
+    )
 }
 
 /// `converge --approach direct`: the grid's first contacts against the

@@ -75,6 +75,57 @@ pub fn study_shard(study: &StudyArgs) -> anyhow::Result<Option<Shard>> {
         .context("--shard")
 }
 
+/// A study's shard of one approach: `verify_shard`, `converge_shard` and
+/// their direct twins.
+pub type ShardFn<O> =
+    fn(&PartFile, &Setup, &O, Shard, &dyn kneeform::Progress) -> Result<StudyPart, HarnessError>;
+
+/// What `verify` and `converge` run, per approach: its shard, and the
+/// whole study with its writers and console lines (the exit code).
+pub struct StudyCommand<'a, O> {
+    pub slide_shard: ShardFn<O>,
+    pub direct_shard: ShardFn<O>,
+    pub slide: &'a dyn Fn(&PartFile, &Setup) -> anyhow::Result<ExitCode>,
+    pub direct: &'a dyn Fn(&PartFile, &Setup) -> anyhow::Result<ExitCode>,
+}
+
+/// Runs a study command: reads its part and setup (`check`: its options'
+/// own validation), then its shard when `--shard` is given (written to
+/// `out`), else the whole study, of the setup's approach. `--budget-s`
+/// does not apply to the direct approach, which says so.
+pub fn run_study<O>(
+    study: &StudyArgs,
+    out: &Path,
+    options: &O,
+    check: Result<(), HarnessError>,
+    budget_s: Option<f64>,
+    command: StudyCommand<O>,
+) -> anyhow::Result<ExitCode> {
+    let shard = study_shard(study)?;
+    let (input, setup) = study_inputs(study, check)?;
+    let direct = setup.approach == kneeform::Approach::Direct;
+    if direct && budget_s.is_some() {
+        // The direct study casts once per position: no sample predicts it.
+        eprintln!(
+            "kneeform: warning: --budget-s is not applied with --approach direct (one cast per knee position; --shard fans it out)"
+        );
+    }
+    match (shard, direct) {
+        (Some(shard), _) => {
+            let of = if direct {
+                command.direct_shard
+            } else {
+                command.slide_shard
+            };
+            let part = of(&input, &setup, options, shard, &progress::Bars::default())
+                .map_err(harness_error)?;
+            write_study_shard(out, &part)
+        }
+        (None, true) => (command.direct)(&input, &setup),
+        (None, false) => (command.slide)(&input, &setup),
+    }
+}
+
 /// Writes a study's shard into `out` (staged: it appears whole or not at
 /// all) and says so.
 pub fn write_study_shard(out: &Path, part: &StudyPart) -> anyhow::Result<ExitCode> {

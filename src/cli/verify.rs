@@ -4,7 +4,6 @@
 
 use std::process::ExitCode;
 
-use kneeform::Approach;
 use kneeform::harness::{self, VerifyOptions};
 use kneeform::output;
 
@@ -20,32 +19,25 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
             .unwrap_or_else(|| sampling_tolerance(&args.study)),
         budget_s: args.budget_s,
     };
-    let shard = super::study_shard(&args.study)?;
-    let (input, setup) = super::study_inputs(&args.study, options.validate())?;
-    if setup.approach == Approach::Direct {
-        if args.budget_s.is_some() {
-            // The direct study casts once per position: no sample predicts it.
-            eprintln!(
-                "kneeform: warning: --budget-s is not applied with --approach direct (one cast per knee position; --shard fans it out)"
-            );
-        }
-        if let Some(shard) = shard {
-            let part =
-                harness::verify_direct_shard(&input, &setup, &options, shard, &Bars::default())
-                    .map_err(super::harness_error)?;
-            return super::write_study_shard(&args.out, &part);
-        }
-        return run_direct(args, &input, &setup, &options);
-    }
-    if let Some(shard) = shard {
-        let part = harness::verify_shard(&input, &setup, &options, shard, &Bars::default())
-            .map_err(super::harness_error)?;
-        return super::write_study_shard(&args.out, &part);
-    }
-    let result = harness::verify(&input, &setup, &options, &Bars::default())
-        .map_err(super::harness_error)?;
-    output::write_verification(&args.out, &result)?;
-    Ok(super::study::print_verification(&result, &args.out))
+    let command = super::StudyCommand {
+        slide_shard: harness::verify_shard,
+        direct_shard: harness::verify_direct_shard,
+        slide: &|input, setup| {
+            let result = harness::verify(input, setup, &options, &Bars::default())
+                .map_err(super::harness_error)?;
+            output::write_verification(&args.out, &result)?;
+            Ok(super::study::print_verification(&result, &args.out))
+        },
+        direct: &|input, setup| run_direct(args, input, setup, &options),
+    };
+    super::run_study(
+        &args.study,
+        &args.out,
+        &options,
+        options.validate(),
+        args.budget_s,
+        command,
+    )
 }
 
 /// `verify`'s default tolerance ([`harness::sampling_tolerance`]). Under
