@@ -15,9 +15,9 @@
 //! the clipping's rounding): a triangle it rejects is further than that from
 //! the swept volume, so GJK's cast would report no impact within the travel
 //! and the confirming contact query no overlap; the cast returns what it
-//! returned before, without them. Measured on the console (12 starts x 3
-//! angles): 79% of the triangles the BVH handed to GJK were misses, each
-//! then confirmed by a contact query on the swept shape.
+//! returned before, without them. Most triangles the BVH hands to GJK are
+//! such misses, each of which a contact query on the swept shape had to
+//! confirm (measured: `results/design.md`, "The oracle's prune").
 
 use parry3d_f64::math::Vector;
 

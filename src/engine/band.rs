@@ -150,10 +150,9 @@ dispatch! {
     ///
     /// A block is 128 starts with AVX-512 (eight registers of ranks), 64
     /// with AVX2 (eight), 16 without: wider blocks walk the footprint's
-    /// offsets fewer times. Measured on AVX2 (11 angles, one thread): 64
-    /// about 5% faster than 32 and level with 128 (the noise is about
-    /// 10%); 16 slower. [`LANE_SLACK`](crate::engine::padded::LANE_SLACK) covers the
-    /// widest block.
+    /// offsets fewer times (measured: `results/design.md`, "Block
+    /// widths"). [`LANE_SLACK`](crate::engine::padded::LANE_SLACK) covers
+    /// the widest block.
     pub(super) fn fast_band(padded: &PaddedGrid, fast: &Fast, fp: &GridFootprint, band: &[usize], window: usize, visits: &ProbeVisits, out: BandOut) -> usize => fast_band_impl::<128, 64, 16>
 }
 

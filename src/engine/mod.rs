@@ -98,11 +98,9 @@ const LANES: usize = 16;
 /// flat in the thread count. Deciding strikes per window costs one pass
 /// over `(BAND_ROWS + footprint rows) / BAND_ROWS` times the grid per
 /// angle. Within a band every block of starts is swept over all its start
-/// rows, so the footprint rows they share stay in cache. On the README run
-/// (2 threads, median of 3), 512 rows took 4.72 s of processor time
-/// against 4.91 for 128 (wall 2.77 s against 2.88), the window's passes
-/// being fewer; 1024 was a little faster again but held 401 MiB at 16
-/// threads (issue 11 allows 400), 512 held 311.
+/// rows, so the footprint rows they share stay in cache. Taller bands
+/// pass over the grid fewer times but hold more memory per thread; 512
+/// was measured against 128 and 1024 (`results/design.md`, "Band rows").
 pub(crate) const BAND_ROWS: usize = 512;
 
 /// Runs push and slide for every footprint (one per angle) on `grid`.
