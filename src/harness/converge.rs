@@ -12,7 +12,7 @@ use super::compare::{
     CompareOptions, Comparison, GridSide, PairResult, StartSelection, assemble, pair_results,
 };
 use super::metrics::{METRICS, TieBand};
-use super::sharded::{Pairs, PitchPart};
+use super::pairs::{Pairs, PitchPart};
 use super::verify::{
     check_selection, check_tie_band, check_tolerance, oracle_options, run_oracle, start_positions,
     tie_band_rule,
@@ -276,7 +276,7 @@ impl<'a> Ladder<'a> {
         let coarse_grid = HeightGrid::sample(triangles, coarse);
         let all_starts = start_positions(&coarse_grid, &setup.footprints(&coarse), selection)?;
         drop(coarse_grid);
-        let starts = super::sharded::share(&all_starts, shard)?;
+        let starts = super::pairs::share(&all_starts, shard)?;
         let oracle = oracle_options(&setup.knee, finest, coarse.x(0));
         let (traces, oracle_s) = match oracle_budget_s {
             None => run_oracle(

@@ -44,7 +44,8 @@ use super::HarnessError;
 use super::compare::{StartSelection, choose_nodes, node_at};
 use super::converge::{Fit, fit_power_law};
 use super::metrics::{nearest_rank, sorted_abs};
-use super::sharded::{NO_BAND, Pairs, PitchPart, StudyPart, StudySummary, share, study_settings};
+use super::pairs::share;
+pub(crate) use super::pairs::{DirectPair, DirectRow};
 use super::verify::{check_selection, check_tolerance};
 use super::{ConvergeOptions, VerifyOptions};
 use crate::analysis::Progress;
@@ -197,36 +198,6 @@ impl DirectStats {
     }
 }
 
-/// One position at one angle: both sides' first contacts and the errors.
-/// Positions and points in mm, in the placed part's frame.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct DirectRow {
-    /// The position's y (the centre of the knee-form's width).
-    pub y: f64,
-    /// The position's z (the reference point's height).
-    pub z: f64,
-    /// Angle (degrees).
-    pub angle_deg: f64,
-    /// `both`, `grid_only`, `exact_only`, `neither` or `oracle_failed`.
-    pub status: String,
-    /// The grid's `X* = -Y*` (the reference point's x at first contact).
-    pub grid_level: Option<f64>,
-    /// The exact `X*`.
-    pub exact_level: Option<f64>,
-    /// `|Y*_grid - Y*_exact|`.
-    pub level_error: Option<f64>,
-    /// The exact contact point's y and z.
-    pub exact_y: Option<f64>,
-    /// See `exact_y`.
-    pub exact_z: Option<f64>,
-    /// From the exact contact to the nearest grid-contacted node, in y-z.
-    pub contact_distance: Option<f64>,
-    /// Grid-contacted nodes (ties within `e0`).
-    pub grid_contacted: usize,
-    /// Exact contact points (ties within `e0` of travel).
-    pub exact_ties: usize,
-}
-
 /// Counts of a direct comparison.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct DirectCounts {
@@ -278,17 +249,6 @@ impl DirectComparison {
             .find(|(m, _)| m == name)
             .map_or_else(DirectStats::default, |(_, s)| *s)
     }
-}
-
-/// One position at one angle as a shard keeps it: its row, and whether
-/// the engine's level there is not the transcription's (which the row
-/// does not say). A comparison is [`assemble_direct`]d from these alone.
-#[derive(Debug, Clone, PartialEq)]
-pub struct DirectPair {
-    /// The row.
-    pub row: DirectRow,
-    /// The engine's level differs from the transcription's, to the bit.
-    pub engine_mismatch: bool,
 }
 
 /// The statuses of a [`DirectRow`].
@@ -443,10 +403,10 @@ pub(crate) fn direct_oracle_options(knee: &KneeForm, e0: f64) -> DirectOptions {
 
 /// The rotated part's grid at `setup`'s pitch, its footprints, and the
 /// positions of `selection` on it (mm).
-struct DirectStudy {
+pub(super) struct DirectStudy {
     part: Part,
-    spec: GridSpec,
-    positions: Vec<[f64; 2]>,
+    pub(super) spec: GridSpec,
+    pub(super) positions: Vec<[f64; 2]>,
 }
 
 impl DirectStudy {
@@ -577,7 +537,7 @@ pub struct DirectVerification {
 /// The direct verification of `shard`'s share of the positions (all of
 /// them without a shard): the study, the share's pairs, the seconds of
 /// their grid side and of the oracle.
-fn verify_pairs(
+pub(super) fn verify_pairs(
     input: &PartFile,
     setup: &Setup,
     options: &VerifyOptions,
@@ -605,7 +565,11 @@ impl DirectVerifySummary {
     /// `verify.json` of `input`, `setup` and `options` before any
     /// comparison: no pass, no statistics, no counts, no seconds
     /// ([`DirectVerifySummary::set_comparison`] sets them).
-    fn new(input: &PartFile, setup: &Setup, options: &VerifyOptions) -> DirectVerifySummary {
+    pub(super) fn new(
+        input: &PartFile,
+        setup: &Setup,
+        options: &VerifyOptions,
+    ) -> DirectVerifySummary {
         let (starts, seed) = super::verify::selection_words(&options.selection);
         DirectVerifySummary {
             approach: "direct".into(),
@@ -657,48 +621,6 @@ pub fn verify_direct(
     Ok(DirectVerification {
         comparison,
         summary,
-    })
-}
-
-/// [`verify_direct`] of `shard`'s share of the positions only: the
-/// positions `s` (0-based, in the study's order, after sampling) with
-/// `s % N == K - 1`, the oracle run on those alone.
-pub fn verify_direct_shard(
-    input: &PartFile,
-    setup: &Setup,
-    options: &VerifyOptions,
-    shard: Shard,
-    progress: &dyn Progress,
-) -> Result<StudyPart, HarnessError> {
-    let (study, pairs, grid_s, oracle_s) =
-        verify_pairs(input, setup, options, Some(shard), progress)?;
-    // The study's identity and settings, the shard's own seconds; its
-    // statistics are the merge's.
-    let mut summary = DirectVerifySummary::new(input, setup, options);
-    summary.grid_s = grid_s;
-    summary.oracle_s = oracle_s;
-    Ok(StudyPart {
-        shard,
-        spec: study.spec,
-        pitches: vec![PitchPart {
-            pitch: setup.pitch,
-            pairs: Pairs::Direct(pairs),
-            band: NO_BAND,
-            grid_s,
-            seconds: 0.0,
-            nodes: study.spec.len(),
-        }],
-        starts: study.positions,
-        angles_deg: setup.angles.clone(),
-        settings: study_settings(
-            &options.selection,
-            options.tie_band_per_mm,
-            Some(options.tolerance),
-            vec![setup.pitch],
-        ),
-        summary: StudySummary::VerifyDirect(summary),
-        sample_s: 0.0,
-        oracle_s,
     })
 }
 
@@ -759,11 +681,11 @@ pub struct DirectConvergence {
 
 /// One pitch of a direct convergence study on some positions: its pairs,
 /// not yet assembled, and what was measured.
-struct DirectPitchPairs {
-    pitch: f64,
-    pairs: Vec<DirectPair>,
-    grid_s: f64,
-    nodes: usize,
+pub(super) struct DirectPitchPairs {
+    pub(super) pitch: f64,
+    pub(super) pairs: Vec<DirectPair>,
+    pub(super) grid_s: f64,
+    pub(super) nodes: usize,
 }
 
 impl DirectPitchPairs {
@@ -775,24 +697,12 @@ impl DirectPitchPairs {
             nodes: self.nodes,
         }
     }
-
-    /// The pitch as a shard keeps it.
-    fn part(self) -> PitchPart {
-        PitchPart {
-            pitch: self.pitch,
-            pairs: Pairs::Direct(self.pairs),
-            band: NO_BAND,
-            grid_s: self.grid_s,
-            seconds: 0.0,
-            nodes: self.nodes,
-        }
-    }
 }
 
 /// The direct convergence study's pitches on `shard`'s share of the
 /// positions (all of them without a shard), coarsest first: the study,
 /// each pitch's pairs, and the oracle's seconds.
-fn converge_pairs(
+pub(super) fn converge_pairs(
     input: &PartFile,
     setup: &Setup,
     options: &ConvergeOptions,
@@ -848,7 +758,7 @@ impl DirectConvergeSummary {
     /// `converge.json` of `input`, `setup` and `options` with `starts`
     /// positions before any comparison: no fits, no recommended pitch
     /// ([`DirectConvergeSummary::set_results`] sets them).
-    fn new(
+    pub(super) fn new(
         input: &PartFile,
         setup: &Setup,
         options: &ConvergeOptions,
@@ -922,38 +832,6 @@ pub fn converge_direct(
         DirectConvergeSummary::new(input, setup, options, study.positions.len(), oracle_s);
     summary.set_results(&results);
     Ok(DirectConvergence { results, summary })
-}
-
-/// [`converge_direct`] of `shard`'s share of the positions only (as
-/// [`verify_direct_shard`]), every pitch compared on the share.
-pub fn converge_direct_shard(
-    input: &PartFile,
-    setup: &Setup,
-    options: &ConvergeOptions,
-    shard: Shard,
-    progress: &dyn Progress,
-) -> Result<StudyPart, HarnessError> {
-    let (study, pitches, oracle_s) = converge_pairs(input, setup, options, Some(shard), progress)?;
-    // The study's identity and settings, the shard's own oracle seconds;
-    // its fits are the merge's.
-    let summary =
-        DirectConvergeSummary::new(input, setup, options, study.positions.len(), oracle_s);
-    Ok(StudyPart {
-        shard,
-        spec: study.spec,
-        starts: study.positions,
-        angles_deg: setup.angles.clone(),
-        pitches: pitches.into_iter().map(DirectPitchPairs::part).collect(),
-        settings: study_settings(
-            &options.selection,
-            options.tie_band_per_mm,
-            options.tolerance,
-            options.pitches.clone(),
-        ),
-        summary: StudySummary::ConvergeDirect(summary),
-        sample_s: 0.0,
-        oracle_s,
-    })
 }
 
 #[cfg(test)]

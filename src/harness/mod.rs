@@ -18,8 +18,10 @@
 //! * `metrics`: push, first-contact, miss and false-alarm errors, the
 //!   tie band, the area distance;
 //! * `nearest`: a 2-d tree for the area distance's nearest points;
+//! * `pairs`: what a study compares per start and angle, and per pitch,
+//!   for either approach, and a shard's share of the starts;
 //! * `sharded`: a study's starts fanned out over shards
-//!   (`verify --shard K/N`) and merged back.
+//!   (`verify --shard K/N`, either approach) and merged back.
 //!
 //! **Invariant:** the harness reads the engine's grid and the oracle's
 //! traces and computes neither side's geometry, with one exception stated
@@ -36,6 +38,7 @@ pub(crate) mod converge;
 pub(crate) mod direct;
 pub(crate) mod metrics;
 pub(crate) mod nearest;
+pub(crate) mod pairs;
 pub(crate) mod sharded;
 pub(crate) mod trace;
 pub(crate) mod verify;
@@ -49,11 +52,12 @@ pub use check::check_analysis;
 pub use compare::{Comparison, StartSelection};
 pub use converge::{ConvergeOptions, Convergence, ROUNDING_MM, converge, fit_power_law};
 pub use direct::{
-    DIRECT_METRICS, DirectConvergence, DirectVerification, converge_direct, converge_direct_shard,
-    verify_direct, verify_direct_shard,
+    DIRECT_METRICS, DirectConvergence, DirectVerification, converge_direct, verify_direct,
 };
 pub use metrics::{DECIDED_METRICS, METRICS, TieBand};
-pub use sharded::{StudyPart, converge_shard, verify_shard};
+pub use sharded::{
+    StudyPart, converge_direct_shard, converge_shard, verify_direct_shard, verify_shard,
+};
 pub use verify::{Verification, VerifyOptions, oracle_options, sampling_tolerance, verify};
 
 use serde::{Deserialize, Serialize};

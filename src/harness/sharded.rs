@@ -29,67 +29,17 @@ use super::HarnessError;
 use super::compare::{GridSide, PairResult, StartSelection, assemble, pair_results};
 use super::converge::{ConvergeOptions, ConvergeSummary, Convergence, Ladder, PitchResult};
 use super::direct::{
-    DirectConvergeSummary, DirectConvergence, DirectPair, DirectPitchResult, DirectVerification,
-    DirectVerifySummary, assemble_direct,
+    DirectConvergeSummary, DirectConvergence, DirectPitchPairs, DirectPitchResult,
+    DirectVerification, DirectVerifySummary, assemble_direct, converge_pairs, verify_pairs,
 };
 use super::metrics::TieBand;
+use super::pairs::{DirectPair, NO_BAND, Pairs, PitchPart};
 use super::verify::{Traced, Verification, VerifyOptions, VerifySummary};
 use crate::analysis::Progress;
 use crate::grid::GridSpec;
 use crate::input::PartFile;
 use crate::partition::Shard;
 use crate::setup::Setup;
-
-/// The pairs of one pitch of a share, angle-major over the share's starts.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Pairs {
-    /// Push-and-slide's start-angle pairs.
-    Slide(Vec<PairResult>),
-    /// The direct approach's position-angle pairs.
-    Direct(Vec<DirectPair>),
-}
-
-impl Pairs {
-    /// How many pairs.
-    pub fn len(&self) -> usize {
-        match self {
-            Pairs::Slide(p) => p.len(),
-            Pairs::Direct(p) => p.len(),
-        }
-    }
-
-    /// Whether there is none.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-}
-
-/// The tie band of a direct study's pitch, which has none (the knee does
-/// not slide): zero.
-pub(super) const NO_BAND: TieBand = TieBand {
-    sigma: 0.0,
-    m: 0.0,
-    pitch: 0.0,
-};
-
-/// One pitch of a share: its start-angle pairs, angle-major over the
-/// share's starts, and what was timed.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PitchPart {
-    /// The pitch (mm).
-    pub pitch: f64,
-    /// The pairs compared, angle-major over the share's starts.
-    pub pairs: Pairs,
-    /// The tie band at this pitch (zero for the direct approach).
-    pub band: TieBand,
-    /// Seconds on the grid side of the comparison.
-    pub grid_s: f64,
-    /// Seconds of the engine's full push and slide at this pitch (a
-    /// convergence study times it; a verification does not: 0).
-    pub seconds: f64,
-    /// Grid nodes at this pitch.
-    pub nodes: usize,
-}
 
 /// A shard's summary: `verify.json` or `converge.json` as the shard knows
 /// it: the part's identity, every setting and the shard's own timings,
@@ -149,25 +99,6 @@ pub struct StudyPart {
     pub sample_s: f64,
     /// Seconds of the oracle on the share's starts.
     pub oracle_s: f64,
-}
-
-/// `shard`'s share of `all` (all of it without a shard); an error when a
-/// shard would have no start.
-pub(super) fn share(all: &[[f64; 2]], shard: Option<Shard>) -> Result<Vec<[f64; 2]>, HarnessError> {
-    let Some(shard) = shard else {
-        return Ok(all.to_vec());
-    };
-    if shard.count > all.len() {
-        return Err(HarnessError::TooManyShards {
-            shards: shard.count,
-            starts: all.len(),
-        });
-    }
-    Ok(shard
-        .indices(all.len())
-        .into_iter()
-        .map(|s| all[s])
-        .collect())
 }
 
 /// A study's [`StudySettings`]: `selection` as given, its tie band,
@@ -462,4 +393,90 @@ pub(crate) fn merge_converge_direct(parts: &[StudyPart]) -> Option<DirectConverg
     summary.oracle_s = oracle_s(parts);
     summary.set_results(&results);
     Some(DirectConvergence { results, summary })
+}
+
+/// [`verify_direct`](crate::harness::verify_direct) of `shard`'s share of the positions only: the
+/// positions `s` (0-based, in the study's order, after sampling) with
+/// `s % N == K - 1`, the oracle run on those alone.
+pub fn verify_direct_shard(
+    input: &PartFile,
+    setup: &Setup,
+    options: &VerifyOptions,
+    shard: Shard,
+    progress: &dyn Progress,
+) -> Result<StudyPart, HarnessError> {
+    let (study, pairs, grid_s, oracle_s) =
+        verify_pairs(input, setup, options, Some(shard), progress)?;
+    // The study's identity and settings, the shard's own seconds; its
+    // statistics are the merge's.
+    let mut summary = DirectVerifySummary::new(input, setup, options);
+    summary.grid_s = grid_s;
+    summary.oracle_s = oracle_s;
+    Ok(StudyPart {
+        shard,
+        spec: study.spec,
+        pitches: vec![PitchPart {
+            pitch: setup.pitch,
+            pairs: Pairs::Direct(pairs),
+            band: NO_BAND,
+            grid_s,
+            seconds: 0.0,
+            nodes: study.spec.len(),
+        }],
+        starts: study.positions,
+        angles_deg: setup.angles.clone(),
+        settings: study_settings(
+            &options.selection,
+            options.tie_band_per_mm,
+            Some(options.tolerance),
+            vec![setup.pitch],
+        ),
+        summary: StudySummary::VerifyDirect(summary),
+        sample_s: 0.0,
+        oracle_s,
+    })
+}
+
+/// [`converge_direct`](crate::harness::converge_direct) of `shard`'s share of the positions only (as
+/// [`verify_direct_shard`]), every pitch compared on the share.
+pub fn converge_direct_shard(
+    input: &PartFile,
+    setup: &Setup,
+    options: &ConvergeOptions,
+    shard: Shard,
+    progress: &dyn Progress,
+) -> Result<StudyPart, HarnessError> {
+    let (study, pitches, oracle_s) = converge_pairs(input, setup, options, Some(shard), progress)?;
+    // The study's identity and settings, the shard's own oracle seconds;
+    // its fits are the merge's.
+    let summary =
+        DirectConvergeSummary::new(input, setup, options, study.positions.len(), oracle_s);
+    Ok(StudyPart {
+        shard,
+        spec: study.spec,
+        starts: study.positions,
+        angles_deg: setup.angles.clone(),
+        pitches: pitches.into_iter().map(direct_part).collect(),
+        settings: study_settings(
+            &options.selection,
+            options.tie_band_per_mm,
+            options.tolerance,
+            options.pitches.clone(),
+        ),
+        summary: StudySummary::ConvergeDirect(summary),
+        sample_s: 0.0,
+        oracle_s,
+    })
+}
+
+/// A direct pitch's pairs as a shard keeps them.
+fn direct_part(p: DirectPitchPairs) -> PitchPart {
+    PitchPart {
+        pitch: p.pitch,
+        pairs: Pairs::Direct(p.pairs),
+        band: NO_BAND,
+        grid_s: p.grid_s,
+        seconds: 0.0,
+        nodes: p.nodes,
+    }
 }

@@ -324,7 +324,7 @@ impl Traced {
         let footprints = setup.footprints(&spec);
         let sample_s = t.elapsed().as_secs_f64();
         let all = start_positions(&grid, &footprints, &options.selection)?;
-        let starts = super::sharded::share(&all, shard)?;
+        let starts = super::pairs::share(&all, shard)?;
         let oracle = oracle_options(&setup.knee, setup.pitch, spec.x(0));
         let (traces, oracle_s) = run_oracle(
             triangles,

@@ -34,9 +34,10 @@ use super::codec::{Reader, put_direct_pair, put_f64, put_f64s, put_pair, put_poi
 use super::{Shard, ShardDir, ShardError, first_difference, hex_sha256, read_set};
 use crate::grid::GridSpec;
 use crate::harness::metrics::TieBand;
+use crate::harness::pairs::{Pairs, PitchPart};
 use crate::harness::sharded::{
-    Pairs, PitchPart, StudySettings, StudySummary, merge_converge, merge_converge_direct,
-    merge_verify, merge_verify_direct,
+    StudySettings, StudySummary, merge_converge, merge_converge_direct, merge_verify,
+    merge_verify_direct,
 };
 use crate::harness::{Convergence, DirectConvergence, DirectVerification, StudyPart, Verification};
 use crate::output::{OutputDir, WriteError};
