@@ -2,8 +2,9 @@
 //! grid, the colliding mask per angle, the composite, the warnings and the
 //! summary out ([`Analysis`]).
 //!
-//! This is the pipeline every front end shares (the CLI's `analyze`, the
-//! harness's `verify` and `converge`, the tests, an embedding program):
+//! This is the pipeline every front end shares (the CLI's `analyze` and
+//! `analyze --shard`, the tests, an embedding program; the harness's
+//! studies lay their grids through the same [`Setup`]):
 //! SPEC's default grid extent, the memory check before anything is
 //! allocated, the grid laid and sampled, the footprints laid on that grid,
 //! push and slide, the composite. Progress and warnings go through a

@@ -21,7 +21,7 @@
 //! identity), so such runs give the same bytes as before the flag existed.
 //!
 //! **Invariant:** the engine never sees a frame: parts enter the analysis
-//! frame in [`crate::mesh`], results leave it in [`crate::output`].
+//! frame in [`crate::input`], results leave it in [`crate::output`].
 
 use std::path::{Path, PathBuf};
 

@@ -1,6 +1,6 @@
 //! The exact **direct approach**: the knee-form comes from far in +x and
 //! moves in -x until it first touches the part (issue 12; the definition in
-//! ARCHITECTURE.md, "The direct approach").
+//! README.md, "Two approaches").
 //!
 //! A knee position is `(y0, z0)`: the knee-form's width covers y in
 //! `[y0 - W/2, y0 + W/2]` (closed) and its reference point `v0` lies at

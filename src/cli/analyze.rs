@@ -170,7 +170,7 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         );
     }
     if let Some(check) = &analysis.sample_check {
-        print_check(check);
+        super::print_check(check);
     }
     if args.report {
         // From the committed run, so the analysis stands whatever the
@@ -192,16 +192,4 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// The sample check's line, and its warning where it found the grid beyond
-/// its tolerance.
-pub fn print_check(check: &SampleCheck) {
-    eprintln!("kneeform: {}", check.line());
-    if check.exceeds_tolerance {
-        eprintln!(
-            "kneeform: warning: the sample check found the grid's colliding area further than sqrt 2 pitches ({} mm, `verify`'s default tolerance) from the exact knee-form's; run `kneeform verify` on this part with the same flags for the evidence, or choose a finer pitch (`--pitch auto --tolerance MM`)",
-            kneeform::limits::short(check.tolerance_mm)
-        );
-    }
 }

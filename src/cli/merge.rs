@@ -83,7 +83,7 @@ fn merge_analysis(args: &MergeArgs, out: OutputDir) -> anyhow::Result<ExitCode> 
         args.out.display()
     );
     if let Some(check) = &summary.sample_check {
-        super::analyze::print_check(check);
+        super::print_check(check);
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -126,6 +126,18 @@ pub fn run_study<O>(
     }
 }
 
+/// The sample check's line, and its warning where it found the grid beyond
+/// its tolerance.
+pub fn print_check(check: &kneeform::summary::SampleCheck) {
+    eprintln!("kneeform: {}", check.line());
+    if check.exceeds_tolerance {
+        eprintln!(
+            "kneeform: warning: the sample check found the grid's colliding area further than sqrt 2 pitches ({} mm, `verify`'s default tolerance) from the exact knee-form's; run `kneeform verify` on this part with the same flags for the evidence, or choose a finer pitch (`--pitch auto --tolerance MM`)",
+            kneeform::limits::short(check.tolerance_mm)
+        );
+    }
+}
+
 /// Writes a study's shard into `out` (staged: it appears whole or not at
 /// all) and says so.
 pub fn write_study_shard(out: &Path, part: &StudyPart) -> anyhow::Result<ExitCode> {

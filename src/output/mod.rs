@@ -14,9 +14,10 @@
 //!   never sees a half-written result.
 //!
 //! **Invariant:** nothing here changes a result; writers only format what
-//! the engine computed, mapping y back to the part with [`Side::to_part`].
+//! the engine computed, mapping points back to the part with
+//! [`Placement::to_part`].
 //!
-//! [`Side::to_part`]: crate::frame::Side::to_part
+//! [`Placement::to_part`]: crate::frame::Placement::to_part
 
 use std::io;
 use std::path::{Path, PathBuf};
