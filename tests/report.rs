@@ -499,6 +499,65 @@ fn report_of_a_scenario_run_has_every_section_embeds_every_figure_and_cites_the_
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// The report of real `verify` and `converge` runs (not hand-written
+/// fixtures) finds every value it cites: the JSON pointers it reads stay
+/// those the studies write. A missing one shows as "not in file" with its
+/// place in `data-missing`.
+#[test]
+fn every_value_the_report_cites_from_real_studies_is_in_their_files() {
+    let dir = step_run("report-real-studies", "left");
+    let study = |command: &str, out: &str, extra: &[&str]| {
+        let mut args = vec![
+            command, "part.stl", "--pitch", PITCH, ANGLES, "--starts", "6", "--out", out,
+        ];
+        args.extend_from_slice(extra);
+        // A failing verdict (exit 1) is a study all the same.
+        let run = kneeform(&dir, &args);
+        assert!(
+            matches!(run.status.code(), Some(0 | 1)),
+            "{command}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+    };
+    study("verify", "verify", &[]);
+    study("converge", "converge", &["--pitches", "4,2"]);
+    ok(
+        kneeform(
+            &dir,
+            &[
+                "report",
+                "run",
+                "verify",
+                "converge",
+                "--out",
+                "report.html",
+            ],
+        ),
+        "report",
+    );
+    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    let missing: Vec<&str> = html
+        .split("data-missing=\"")
+        .skip(1)
+        .map(|rest| &rest[..rest.find('"').unwrap_or(rest.len())])
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "cited but not in the files: {missing:?}"
+    );
+    let cited = citations(&html);
+    for file in [
+        "summary.json",
+        "verify[0]/verify.json",
+        "verify[1]/converge.json",
+    ] {
+        assert!(
+            cited.iter().any(|(f, _, _)| f == file),
+            "nothing cited from {file}"
+        );
+    }
+}
+
 #[test]
 fn side_views_are_coloured_exactly_on_the_csv_node_cells() {
     for side in ["left", "right"] {

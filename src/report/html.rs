@@ -61,11 +61,13 @@ pub(crate) fn value_text(v: &Value) -> String {
 
 /// The value at `pointer` in `json` (the contents of `file`), cited:
 /// `<span data-src="file#pointer">text</span>`; a missing value shows as
-/// "not in file", uncited.
+/// "not in file", with the place it was looked for in `data-missing`.
 pub(crate) fn cite(file: &str, json: &Value, pointer: &str) -> Markup {
     match json.pointer(pointer) {
         Some(v) => html! { span data-src={ (file) "#" (pointer) } { (value_text(v)) } },
-        None => html! { span class="missing" { "not in file" } },
+        None => {
+            html! { span class="missing" data-missing={ (file) "#" (pointer) } { "not in file" } }
+        }
     }
 }
 
