@@ -36,6 +36,9 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
         budget_s: args.budget_s,
     };
     let command = super::StudyCommand {
+        options: &options,
+        check: options.validate(),
+        budget_s: args.budget_s,
         slide_shard: harness::converge_shard,
         direct_shard: harness::converge_direct_shard,
         slide: &|input, setup| {
@@ -53,14 +56,7 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
         },
         direct: &|input, setup| run_direct(args, input, setup, &options),
     };
-    super::run_study(
-        &args.study,
-        &args.out,
-        &options,
-        options.validate(),
-        args.budget_s,
-        command,
-    )
+    super::run_study(&args.study, &args.out, command)
 }
 
 /// `converge --approach direct`: the grid's first contacts against the

@@ -81,30 +81,31 @@ pub type ShardFn<O> =
     fn(&PartFile, &Setup, &O, Shard, &dyn kneeform::Progress) -> Result<StudyPart, HarnessError>;
 
 /// What `verify` and `converge` run, per approach: its shard, and the
-/// whole study with its writers and console lines (the exit code).
+/// whole study with its writers and console lines (the exit code); and
+/// the study's own options, checked (`check`), with its `--budget-s`.
 pub struct StudyCommand<'a, O> {
+    pub options: &'a O,
+    pub check: Result<(), HarnessError>,
+    pub budget_s: Option<f64>,
     pub slide_shard: ShardFn<O>,
     pub direct_shard: ShardFn<O>,
     pub slide: &'a dyn Fn(&PartFile, &Setup) -> anyhow::Result<ExitCode>,
     pub direct: &'a dyn Fn(&PartFile, &Setup) -> anyhow::Result<ExitCode>,
 }
 
-/// Runs a study command: reads its part and setup (`check`: its options'
-/// own validation), then its shard when `--shard` is given (written to
-/// `out`), else the whole study, of the setup's approach. `--budget-s`
-/// does not apply to the direct approach, which says so.
+/// Runs a study command: reads its part and setup (and the command's
+/// `check`), then its shard when `--shard` is given (written to `out`),
+/// else the whole study, of the setup's approach. `--budget-s` does not
+/// apply to the direct approach, which says so.
 pub fn run_study<O>(
     study: &StudyArgs,
     out: &Path,
-    options: &O,
-    check: Result<(), HarnessError>,
-    budget_s: Option<f64>,
     command: StudyCommand<O>,
 ) -> anyhow::Result<ExitCode> {
     let shard = study_shard(study)?;
-    let (input, setup) = study_inputs(study, check)?;
+    let (input, setup) = study_inputs(study, command.check)?;
     let direct = setup.approach == kneeform::Approach::Direct;
-    if direct && budget_s.is_some() {
+    if direct && command.budget_s.is_some() {
         // The direct study casts once per position: no sample predicts it.
         eprintln!(
             "kneeform: warning: --budget-s is not applied with --approach direct (one cast per knee position; --shard fans it out)"
@@ -117,8 +118,14 @@ pub fn run_study<O>(
             } else {
                 command.slide_shard
             };
-            let part = of(&input, &setup, options, shard, &progress::Bars::default())
-                .map_err(harness_error)?;
+            let part = of(
+                &input,
+                &setup,
+                command.options,
+                shard,
+                &progress::Bars::default(),
+            )
+            .map_err(harness_error)?;
             write_study_shard(out, &part)
         }
         (None, true) => (command.direct)(&input, &setup),

@@ -20,6 +20,9 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
         budget_s: args.budget_s,
     };
     let command = super::StudyCommand {
+        options: &options,
+        check: options.validate(),
+        budget_s: args.budget_s,
         slide_shard: harness::verify_shard,
         direct_shard: harness::verify_direct_shard,
         slide: &|input, setup| {
@@ -30,14 +33,7 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
         },
         direct: &|input, setup| run_direct(args, input, setup, &options),
     };
-    super::run_study(
-        &args.study,
-        &args.out,
-        &options,
-        options.validate(),
-        args.budget_s,
-        command,
-    )
+    super::run_study(&args.study, &args.out, command)
 }
 
 /// `verify`'s default tolerance ([`harness::sampling_tolerance`]). Under

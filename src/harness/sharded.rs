@@ -395,9 +395,10 @@ pub(crate) fn merge_converge_direct(parts: &[StudyPart]) -> Option<DirectConverg
     Some(DirectConvergence { results, summary })
 }
 
-/// [`verify_direct`](crate::harness::verify_direct) of `shard`'s share of the positions only: the
-/// positions `s` (0-based, in the study's order, after sampling) with
-/// `s % N == K - 1`, the oracle run on those alone.
+/// [`verify_direct`](crate::harness::verify_direct) of `shard`'s share
+/// of the positions only: the positions `s` (0-based, in the study's
+/// order, after sampling) with `s % N == K - 1`, the oracle run on those
+/// alone.
 pub fn verify_direct_shard(
     input: &PartFile,
     setup: &Setup,
@@ -437,8 +438,9 @@ pub fn verify_direct_shard(
     })
 }
 
-/// [`converge_direct`](crate::harness::converge_direct) of `shard`'s share of the positions only (as
-/// [`verify_direct_shard`]), every pitch compared on the share.
+/// [`converge_direct`](crate::harness::converge_direct) of `shard`'s
+/// share of the positions only (as [`verify_direct_shard`]), every pitch
+/// compared on the share.
 pub fn converge_direct_shard(
     input: &PartFile,
     setup: &Setup,
