@@ -635,19 +635,27 @@ pub fn reseal(text: &[u8]) -> Option<Vec<u8>> {
     Some(sealed_json(value).into_bytes())
 }
 
+/// The error of reading `path`.
+pub(crate) fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> ShardError {
+    let path = path.to_path_buf();
+    move |source| ShardError::Io { path, source }
+}
+
+/// A shard directory's `shard.json`, read within its bound and checked
+/// by `check` (a reason when it fails, reported against the file).
+pub(crate) fn read_record<R>(
+    dir: &Path,
+    check: impl FnOnce(&[u8]) -> Result<R, String>,
+) -> Result<R, ShardError> {
+    let path = dir.join("shard.json");
+    let text = crate::limits::read_bounded(&path, crate::limits::MAX_RUN_JSON_BYTES)
+        .map_err(io_error(&path))?;
+    check(&text).map_err(|reason| ShardError::Corrupt { path, reason })
+}
+
 fn read_shard(dir: &Path) -> Result<ShardFiles, ShardError> {
-    let json_path = dir.join("shard.json");
-    let io = |path: &Path| {
-        let path = path.to_path_buf();
-        move |source| ShardError::Io { path, source }
-    };
-    let text = crate::limits::read_bounded(&json_path, crate::limits::MAX_RUN_JSON_BYTES)
-        .map_err(io(&json_path))?;
-    let corrupt = |reason: String| ShardError::Corrupt {
-        path: json_path.clone(),
-        reason,
-    };
-    let record = check_record(&text).map_err(corrupt)?;
+    let io = io_error;
+    let record = read_record(dir, check_record)?;
     let bin_path = dir.join("shard.bin");
     let header = {
         let mut head = [0u8; HEADER_LEN];

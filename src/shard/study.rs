@@ -31,7 +31,9 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::codec::{Reader, put_direct_pair, put_f64, put_f64s, put_pair, put_points, put_u64};
-use super::{Shard, ShardDir, ShardError, first_difference, hex_sha256, read_set};
+use super::{
+    Shard, ShardDir, ShardError, first_difference, hex_sha256, io_error, read_record, read_set,
+};
 use crate::grid::GridSpec;
 use crate::harness::metrics::TieBand;
 use crate::harness::pairs::{Pairs, PitchPart};
@@ -384,19 +386,9 @@ fn identity(record: &StudyRecord) -> serde_json::Value {
 }
 
 fn read_study(dir: &Path) -> Result<StudyFiles, ShardError> {
-    let json_path = dir.join("shard.json");
-    let io = |path: &Path| {
-        let path = path.to_path_buf();
-        move |source| ShardError::Io { path, source }
-    };
-    let text = crate::limits::read_bounded(&json_path, crate::limits::MAX_RUN_JSON_BYTES)
-        .map_err(io(&json_path))?;
-    let record = check_study_record(&text).map_err(|reason| ShardError::Corrupt {
-        path: json_path.clone(),
-        reason,
-    })?;
+    let record = read_record(dir, check_study_record)?;
     let bin_path = dir.join("shard.bin");
-    let bin = crate::limits::read_bounded(&bin_path, MAX_BIN_BYTES).map_err(io(&bin_path))?;
+    let bin = crate::limits::read_bounded(&bin_path, MAX_BIN_BYTES).map_err(io_error(&bin_path))?;
     let part = check_study_bin(&bin, &record).map_err(|reason| ShardError::Corrupt {
         path: bin_path.clone(),
         reason,
