@@ -3,6 +3,7 @@
 //! their difference ([`compare_grid_with`]).
 
 use std::collections::HashSet;
+use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use kneeform_oracle::{StartStatus, StartTrace};
@@ -598,6 +599,7 @@ pub(crate) fn pair_results(
     let pairs: Vec<(usize, usize)> = (0..footprints.len())
         .flat_map(|a| (0..nodes.len()).map(move |s| (a, s)))
         .collect();
+    let bands = HalfPitchBands::new(triangles, options.blind_depth);
     Ok(pairs
         .par_iter()
         .map(|&(a, s)| {
@@ -615,7 +617,7 @@ pub(crate) fn pair_results(
                     .is_some_and(|d| d.is_finite() && d > reach)
             {
                 cmp.miss_half_pitch = Some(inside_miss_at_half_pitch(
-                    triangles,
+                    &bands,
                     grid,
                     fp.angle_deg,
                     (i, j),
@@ -660,7 +662,7 @@ pub(crate) fn pair_results(
 /// indices doubled) and only the rows the footprint covers from the start:
 /// the slide of this start sees the same nodes as on the whole finer grid.
 fn inside_miss_at_half_pitch(
-    triangles: &[Triangle],
+    bands: &HalfPitchBands,
     grid: &HeightGrid,
     angle_deg: f64,
     (i, j): (usize, usize),
@@ -687,13 +689,76 @@ fn inside_miss_at_half_pitch(
         nz: (hi - lo + 1) as usize,
         ..whole
     };
-    let fine = HeightGrid::sample(triangles, band);
-    let g = grid_trace(&fine, &fp, 2 * i, (j2 - lo) as usize, &options.rule, fault);
+    let sampled = bands.get((angle_deg.to_bits(), lo, hi), band);
+    let (fine, cells) = sampled.get().expect("the band is made");
+    let g = grid_trace(fine, &fp, 2 * i, (j2 - lo) as usize, &options.rule, fault);
     let ties = TieBand::new(options.rule.sigma, band.pitch, options.tie_band_per_mm);
-    let cells = Cells::of(triangles, &fine, options.blind_depth);
-    compare(&g, trace, &ties, ExactRule::of(&options.rule), &cells)
+    compare(&g, trace, &ties, ExactRule::of(&options.rule), cells)
         .inside_miss()
         .unwrap_or(0.0)
+}
+
+/// A band of the half-pitch grid: the angle (its bits) and the band's
+/// first and last rows.
+type BandKey = (u64, i64, i64);
+
+/// The half-pitch bands [`inside_miss_at_half_pitch`] sampled last, with
+/// their cells: every start of one start row at one angle needs the same
+/// band (a strip's row measured them again for each of its 1,467 starts),
+/// and a band's heights and cells depend on its key alone, so a kept one
+/// is the one sampling would give. At most [`KEPT_BANDS`] are kept, the
+/// most recent first: pairs come angle by angle, start row by start row.
+struct HalfPitchBands<'a> {
+    /// The part the bands are sampled from.
+    triangles: &'a [Triangle],
+    /// The blind-spot threshold of their cells (mm).
+    blind_depth: f64,
+    recent: Mutex<Vec<(BandKey, Band)>>,
+}
+
+/// A half-pitch band, sampled once: its heights and its cells.
+type Band = Arc<OnceLock<(HeightGrid, Cells)>>;
+
+/// How many half-pitch bands are kept (each about 20 bytes per node of a
+/// band as wide as the grid).
+const KEPT_BANDS: usize = 4;
+
+impl<'a> HalfPitchBands<'a> {
+    fn new(triangles: &'a [Triangle], blind_depth: f64) -> HalfPitchBands<'a> {
+        HalfPitchBands {
+            triangles,
+            blind_depth,
+            recent: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The band `key` (the grid `spec`), sampled unless it is kept (a
+    /// thread asking for a band another is sampling waits for it).
+    fn get(&self, key: BandKey, spec: GridSpec) -> Band {
+        let cell = {
+            let mut recent = self.recent.lock().expect("no band panics");
+            match recent.iter().position(|(k, _)| *k == key) {
+                Some(n) => {
+                    let entry = recent.remove(n);
+                    let cell = entry.1.clone();
+                    recent.insert(0, entry);
+                    cell
+                }
+                None => {
+                    let cell = Arc::new(OnceLock::new());
+                    recent.insert(0, (key, cell.clone()));
+                    recent.truncate(KEPT_BANDS);
+                    cell
+                }
+            }
+        };
+        cell.get_or_init(|| {
+            let fine = HeightGrid::sample(self.triangles, spec);
+            let cells = Cells::of(self.triangles, &fine, self.blind_depth);
+            (fine, cells)
+        });
+        cell
+    }
 }
 
 /// The comparison of `results`: every start-angle pair at the angles
@@ -1257,6 +1322,7 @@ mod tests {
         let oracle = oracle_options(&options.knee, 1.0, grid.spec.x(0));
         let traces = exact_traces(&tris, &starts, &angles, &oracle).unwrap();
         let mut struck = 0;
+        let bands = HalfPitchBands::new(&tris, options.blind_depth);
         for (a, &angle) in angles.iter().enumerate() {
             let fp = GridFootprint::new(&options.knee, angle, &whole);
             for (s, &(i, j)) in nodes.iter().enumerate() {
@@ -1266,8 +1332,10 @@ mod tests {
                 let expected = compare(&g, trace, &ties, ExactRule::of(&options.rule), &cells)
                     .inside_miss()
                     .unwrap_or(0.0);
+                // The bands kept across starts and angles, as the pairs
+                // use them.
                 let banded =
-                    inside_miss_at_half_pitch(&tris, &grid, angle, (i, j), trace, &options, None);
+                    inside_miss_at_half_pitch(&bands, &grid, angle, (i, j), trace, &options, None);
                 assert_eq!(banded.to_bits(), expected.to_bits(), "{angle} {i} {j}");
             }
         }
