@@ -320,6 +320,22 @@ fn merged_direct_pitch(parts: &[StudyPart], k: usize) -> Option<DirectPitchResul
     })
 }
 
+/// A convergence study's summary as its first shard holds it (`None`
+/// when it is another kind), and every pitch of the shares `parts`
+/// merged by `pitch` (either approach's).
+fn merged_pitches<S, R>(
+    parts: &[StudyPart],
+    summary: impl Fn(&StudySummary) -> Option<S>,
+    pitch: impl Fn(&[StudyPart], usize) -> Option<R>,
+) -> Option<(S, Vec<R>)> {
+    let first = parts.first()?;
+    let summary = summary(&first.summary)?;
+    let results = (0..first.pitches.len())
+        .map(|k| pitch(parts, k))
+        .collect::<Option<Vec<R>>>()?;
+    Some((summary, results))
+}
+
 /// The oracle's seconds summed over the shards.
 fn oracle_s(parts: &[StudyPart]) -> f64 {
     parts.iter().map(|p| p.oracle_s).sum()
@@ -347,14 +363,11 @@ pub(crate) fn merge_verify(parts: &[StudyPart]) -> Option<Verification> {
 
 /// The convergence study of the shares `parts` (as [`merge_verify`]).
 pub(crate) fn merge_converge(parts: &[StudyPart]) -> Option<Convergence> {
-    let first = parts.first()?;
-    let StudySummary::Converge(summary) = &first.summary else {
-        return None;
+    let converge = |s: &StudySummary| match s {
+        StudySummary::Converge(c) => Some(c.clone()),
+        _ => None,
     };
-    let results = (0..first.pitches.len())
-        .map(|k| merged_pitch(parts, k))
-        .collect::<Option<Vec<PitchResult>>>()?;
-    let mut summary = summary.clone();
+    let (mut summary, results) = merged_pitches(parts, converge, merged_pitch)?;
     summary.set_results(&results);
     Some(Convergence {
         fits: super::converge::fits(&results),
@@ -382,14 +395,11 @@ pub(crate) fn merge_verify_direct(parts: &[StudyPart]) -> Option<DirectVerificat
 /// The direct convergence study of the shares `parts` (as
 /// [`merge_verify`]).
 pub(crate) fn merge_converge_direct(parts: &[StudyPart]) -> Option<DirectConvergence> {
-    let first = parts.first()?;
-    let StudySummary::ConvergeDirect(summary) = &first.summary else {
-        return None;
+    let converge_direct = |s: &StudySummary| match s {
+        StudySummary::ConvergeDirect(c) => Some(c.clone()),
+        _ => None,
     };
-    let results = (0..first.pitches.len())
-        .map(|k| merged_direct_pitch(parts, k))
-        .collect::<Option<Vec<DirectPitchResult>>>()?;
-    let mut summary = summary.clone();
+    let (mut summary, results) = merged_pitches(parts, converge_direct, merged_direct_pitch)?;
     summary.oracle_s = oracle_s(parts);
     summary.set_results(&results);
     Some(DirectConvergence { results, summary })
