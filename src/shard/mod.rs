@@ -303,9 +303,10 @@ struct Header {
 /// Reads the shard directories `dirs` (one per shard, in any order) and
 /// merges them into the whole run's results.
 pub fn merge(dirs: &[PathBuf]) -> Result<Merged, ShardError> {
+    let first_identity = std::cell::OnceCell::new();
     let shards = read_set(dirs, "run", read_shard, |first, s| {
-        let identity = identity(&first.record.summary);
-        if let Some(key) = first_difference(&identity, &self::identity(&s.record.summary)) {
+        let identity = first_identity.get_or_init(|| identity(&first.record.summary));
+        if let Some(key) = first_difference(identity, &self::identity(&s.record.summary)) {
             return Err(ShardError::Mismatch(format!(
                 "{} and {} are shards of different runs (their summaries' `{key}` differ)",
                 first.dir.display(),

@@ -223,11 +223,15 @@ impl ShardDir for StudyFiles {
 /// order) and merges them into the whole study, as the unsharded command
 /// computes it (clock readings aside).
 pub fn merge_study(dirs: &[PathBuf]) -> Result<MergedStudy, ShardError> {
+    let first_identity = std::cell::OnceCell::new();
     let shards = read_set(
         dirs,
         "study",
         read_study,
-        |first, s| match first_difference(&identity(&first.record), &identity(&s.record)) {
+        |first, s| match first_difference(
+            first_identity.get_or_init(|| identity(&first.record)),
+            &identity(&s.record),
+        ) {
             Some(key) => Err(ShardError::Mismatch(format!(
                 "{} and {} are shards of different studies (their `{key}` differ)",
                 first.dir.display(),
