@@ -181,52 +181,47 @@ fn search(points: &[[f64; 2]], depth: usize, q: [f64; 2], stop_d2: f64, best: &m
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::harness::compare::SplitMix;
+
+    /// Uniform numbers in `[0, 1)` from `seed`.
+    fn uniform(seed: u64) -> impl FnMut() -> f64 {
+        let mut bits = SplitMix(seed);
+        move || (bits.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// The distance from `q` to the nearest of `points` by a scan.
+    fn brute(points: &[[f64; 2]], q: [f64; 2]) -> f64 {
+        points
+            .iter()
+            .map(|p| (p[0] - q[0]).hypot(p[1] - q[1]))
+            .fold(f64::INFINITY, f64::min)
+    }
 
     #[test]
     fn nearest_distance_equals_brute_force() {
-        let mut state = 12345u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 100.0
-        };
+        let mut next = uniform(12345);
         // Duplicates and a line of equal x, to exercise ties in the split.
-        let mut points: Vec<[f64; 2]> = (0..500).map(|_| [next(), next()]).collect();
+        let mut points: Vec<[f64; 2]> =
+            (0..500).map(|_| [next() * 100.0, next() * 100.0]).collect();
         points.extend((0..50).map(|k| [50.0, k as f64]));
         points.extend((0..20).map(|_| [10.0, 10.0]));
         let set = PointSet::new(points.clone());
         for _ in 0..300 {
-            let q = [next() * 1.5 - 25.0, next() * 1.5 - 25.0];
-            let brute = points
-                .iter()
-                .map(|p| (p[0] - q[0]).hypot(p[1] - q[1]))
-                .fold(f64::INFINITY, f64::min);
-            assert_eq!(set.distances(&[q]), [brute], "{q:?}");
+            let q = [next() * 150.0 - 25.0, next() * 150.0 - 25.0];
+            assert_eq!(set.distances(&[q]), [brute(&points, q)], "{q:?}");
         }
     }
 
     #[test]
     fn seeded_and_early_stopped_searches_equal_brute_force() {
-        let mut state = 777u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(777);
         // Grid nodes (many equidistant near-ties) and a walk of queries
         // along a curve, as a trace's contacts come.
         let points: Vec<[f64; 2]> = (0..40)
             .flat_map(|i| (0..30).map(move |j| [i as f64 * 1.24 + 0.1, j as f64 * 1.24]))
             .collect();
         let set = PointSet::new(points.clone());
-        let brute = |q: [f64; 2]| {
-            points
-                .iter()
-                .map(|p| (p[0] - q[0]).hypot(p[1] - q[1]))
-                .fold(f64::INFINITY, f64::min)
-        };
+        let brute = |q: [f64; 2]| brute(&points, q);
         let mut queries: Vec<[f64; 2]> = (0..400)
             .map(|k| {
                 let t = k as f64 * 0.13;
