@@ -180,7 +180,9 @@ pub struct Summary {
     /// The sample check: the exact oracle on a few seeded starts of this
     /// analysis, compared with its grid as `verify` does, so the result
     /// carries its measured accuracy; or why it was not run. Absent in
-    /// runs of earlier versions, and in merged shards.
+    /// runs of earlier versions; a merge of shards holds the shards'
+    /// checks merged ([`SampleCheck::merged`]), or none when a shard has
+    /// none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sample_check: Option<SampleCheck>,
     /// The working memory estimated before the run (MiB,

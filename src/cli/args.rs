@@ -276,8 +276,9 @@ pub struct AnalyzeArgs {
     /// angle, compares them with its grid as `verify` does, and states the
     /// decided miss and false-alarm distances it measured (console,
     /// summary.json's `sample_check`, the report), warning when they
-    /// exceed the pitch; it costs the oracle's time on those 15 pairs
-    /// (0.45 s on the bundled console). With --no-check the
+    /// exceed sqrt 2 pitches (`verify`'s default tolerance); it costs the
+    /// oracle's time on those 15 pairs (about half a second on the bundled
+    /// console). With --no-check the
     /// summary says the analysis carries no measured accuracy.
     #[arg(long)]
     pub no_check: bool,
