@@ -29,7 +29,6 @@ use nalgebra::{Matrix3, Point3, Rotation3, Translation3};
 
 /// Which side of the vehicle the analysed surface is on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum Side {
     /// The analysed surface faces -y (SPEC's canonical frame).
@@ -40,6 +39,17 @@ pub enum Side {
 }
 
 impl Side {
+    /// Both sides, as `--side` offers them.
+    pub const ALL: [Side; 2] = [Side::Left, Side::Right];
+
+    /// The name, as `--side` takes it and `summary.json` records it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Side::Left => "left",
+            Side::Right => "right",
+        }
+    }
+
     /// Maps a y coordinate between the part's frame and the analysis frame
     /// (the mapping is its own inverse).
     pub fn to_part(self, y: f64) -> f64 {
@@ -52,7 +62,6 @@ impl Side {
 
 /// Which knee motion an analysis follows. See README's "Two approaches".
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum Approach {
     /// SPEC's push-and-slide (the paper's method): the knee-form pushed in
@@ -68,6 +77,9 @@ pub enum Approach {
 }
 
 impl Approach {
+    /// Both approaches, as `--approach` offers them.
+    pub const ALL: [Approach; 2] = [Approach::Slide, Approach::Direct];
+
     /// The name as the flag and `summary.json` write it.
     pub fn name(self) -> &'static str {
         match self {
@@ -410,6 +422,25 @@ impl Placement {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_flags_names_are_the_names_summary_json_records() {
+        // A flag's value (`name`, parsed by the CLI) and the JSON that
+        // records it (serde) must spell every value alike.
+        fn same<T: serde::Serialize + Copy>(all: &[T], name: fn(T) -> &'static str) {
+            for &v in all {
+                let json = serde_json::to_string(&v).expect("a name");
+                assert_eq!(json, format!("\"{}\"", name(v)));
+            }
+        }
+        same(&Side::ALL, Side::name);
+        same(&Approach::ALL, Approach::name);
+        same(&crate::Algorithm::ALL, crate::Algorithm::name);
+        same(
+            &crate::strike::RateEstimate::ALL,
+            crate::strike::RateEstimate::name,
+        );
+    }
 
     #[test]
     fn axes_map_part_axes_to_vehicle_axes_and_back_exactly() {

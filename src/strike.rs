@@ -34,7 +34,6 @@ use serde::{Deserialize, Serialize};
 
 /// How a grid contact's deflection is measured.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum RateEstimate {
     /// SPEC's default: the drop of the start's own level over the last
@@ -52,6 +51,9 @@ pub enum RateEstimate {
 }
 
 impl RateEstimate {
+    /// Every rule, as `--rate` offers them.
+    pub const ALL: [RateEstimate; 2] = [RateEstimate::Window, RateEstimate::XSlope];
+
     /// The name, as `--rate` takes it and `summary.json` records it.
     pub fn name(self) -> &'static str {
         match self {

@@ -66,7 +66,7 @@ pub struct PartArgs {
     /// knee is pushed in +y); `right` faces +y and is mirrored y -> -y for
     /// the analysis, results are mirrored back. With --frame, the side is
     /// applied after the frame, in vehicle coordinates.
-    #[arg(long, value_enum, default_value_t = Side::Left)]
+    #[arg(long, default_value = "left", value_parser = one_of(&Side::ALL, Side::name))]
     pub side: Side,
     /// The part's axes in vehicle coordinates (front -x, z up), for a part
     /// not modelled in them: three signed part axes, one per vehicle axis
@@ -162,7 +162,12 @@ pub struct SetupArgs {
     /// (on the grid and in the exact oracle alike); `x-slope` (SPEC's former
     /// baseline, for node-for-node comparison with other implementations):
     /// the surface's rise over one pitch from the point behind it.
-    #[arg(long, value_enum, default_value_t = RateEstimate::Window, value_name = "RATE")]
+    #[arg(
+        long,
+        default_value = "window",
+        value_name = "RATE",
+        value_parser = one_of(&RateEstimate::ALL, RateEstimate::name)
+    )]
     pub rate: RateEstimate,
     /// The deflection window W (mm, > 0, at most 100 and 1024 pitches) of
     /// `--rate window`: how far back along its travel the knee-form's drop
@@ -184,7 +189,7 @@ pub struct SetupArgs {
     /// Push-and-slide implementation: `fast` (sliding-window push,
     /// streaming slide) or `paper` (the paper's sections 3-4, literally;
     /// slow). Both give identical results.
-    #[arg(long, value_enum, default_value_t = Algorithm::Fast)]
+    #[arg(long, default_value = "fast", value_parser = one_of(&Algorithm::ALL, Algorithm::name))]
     pub algorithm: Algorithm,
     /// Which knee motion: `slide` (default; the paper's push-and-slide:
     /// the knee-form pushed in +y against a surface facing -y, then slid
@@ -194,7 +199,12 @@ pub struct SetupArgs {
     /// panel; the area is every first-contact point, within --e0, over
     /// every position and angle; --deflection, --rate and --algorithm
     /// are recorded but not used). See README, "Two approaches".
-    #[arg(long, value_enum, default_value_t = Approach::Slide, value_name = "APPROACH")]
+    #[arg(
+        long,
+        default_value = "slide",
+        value_name = "APPROACH",
+        value_parser = one_of(&Approach::ALL, Approach::name)
+    )]
     pub approach: Approach,
     /// Worker threads (default: one per CPU). Results do not depend on it.
     #[arg(long, value_name = "N")]
@@ -570,6 +580,21 @@ impl SetupArgs {
         setup.validate().map_err(with_flag)?;
         Ok((setup, self.threads))
     }
+}
+
+/// The parser of a flag taking one of a library enum's values by name
+/// (`name` of each of `all`): the library's types carry no clap derive,
+/// and the flag's own help says what each value does.
+fn one_of<T: Copy + Send + Sync + 'static>(
+    all: &'static [T],
+    name: fn(T) -> &'static str,
+) -> impl clap::builder::TypedValueParser<Value = T> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(all.iter().map(|&v| name(v))).map(move |s| {
+        *all.iter()
+            .find(|&&v| name(v) == s)
+            .expect("the parser admits only the names of `all`")
+    })
 }
 
 /// A setup error with the flag it concerns in front: `--pitch: ...`.

@@ -33,13 +33,25 @@ use crate::strike::StrikeRule;
 
 /// Which implementation of push and slide to run. Both give identical masks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum Algorithm {
     /// The paper's sections 3 and 4, literally: the reference and baseline.
     Paper,
     /// Sliding-window-minimum push and the one-layer streaming slide.
     Fast,
+}
+
+impl Algorithm {
+    /// Every implementation, as `--algorithm` offers them.
+    pub const ALL: [Algorithm; 2] = [Algorithm::Paper, Algorithm::Fast];
+
+    /// The name, as `--algorithm` takes it and `summary.json` records it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Algorithm::Paper => "paper",
+            Algorithm::Fast => "fast",
+        }
+    }
 }
 
 /// How to run the engine.
