@@ -3,8 +3,8 @@
 //! along -x, on a smooth part facing +x at two coarse pitches: both
 //! metrics within a bound that halves with the pitch.
 
-use kneeform::harness::{ConvergeOptions, StartSelection, converge_direct};
-use kneeform::{Part, PartFile, Setup};
+use kneeform::harness::{ConvergeOptions, StartSelection, Study, StudyOptions, study};
+use kneeform::{Approach, Part, PartFile, Setup};
 
 mod util;
 
@@ -35,6 +35,7 @@ fn grid_and_exact_direct_contacts_agree_within_a_bound_that_shrinks_with_the_pit
     let input = smooth_part();
     let setup = Setup {
         angles: vec![-30.0, 0.0, 30.0],
+        approach: Approach::Direct,
         ..Setup::default()
     };
     let options = ConvergeOptions {
@@ -44,7 +45,11 @@ fn grid_and_exact_direct_contacts_agree_within_a_bound_that_shrinks_with_the_pit
         tolerance: None,
         budget_s: None,
     };
-    let study = converge_direct(&input, &setup, &options, &()).unwrap();
+    let Study::ConvergeDirect(study) =
+        study(&input, &setup, StudyOptions::Converge(&options), &()).unwrap()
+    else {
+        panic!("the direct approach's convergence study");
+    };
     assert_eq!(study.summary.approach, "direct");
     assert_eq!(study.results.len(), 2);
     let mut worst = Vec::new();

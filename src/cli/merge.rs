@@ -8,7 +8,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, ensure};
 use kneeform::output::{self, OutputDir, WriteOptions};
-use kneeform::shard::study::{MergedStudy, ShardKind, shard_kind};
+use kneeform::shard::study::{ShardKind, shard_kind};
 
 use super::args::MergeArgs;
 
@@ -39,27 +39,11 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<ExitCode> {
     }
     let merged =
         kneeform::shard::study::merge_study(&args.shards).context("cannot merge the shards")?;
-    match &merged {
-        MergedStudy::Verify(v) => output::write_verification_files(&out, v)?,
-        MergedStudy::Converge(c) => output::write_convergence_files(&out, c)?,
-        MergedStudy::VerifyDirect(v) => output::write_direct_verification_files(&out, v)?,
-        MergedStudy::ConvergeDirect(c) => output::write_direct_convergence_files(&out, c)?,
-    }
+    output::write_study_files(&out, &merged)?;
     out.commit()
         .with_context(|| format!("cannot move results into {}", args.out.display()))?;
     eprintln!("kneeform: merged {} shards of {kind}", args.shards.len());
-    Ok(match &merged {
-        MergedStudy::Verify(v) => super::study::print_verification(v, &args.out),
-        MergedStudy::Converge(c) => {
-            super::study::print_convergence(c, &args.out);
-            ExitCode::SUCCESS
-        }
-        MergedStudy::VerifyDirect(v) => super::study::print_direct_verification(v, &args.out),
-        MergedStudy::ConvergeDirect(c) => {
-            super::study::print_direct_convergence(c, &args.out);
-            ExitCode::SUCCESS
-        }
-    })
+    Ok(super::study::print_study(&merged, &args.out))
 }
 
 fn merge_analysis(args: &MergeArgs, out: OutputDir) -> anyhow::Result<ExitCode> {

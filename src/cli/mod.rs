@@ -17,7 +17,7 @@ use std::path::Path;
 use anyhow::Context;
 use std::process::ExitCode;
 
-use kneeform::harness::{HarnessError, StudyPart};
+use kneeform::harness::{self, HarnessError, StudyPart};
 use kneeform::output::OutputDir;
 use kneeform::partition::Shard;
 use kneeform::report::ReportOptions;
@@ -75,62 +75,54 @@ pub fn study_shard(study: &StudyArgs) -> anyhow::Result<Option<Shard>> {
         .context("--shard")
 }
 
-/// A study's shard of one approach: `verify_shard`, `converge_shard` and
-/// their direct twins.
-pub type ShardFn<O> =
-    fn(&PartFile, &Setup, &O, Shard, &dyn kneeform::Progress) -> Result<StudyPart, HarnessError>;
-
-/// What `verify` and `converge` run, per approach: its shard, and the
-/// whole study with its writers and console lines (the exit code); and
-/// the study's own options, checked (`check`), with its `--budget-s`.
-pub struct StudyCommand<'a, O> {
-    pub options: &'a O,
-    pub check: Result<(), HarnessError>,
-    pub budget_s: Option<f64>,
-    pub slide_shard: ShardFn<O>,
-    pub direct_shard: ShardFn<O>,
-    pub slide: &'a dyn Fn(&PartFile, &Setup) -> anyhow::Result<ExitCode>,
-    pub direct: &'a dyn Fn(&PartFile, &Setup) -> anyhow::Result<ExitCode>,
-}
-
-/// Runs a study command: reads its part and setup (and the command's
-/// `check`), then its shard when `--shard` is given (written to `out`),
-/// else the whole study, of the setup's approach. `--budget-s` does not
-/// apply to the direct approach, which says so.
-pub fn run_study<O>(
+/// Runs a study command (`verify`, `converge`): reads its part and setup
+/// (and the command's `check` of its own options), then its shard when
+/// `--shard` is given (written to `out`), else the whole study, of the
+/// setup's approach, written to `out` and printed as `kneeform merge`
+/// prints it. `--budget-s` does not apply to the direct approach, which
+/// says so.
+pub fn run_study(
     study: &StudyArgs,
     out: &Path,
-    command: StudyCommand<O>,
+    options: harness::StudyOptions,
+    check: Result<(), HarnessError>,
+    budget_s: Option<f64>,
 ) -> anyhow::Result<ExitCode> {
     let shard = study_shard(study)?;
-    let (input, setup) = study_inputs(study, command.check)?;
+    let (input, setup) = study_inputs(study, check)?;
     let direct = setup.approach == kneeform::Approach::Direct;
-    if direct && command.budget_s.is_some() {
+    if direct && budget_s.is_some() {
         // The direct study casts once per position: no sample predicts it.
         eprintln!(
             "kneeform: warning: --budget-s is not applied with --approach direct (one cast per knee position; --shard fans it out)"
         );
     }
-    match (shard, direct) {
-        (Some(shard), _) => {
-            let of = if direct {
-                command.direct_shard
-            } else {
-                command.slide_shard
-            };
-            let part = of(
-                &input,
-                &setup,
-                command.options,
-                shard,
-                &progress::Bars::default(),
-            )
-            .map_err(harness_error)?;
-            write_study_shard(out, &part)
-        }
-        (None, true) => (command.direct)(&input, &setup),
-        (None, false) => (command.slide)(&input, &setup),
+    let bars = progress::Bars::default();
+    if let Some(shard) = shard {
+        let part =
+            harness::study_shard(&input, &setup, options, shard, &bars).map_err(harness_error)?;
+        return write_study_shard(out, &part);
     }
+    let result = harness::study(&input, &setup, options, &bars).map_err(harness_error)?;
+    // A convergence study says how long its one oracle run took (a merge
+    // sums its shards').
+    match &result {
+        harness::Study::Converge(c) => eprintln!(
+            "exact oracle: {} starts x {} angles in {:.1} s",
+            c.summary.starts,
+            setup.angles.len(),
+            c.oracle_s
+        ),
+        harness::Study::ConvergeDirect(c) => eprintln!(
+            "exact oracle (direct): {} positions x {} angles in {:.1} s",
+            c.summary.starts,
+            setup.angles.len(),
+            c.summary.oracle_s
+        ),
+        _ => {}
+    }
+    kneeform::output::write_study(out, &result)?;
+    Ok(study::print_study(&result, out))
 }
 
 /// The sample check's line, and its warning where it found the grid beyond

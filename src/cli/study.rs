@@ -6,10 +6,28 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use kneeform::harness::{
-    Convergence, DECIDED_METRICS, DIRECT_METRICS, DirectConvergence, DirectVerification,
+    Convergence, DECIDED_METRICS, DIRECT_METRICS, DirectConvergence, DirectVerification, Study,
     Verification,
 };
 use kneeform::limits::short;
+
+/// Prints what `study` found (its results are in `out`) and returns the
+/// command's exit status: a verification's 0 when it passes, 1 when it
+/// fails; a convergence study's 0.
+pub fn print_study(study: &Study, out: &Path) -> ExitCode {
+    match study {
+        Study::Verify(v) => print_verification(v, out),
+        Study::Converge(c) => {
+            print_convergence(c, out);
+            ExitCode::SUCCESS
+        }
+        Study::VerifyDirect(v) => print_direct_verification(v, out),
+        Study::ConvergeDirect(c) => {
+            print_direct_convergence(c, out);
+            ExitCode::SUCCESS
+        }
+    }
+}
 
 /// What would resolve a failure, in words: the pitch a first-order error
 /// (`error ~ C p`, what the evidence in `results/` shows for push, miss and
@@ -45,7 +63,7 @@ fn resolving_pitch(pitch: f64, tolerance: f64, metric: &str, value: f64) -> Stri
 /// Prints a verification's statistics, counts and verdict (its results
 /// are in `out`) and returns `verify`'s exit status: 0 when it passes, 1
 /// when it fails.
-pub fn print_verification(result: &Verification, out: &Path) -> ExitCode {
+fn print_verification(result: &Verification, out: &Path) -> ExitCode {
     let s = &result.summary;
     for name in kneeform::harness::METRICS {
         let stats = &s.metrics[name];
@@ -181,7 +199,7 @@ pub fn print_verification(result: &Verification, out: &Path) -> ExitCode {
 
 /// Prints a convergence study's errors per pitch, fitted orders and the
 /// pitch it recommends (its results are in `out`).
-pub fn print_convergence(study: &Convergence, out: &Path) {
+fn print_convergence(study: &Convergence, out: &Path) {
     let results = &study.results;
     let fitted = &study.fits;
     for r in results {
@@ -244,7 +262,7 @@ pub fn print_convergence(study: &Convergence, out: &Path) {
 /// Prints a direct verification's statistics, counts and verdict (its
 /// results are in `out`) and returns `verify`'s exit status: 0 when it
 /// passes, 1 when it fails.
-pub fn print_direct_verification(result: &DirectVerification, out: &Path) -> ExitCode {
+fn print_direct_verification(result: &DirectVerification, out: &Path) -> ExitCode {
     let s = &result.summary;
     for name in DIRECT_METRICS {
         let stats = &s.metrics[name];
@@ -279,7 +297,7 @@ pub fn print_direct_verification(result: &DirectVerification, out: &Path) -> Exi
 
 /// Prints a direct convergence study's errors per pitch, fitted orders
 /// and the pitch it recommends (its results are in `out`).
-pub fn print_direct_convergence(study: &DirectConvergence, out: &Path) {
+fn print_direct_convergence(study: &DirectConvergence, out: &Path) {
     for r in &study.results {
         let c = &r.comparison;
         let stats: Vec<String> = c

@@ -5,7 +5,9 @@
 //! rows the band's footprints span. The driver ([`super::colliding_masks`])
 //! ORs the bands' results into each angle's mask.
 
+use crate::engine::options::EngineOptions;
 use crate::engine::padded::PaddedGrid;
+use crate::engine::probe::Probe;
 use crate::engine::probe::ProbeVisits;
 use crate::engine::push::{PushRows, WindowMin, WindowOf, push_block, push_tile};
 use crate::engine::ranked::{NEVER, OFF, Rank, RankedGrid};
@@ -13,7 +15,6 @@ use crate::engine::simd::dispatch;
 use crate::engine::slide::{
     Extension, LayerRows, WindowLayers, WindowSlide, slide_block, slide_block_window, slide_carried,
 };
-use crate::engine::{EngineOptions, Probe};
 use crate::kneeform::GridFootprint;
 use crate::strike::StrikeRule;
 

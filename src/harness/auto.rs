@@ -32,6 +32,7 @@ use std::time::Instant;
 
 use super::compare::StartSelection;
 use super::converge::Ladder;
+use super::method::{Method, Tracing};
 use super::nearest::PointSet;
 use super::{HarnessError, TieBand};
 use crate::analysis::Progress;
@@ -101,26 +102,27 @@ pub fn choose_pitch(
         });
     }
     let angles = study_angles(&setup.angles);
-    let ladder = Ladder::new(
+    let mut ladder = Ladder::lay(
         input,
         &Setup {
             pitch: p0,
             angles: angles.clone(),
             ..setup.clone()
         },
-        pitches[pitches.len() - 1],
         &StartSelection::Sample {
             count: auto.starts,
             seed: 1,
         },
         TieBand::DEFAULT_PER_MM,
-        super::converge::Share {
-            shard: None,
-            oracle_budget_s: Some(auto.budget_s),
-            refuse_beyond_s: None,
-        },
-        progress,
+        None,
     )?;
+    let tracing = Tracing {
+        share: ladder.all_starts().to_vec(),
+        finest,
+        within_s: Some(auto.budget_s),
+        refuse_beyond_s: None,
+    };
+    ladder.trace(tracing, progress)?;
     let scale = setup.angles.len() as f64 / angles.len() as f64;
     let memory = |spec: &GridSpec| {
         setup

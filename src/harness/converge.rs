@@ -11,8 +11,10 @@ use super::HarnessError;
 use super::compare::{
     CompareOptions, Comparison, GridSide, PairResult, StartSelection, assemble, pair_results,
 };
+use super::method::{Method, Tracing, spec_at};
 use super::metrics::{METRICS, TieBand};
 use super::pairs::{Pairs, PitchPart};
+use super::trace::Fault;
 use super::verify::{
     check_selection, check_tie_band, check_tolerance, oracle_options, run_oracle, start_positions,
     tie_band_rule,
@@ -22,7 +24,6 @@ use crate::engine::{AngleMask, EngineOptions, colliding_masks};
 use crate::grid::{GridSpec, HeightGrid};
 use crate::input::PartFile;
 use crate::mesh::Triangle;
-use crate::partition::Shard;
 use crate::setup::Setup;
 use kneeform_oracle::StartTrace;
 
@@ -173,35 +174,28 @@ pub struct PitchVerdict {
 }
 
 /// Nested grids over the coarsest grid's extent (pitches dividing its
-/// pitch), sharing its starts and the oracle's traces of them: what
-/// [`converge`] and [`super::choose_pitch`] measure at each pitch.
+/// pitch), sharing its starts and the oracle's traces of them: the slide's
+/// [`Method`] of every study, and what [`super::choose_pitch`] measures at
+/// each pitch.
 pub(super) struct Ladder<'a> {
     triangles: &'a [Triangle],
     /// The study's setup at the coarsest pitch.
     setup: Setup,
     coarse: GridSpec,
-    /// The starts (mm), nodes of every grid of the ladder: a shard's
-    /// share of `all_starts`, or all of them.
-    pub starts: Vec<[f64; 2]>,
+    /// The coarsest grid, kept until its pitch is measured (a
+    /// verification's one grid is sampled once).
+    coarse_grid: Option<HeightGrid>,
+    /// Seconds sampling the coarsest grid.
+    sample_s: f64,
     /// Every start of the study (mm), in its order.
-    pub all_starts: Vec<[f64; 2]>,
+    all_starts: Vec<[f64; 2]>,
+    /// The starts traced (mm), nodes of every grid of the ladder: a
+    /// shard's share of `all_starts`, or all of them.
+    pub starts: Vec<[f64; 2]>,
     traces: Vec<StartTrace>,
-    /// Seconds the oracle took.
-    pub oracle_s: f64,
     compare: CompareOptions,
-}
-
-/// Which of a ladder's starts to trace, and within what time.
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct Share {
-    /// A shard's share of the starts (all of them when `None`).
-    pub shard: Option<Shard>,
-    /// Seconds the oracle may take (a pitch study's budget; unbounded
-    /// when `None`).
-    pub oracle_budget_s: Option<f64>,
-    /// The oracle's predicted time beyond which the study is refused
-    /// before the traces (`--budget-s`; none when `None`).
-    pub refuse_beyond_s: Option<f64>,
+    /// A deliberate mistake on the grid side (tests only).
+    fault: Option<Fault>,
 }
 
 /// The exact traces of `starts` at `angles` (in [`run_oracle`]'s order),
@@ -252,84 +246,51 @@ fn traces_within(
 }
 
 impl<'a> Ladder<'a> {
-    /// The coarsest grid of `setup` (its pitch) on `input`, the starts of
-    /// `selection` on it (`shard`'s share of them when given), and their
-    /// exact traces at `setup`'s angles with the oracle resolving `finest`
-    /// (mm).
-    pub(super) fn new(
+    /// The coarsest grid of `setup` (its pitch) on `input` and the starts
+    /// of `selection` on it, not yet traced ([`Method::trace`]).
+    pub(super) fn lay(
         input: &'a PartFile,
         setup: &Setup,
-        finest: f64,
         selection: &StartSelection,
         tie_band_per_mm: f64,
-        share: Share,
-        progress: &dyn Progress,
+        fault: Option<Fault>,
     ) -> Result<Ladder<'a>, HarnessError> {
-        let Share {
-            shard,
-            oracle_budget_s,
-            refuse_beyond_s,
-        } = share;
         setup.validate()?;
         let triangles = &input.part.triangles;
+        let t = Instant::now();
         let coarse = setup.grid_spec(&input.part)?;
         let coarse_grid = HeightGrid::sample(triangles, coarse);
+        let sample_s = t.elapsed().as_secs_f64();
         let all_starts = start_positions(&coarse_grid, &setup.footprints(&coarse), selection)?;
-        drop(coarse_grid);
-        let starts = super::pairs::share(&all_starts, shard)?;
-        let oracle = oracle_options(&setup.knee, finest, coarse.x(0));
-        let (traces, oracle_s) = match oracle_budget_s {
-            None => run_oracle(
-                triangles,
-                &starts,
-                &setup.angles,
-                &oracle,
-                refuse_beyond_s,
-                progress,
-            )?,
-            Some(budget_s) => traces_within(
-                triangles,
-                &starts,
-                &setup.angles,
-                &oracle,
-                budget_s,
-                progress,
-            )?,
-        };
         Ok(Ladder {
             triangles,
             setup: setup.clone(),
             coarse,
-            starts,
+            coarse_grid: Some(coarse_grid),
+            sample_s,
             all_starts,
-            traces,
-            oracle_s,
+            starts: Vec::new(),
+            traces: Vec::new(),
             compare: CompareOptions::of(setup, tie_band_per_mm),
+            fault,
         })
     }
 
     /// The grid at pitch `p`: exactly the coarse grid's extent from its
     /// origin.
     pub(super) fn spec_at(&self, p: f64) -> GridSpec {
-        let c = &self.coarse;
-        let r = (c.pitch / p).round() as usize;
-        GridSpec::explicit(c.x(0), c.z(0), (c.nx - 1) * r + 1, (c.nz - 1) * r + 1, p)
-    }
-
-    /// The coarsest grid (mm, analysis frame).
-    pub(super) fn coarse(&self) -> GridSpec {
-        self.coarse
+        spec_at(&self.coarse, p)
     }
 
     /// The grid at pitch `p` sampled, the engine timed over the ladder's
     /// angles, and the comparison on the ladder's starts; with the masks
     /// and the grid.
     pub(super) fn measure(
-        &self,
+        &mut self,
         p: f64,
         progress: &dyn Progress,
     ) -> Result<(PitchResult, Vec<AngleMask>, HeightGrid), HarnessError> {
-        let (pairs, pitch, masks, grid) = self.measure_raw(p, progress)?;
+        let (pairs, pitch, masks, grid) = self.measure_raw(p, true, progress)?;
         let result = PitchResult {
             pitch: p,
             comparison: assemble(pairs, &self.setup.angles, pitch.band, pitch.grid_s),
@@ -339,45 +300,43 @@ impl<'a> Ladder<'a> {
         Ok((result, masks, grid))
     }
 
-    /// [`Ladder::measure`] with the comparison's start-angle pairs as they
-    /// are, not yet assembled: a shard's share of one pitch.
-    pub(super) fn measure_pairs(
-        &self,
-        p: f64,
-        progress: &dyn Progress,
-    ) -> Result<PitchPart, HarnessError> {
-        let (pairs, pitch, _, _) = self.measure_raw(p, progress)?;
-        Ok(PitchPart {
-            pairs: Pairs::Slide(pairs),
-            ..pitch
-        })
-    }
-
     /// The pairs of pitch `p`, and the pitch's part without them (its
-    /// timings), its masks and grid.
+    /// timings), its masks (none unless `time_engine`, a convergence
+    /// study's pitch, whose stage is named by its pitch) and grid.
     fn measure_raw(
-        &self,
+        &mut self,
         p: f64,
+        time_engine: bool,
         progress: &dyn Progress,
     ) -> Result<(Vec<PairResult>, PitchPart, Vec<AngleMask>, HeightGrid), HarnessError> {
         let spec = self.spec_at(p);
-        progress.begin(
-            &format!("pitch {p} mm: {} x {} grid", spec.nx, spec.nz),
-            None,
-        );
-        let grid = HeightGrid::sample(self.triangles, spec);
+        let stage = if time_engine {
+            format!("pitch {p} mm: {} x {} grid", spec.nx, spec.nz)
+        } else {
+            super::comparing(self.traces.len())
+        };
+        progress.begin(&stage, None);
+        let grid = match self.coarse_grid.take() {
+            Some(grid) if grid.spec == spec => grid,
+            _ => HeightGrid::sample(self.triangles, spec),
+        };
         let footprints = self.setup.footprints(&spec);
-        let t = Instant::now();
-        let masks = colliding_masks(
-            &grid,
-            &footprints,
-            &EngineOptions {
-                rule: self.setup.rule,
-                ..EngineOptions::default()
-            },
-            &|| {},
-        );
-        let seconds = t.elapsed().as_secs_f64();
+        let (masks, seconds) = if time_engine {
+            let t = Instant::now();
+            let masks = colliding_masks(
+                &grid,
+                &footprints,
+                &EngineOptions {
+                    rule: self.setup.rule,
+                    ..EngineOptions::default()
+                },
+                &|| {},
+            );
+            (masks, t.elapsed().as_secs_f64())
+        } else {
+            // A verification does not time the engine.
+            (Vec::new(), 0.0)
+        };
         let t = Instant::now();
         let pairs = pair_results(
             self.triangles,
@@ -386,7 +345,10 @@ impl<'a> Ladder<'a> {
             &self.starts,
             &self.traces,
             &self.compare,
-            GridSide::default(),
+            GridSide {
+                cells: None,
+                fault: self.fault,
+            },
         );
         let grid_s = t.elapsed().as_secs_f64();
         progress.end();
@@ -399,6 +361,64 @@ impl<'a> Ladder<'a> {
             nodes: spec.len(),
         };
         Ok((pairs?, part, masks, grid))
+    }
+}
+
+impl Method for Ladder<'_> {
+    fn coarse(&self) -> GridSpec {
+        self.coarse
+    }
+
+    fn all_starts(&self) -> &[[f64; 2]] {
+        &self.all_starts
+    }
+
+    fn sample_s(&self) -> f64 {
+        self.sample_s
+    }
+
+    fn trace(&mut self, what: Tracing, progress: &dyn Progress) -> Result<f64, HarnessError> {
+        let Tracing {
+            share,
+            finest,
+            refuse_beyond_s,
+            within_s,
+        } = what;
+        let oracle = oracle_options(&self.setup.knee, finest, self.coarse.x(0));
+        let (traces, oracle_s) = match within_s {
+            None => run_oracle(
+                self.triangles,
+                &share,
+                &self.setup.angles,
+                &oracle,
+                refuse_beyond_s,
+                progress,
+            )?,
+            Some(budget_s) => traces_within(
+                self.triangles,
+                &share,
+                &self.setup.angles,
+                &oracle,
+                budget_s,
+                progress,
+            )?,
+        };
+        self.starts = share;
+        self.traces = traces;
+        Ok(oracle_s)
+    }
+
+    fn pitch(
+        &mut self,
+        p: f64,
+        converging: bool,
+        progress: &dyn Progress,
+    ) -> Result<PitchPart, HarnessError> {
+        let (pairs, pitch, _, _) = self.measure_raw(p, converging, progress)?;
+        Ok(PitchPart {
+            pairs: Pairs::Slide(pairs),
+            ..pitch
+        })
     }
 }
 
@@ -474,53 +494,6 @@ impl Convergence {
     pub fn recommended(&self) -> Option<&PitchResult> {
         recommended_pitch(&self.results, self.summary.tolerance_mm?)
     }
-}
-
-/// Compares grid and oracle on the same starts (the coarsest grid's) at
-/// every pitch of `options`: the oracle runs once, at the finest pitch's
-/// resolution; each grid is sampled, timed over the full engine at the
-/// study's angles, and compared.
-pub fn converge(
-    input: &PartFile,
-    setup: &Setup,
-    options: &ConvergeOptions,
-    progress: &dyn Progress,
-) -> Result<Convergence, HarnessError> {
-    if setup.approach == crate::frame::Approach::Direct {
-        return Err(HarnessError::DirectApproach);
-    }
-    options.validate()?;
-    let pitches = &options.pitches;
-    let ladder = Ladder::new(
-        input,
-        &Setup {
-            pitch: pitches[0],
-            ..setup.clone()
-        },
-        pitches[pitches.len() - 1],
-        &options.selection,
-        options.tie_band_per_mm,
-        Share {
-            refuse_beyond_s: options.budget_s,
-            ..Share::default()
-        },
-        progress,
-    )?;
-    for &p in pitches {
-        setup.check_memory(&ladder.spec_at(p), input.part.triangles.len())?;
-    }
-    let mut results = Vec::new();
-    for &pitch in pitches {
-        results.push(ladder.measure(pitch, progress)?.0);
-    }
-    let fits = fits(&results);
-    let summary = ConvergeSummary::new(input, setup, options, ladder.all_starts.len(), &results);
-    Ok(Convergence {
-        results,
-        fits,
-        summary,
-        oracle_s: ladder.oracle_s,
-    })
 }
 
 impl ConvergeSummary {

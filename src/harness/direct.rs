@@ -43,10 +43,10 @@ use serde::{Deserialize, Serialize};
 use super::HarnessError;
 use super::compare::{StartSelection, choose_nodes, node_at};
 use super::converge::{Fit, fit_power_law};
+use super::method::{Method, Tracing, spec_at};
 use super::metrics::{nearest_rank, sorted_abs};
-use super::pairs::share;
 pub(crate) use super::pairs::{DirectPair, DirectRow};
-use super::verify::{check_selection, check_tolerance};
+use super::pairs::{NO_BAND, Pairs, PitchPart};
 use super::{ConvergeOptions, VerifyOptions};
 use crate::analysis::Progress;
 use crate::direct::{DirectFootprint, contact_levels};
@@ -56,7 +56,6 @@ use crate::grid::{GridSpec, HeightGrid};
 use crate::input::PartFile;
 use crate::kneeform::KneeForm;
 use crate::mesh::{Part, Triangle};
-use crate::partition::Shard;
 use crate::setup::Setup;
 
 /// The metrics of the direct approach, in the order of `converge.csv`.
@@ -401,33 +400,45 @@ pub(crate) fn direct_oracle_options(knee: &KneeForm, e0: f64) -> DirectOptions {
     }
 }
 
-/// The rotated part's grid at `setup`'s pitch, its footprints, and the
-/// positions of `selection` on it (mm).
-pub(super) struct DirectStudy {
+/// The direct approach's [`Method`] of every study: the part rotated into
+/// the direct frame, its coarsest grid and positions, and the exact casts
+/// of a share of them.
+pub(super) struct DirectMethod<'a> {
+    input: &'a PartFile,
+    /// The part in the direct frame.
     part: Part,
-    pub(super) spec: GridSpec,
-    pub(super) positions: Vec<[f64; 2]>,
+    /// The study's setup at the coarsest pitch, of the direct approach.
+    setup: Setup,
+    coarse: GridSpec,
+    /// The coarsest grid, kept until its pitch is measured.
+    coarse_grid: Option<HeightGrid>,
+    /// Every position of the study (mm), in its order.
+    positions: Vec<[f64; 2]>,
+    /// The positions cast: a shard's share of `positions`, or all.
+    share: Vec<[f64; 2]>,
+    traces: Vec<DirectTrace>,
 }
 
-impl DirectStudy {
-    fn new(
-        input: &PartFile,
+impl<'a> DirectMethod<'a> {
+    /// The rotated part's coarsest grid (`setup`'s pitch; the direct
+    /// approach's own default extent, whatever approach `setup` names) and
+    /// the positions of `selection` on it (mm), not yet cast.
+    pub(super) fn lay(
+        input: &'a PartFile,
         setup: &Setup,
         selection: &StartSelection,
-    ) -> Result<DirectStudy, HarnessError> {
+    ) -> Result<DirectMethod<'a>, HarnessError> {
         let part = to_direct_frame(&input.part.triangles);
-        // The direct approach's own default extent, whatever `setup` says.
         let setup = Setup {
             approach: Approach::Direct,
             ..setup.clone()
         };
         let spec = setup.grid_spec(&part)?;
         let grid = HeightGrid::sample(&part.triangles, spec);
-        let footprints = footprints(&setup, spec.pitch);
         let positions = match selection {
             StartSelection::At(given) => given.clone(),
             _ => {
-                let placed = placed_nodes(&grid, &footprints);
+                let placed = placed_nodes(&grid, &footprints(&setup, spec.pitch));
                 let nodes = (0..spec.len())
                     .filter(|&n| placed[n])
                     .map(|n| (n % spec.nx, n / spec.nx))
@@ -441,40 +452,87 @@ impl DirectStudy {
         if positions.is_empty() {
             return Err(HarnessError::NoStarts);
         }
-        Ok(DirectStudy {
+        Ok(DirectMethod {
+            input,
             part,
-            spec,
+            setup,
+            coarse: spec,
+            coarse_grid: Some(grid),
             positions,
+            share: Vec::new(),
+            traces: Vec::new(),
         })
     }
+}
 
-    /// The exact casts of `positions` (the study's, or a shard's share
-    /// of them) at `setup`'s angles.
-    fn exact(
-        &self,
-        input: &PartFile,
-        setup: &Setup,
-        positions: &[[f64; 2]],
-        progress: &dyn Progress,
-    ) -> Result<(Vec<DirectTrace>, f64), HarnessError> {
-        progress.begin(
-            &format!(
-                "exact oracle (direct): {} positions x {} angles",
-                positions.len(),
-                setup.angles.len()
-            ),
-            None,
+impl Method for DirectMethod<'_> {
+    fn coarse(&self) -> GridSpec {
+        self.coarse
+    }
+
+    fn all_starts(&self) -> &[[f64; 2]] {
+        &self.positions
+    }
+
+    fn sample_s(&self) -> f64 {
+        // The direct approach's summaries report no sampling time.
+        0.0
+    }
+
+    /// One exact cast per position and angle: no bisection to resolve a
+    /// pitch, and no budget (nothing predicts it: `--shard` fans it out).
+    fn trace(&mut self, what: Tracing, progress: &dyn Progress) -> Result<f64, HarnessError> {
+        let share = what.share;
+        let angles = &self.setup.angles;
+        let what = format!(
+            "exact oracle (direct): {} positions x {} angles",
+            share.len(),
+            angles.len()
         );
         let t = Instant::now();
-        let part = kneeform_oracle::Part::from_triangles(&input.part.triangles)?;
-        let traces = kneeform_oracle::evaluate_direct(
-            &part,
-            positions,
-            &setup.angles,
-            &direct_oracle_options(&setup.knee, setup.rule.e0),
-        );
-        progress.end();
-        Ok((traces?, t.elapsed().as_secs_f64()))
+        let traces = super::in_stage(progress, &what, None, || {
+            let part = kneeform_oracle::Part::from_triangles(&self.input.part.triangles)?;
+            let options = direct_oracle_options(&self.setup.knee, self.setup.rule.e0);
+            kneeform_oracle::evaluate_direct(&part, &share, angles, &options)
+        })?;
+        self.share = share;
+        self.traces = traces;
+        Ok(t.elapsed().as_secs_f64())
+    }
+
+    fn pitch(
+        &mut self,
+        p: f64,
+        converging: bool,
+        progress: &dyn Progress,
+    ) -> Result<PitchPart, HarnessError> {
+        let spec = spec_at(&self.coarse, p);
+        let what = if converging {
+            format!("pitch {p} mm: {} x {} grid (direct)", spec.nx, spec.nz)
+        } else {
+            super::comparing(self.traces.len())
+        };
+        let (pairs, grid_s) = super::in_stage(progress, &what, None, || {
+            let grid = match self.coarse_grid.take() {
+                Some(grid) if grid.spec == spec => grid,
+                _ => HeightGrid::sample(&self.part.triangles, spec),
+            };
+            direct_pairs(
+                &grid,
+                &footprints(&self.setup, p),
+                &self.share,
+                &self.traces,
+                self.setup.rule.e0,
+            )
+        })?;
+        Ok(PitchPart {
+            pitch: p,
+            pairs: Pairs::Direct(pairs),
+            band: NO_BAND,
+            grid_s,
+            seconds: 0.0,
+            nodes: spec.len(),
+        })
     }
 }
 
@@ -534,33 +592,6 @@ pub struct DirectVerification {
     pub summary: DirectVerifySummary,
 }
 
-/// The direct verification of `shard`'s share of the positions (all of
-/// them without a shard): the study, the share's pairs, the seconds of
-/// their grid side and of the oracle.
-pub(super) fn verify_pairs(
-    input: &PartFile,
-    setup: &Setup,
-    options: &VerifyOptions,
-    shard: Option<Shard>,
-    progress: &dyn Progress,
-) -> Result<(DirectStudy, Vec<DirectPair>, f64, f64), HarnessError> {
-    setup.validate()?;
-    check_selection(&options.selection)?;
-    check_tolerance(options.tolerance)?;
-    let study = DirectStudy::new(input, setup, &options.selection)?;
-    let positions = share(&study.positions, shard)?;
-    let (traces, oracle_s) = study.exact(input, setup, &positions, progress)?;
-    let grid = HeightGrid::sample(&study.part.triangles, study.spec);
-    let (pairs, grid_s) = direct_pairs(
-        &grid,
-        &footprints(setup, setup.pitch),
-        &positions,
-        &traces,
-        setup.rule.e0,
-    )?;
-    Ok((study, pairs, grid_s, oracle_s))
-}
-
 impl DirectVerifySummary {
     /// `verify.json` of `input`, `setup` and `options` before any
     /// comparison: no pass, no statistics, no counts, no seconds
@@ -604,24 +635,6 @@ impl DirectVerifySummary {
         self.grid_s = comparison.grid_s;
         self.oracle_s = oracle_s;
     }
-}
-
-/// Verifies the direct approach's grid first contacts against the exact
-/// casts at `setup`'s pitch; positions are `(y0, z0)` nodes of the grid.
-pub fn verify_direct(
-    input: &PartFile,
-    setup: &Setup,
-    options: &VerifyOptions,
-    progress: &dyn Progress,
-) -> Result<DirectVerification, HarnessError> {
-    let (_, pairs, grid_s, oracle_s) = verify_pairs(input, setup, options, None, progress)?;
-    let comparison = assemble_direct(pairs, grid_s);
-    let mut summary = DirectVerifySummary::new(input, setup, options);
-    summary.set_comparison(&comparison, oracle_s);
-    Ok(DirectVerification {
-        comparison,
-        summary,
-    })
 }
 
 /// One pitch of a direct convergence study.
@@ -677,81 +690,6 @@ pub struct DirectConvergence {
     pub results: Vec<DirectPitchResult>,
     /// `converge.json`.
     pub summary: DirectConvergeSummary,
-}
-
-/// One pitch of a direct convergence study on some positions: its pairs,
-/// not yet assembled, and what was measured.
-pub(super) struct DirectPitchPairs {
-    pub(super) pitch: f64,
-    pub(super) pairs: Vec<DirectPair>,
-    pub(super) grid_s: f64,
-    pub(super) nodes: usize,
-}
-
-impl DirectPitchPairs {
-    /// The pitch assembled: the unsharded study's.
-    fn assemble(self) -> DirectPitchResult {
-        DirectPitchResult {
-            pitch: self.pitch,
-            comparison: assemble_direct(self.pairs, self.grid_s),
-            nodes: self.nodes,
-        }
-    }
-}
-
-/// The direct convergence study's pitches on `shard`'s share of the
-/// positions (all of them without a shard), coarsest first: the study,
-/// each pitch's pairs, and the oracle's seconds.
-pub(super) fn converge_pairs(
-    input: &PartFile,
-    setup: &Setup,
-    options: &ConvergeOptions,
-    shard: Option<Shard>,
-    progress: &dyn Progress,
-) -> Result<(DirectStudy, Vec<DirectPitchPairs>, f64), HarnessError> {
-    options.validate()?;
-    let pitches = &options.pitches;
-    let coarse_setup = Setup {
-        pitch: pitches[0],
-        ..setup.clone()
-    };
-    coarse_setup.validate()?;
-    let study = DirectStudy::new(input, &coarse_setup, &options.selection)?;
-    let c = study.spec;
-    let spec_at = |p: f64| {
-        let r = (c.pitch / p).round() as usize;
-        GridSpec::explicit(c.x(0), c.z(0), (c.nx - 1) * r + 1, (c.nz - 1) * r + 1, p)
-    };
-    for &p in pitches {
-        setup.check_memory(&spec_at(p), study.part.triangles.len())?;
-    }
-    let positions = share(&study.positions, shard)?;
-    let (traces, oracle_s) = study.exact(input, setup, &positions, progress)?;
-    let mut parts = Vec::new();
-    for &p in pitches {
-        let spec = spec_at(p);
-        progress.begin(
-            &format!("pitch {p} mm: {} x {} grid (direct)", spec.nx, spec.nz),
-            None,
-        );
-        let grid = HeightGrid::sample(&study.part.triangles, spec);
-        let pairs = direct_pairs(
-            &grid,
-            &footprints(setup, p),
-            &positions,
-            &traces,
-            setup.rule.e0,
-        );
-        progress.end();
-        let (pairs, grid_s) = pairs?;
-        parts.push(DirectPitchPairs {
-            pitch: p,
-            pairs,
-            grid_s,
-            nodes: spec.len(),
-        });
-    }
-    Ok((study, parts, oracle_s))
 }
 
 impl DirectConvergeSummary {
@@ -814,24 +752,6 @@ impl DirectConvergeSummary {
                 .max_by(f64::total_cmp)
         });
     }
-}
-
-/// The direct approach compared with the exact casts at every pitch of
-/// `options`, on the coarsest grid's positions (nodes of every finer grid,
-/// since the pitches nest); the oracle runs once.
-pub fn converge_direct(
-    input: &PartFile,
-    setup: &Setup,
-    options: &ConvergeOptions,
-    progress: &dyn Progress,
-) -> Result<DirectConvergence, HarnessError> {
-    let (study, parts, oracle_s) = converge_pairs(input, setup, options, None, progress)?;
-    let results: Vec<DirectPitchResult> =
-        parts.into_iter().map(DirectPitchPairs::assemble).collect();
-    let mut summary =
-        DirectConvergeSummary::new(input, setup, options, study.positions.len(), oracle_s);
-    summary.set_results(&results);
-    Ok(DirectConvergence { results, summary })
 }
 
 #[cfg(test)]

@@ -3,8 +3,8 @@
 //! faulty one must fail. (Crate-private: the faults are in no public
 //! option.)
 
+use super::study::verify_with;
 use super::trace::Fault;
-use super::verify::verify_with;
 use super::{Comparison, StartSelection, TieBand, VerifyOptions};
 use crate::frame::Side;
 use crate::input::PartFile;

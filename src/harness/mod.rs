@@ -20,8 +20,13 @@
 //! * `nearest`: a 2-d tree for the area distance's nearest points;
 //! * `pairs`: what a study compares per start and angle, and per pitch,
 //!   for either approach, and a shard's share of the starts;
-//! * `sharded`: a study's starts fanned out over shards
-//!   (`verify --shard K/N`, either approach) and merged back.
+//! * `method`: what a study does its own way per approach (the `Method`
+//!   trait, which `converge::Ladder` and `direct::DirectMethod` implement);
+//! * `study`: the one path every study takes, verify or converge, either
+//!   approach, whole or one shard's share ([`study()`], [`study_shard`]),
+//!   and the merge of shares;
+//! * `sharded`: what a shard keeps of its share (`verify --shard K/N`,
+//!   either approach) and how the shares' pairs go back in order.
 //!
 //! **Invariant:** the harness reads the engine's grid and the oracle's
 //! traces and computes neither side's geometry, with one exception stated
@@ -36,10 +41,12 @@ pub(crate) mod check;
 pub(crate) mod compare;
 pub(crate) mod converge;
 pub(crate) mod direct;
+pub(crate) mod method;
 pub(crate) mod metrics;
 pub(crate) mod nearest;
 pub(crate) mod pairs;
 pub(crate) mod sharded;
+pub(crate) mod study;
 pub(crate) mod trace;
 pub(crate) mod verify;
 
@@ -50,15 +57,12 @@ pub use auto::{AutoPitch, choose_pitch};
 pub use causes::Mechanism;
 pub use check::check_analysis;
 pub use compare::{Comparison, StartSelection};
-pub use converge::{ConvergeOptions, Convergence, ROUNDING_MM, converge, fit_power_law};
-pub use direct::{
-    DIRECT_METRICS, DirectConvergence, DirectVerification, converge_direct, verify_direct,
-};
+pub use converge::{ConvergeOptions, Convergence, ROUNDING_MM, fit_power_law};
+pub use direct::{DIRECT_METRICS, DirectConvergence, DirectVerification};
 pub use metrics::{DECIDED_METRICS, METRICS, TieBand};
-pub use sharded::{
-    StudyPart, converge_direct_shard, converge_shard, verify_direct_shard, verify_shard,
-};
-pub use verify::{Verification, VerifyOptions, oracle_options, sampling_tolerance, verify};
+pub use sharded::StudyPart;
+pub use study::{Study, StudyOptions, converge, study, study_shard, verify};
+pub use verify::{Verification, VerifyOptions, oracle_options, sampling_tolerance};
 
 use serde::{Deserialize, Serialize};
 
@@ -121,10 +125,10 @@ pub enum HarnessError {
     #[error(transparent)]
     Oracle(#[from] kneeform_oracle::OracleError),
     /// The setup asks for the direct approach of a call that compares
-    /// push-and-slide: the direct approach has its own
-    /// ([`verify_direct`], [`converge_direct`]); `--pitch auto` has none.
+    /// push-and-slide: [`study()`] compares either approach; `--pitch
+    /// auto` has none for the direct approach.
     #[error(
-        "this compares push-and-slide with the exact oracle: the direct approach is compared by verify_direct and converge_direct (kneeform verify/converge --approach direct), and --pitch auto does not choose its pitch yet"
+        "this compares push-and-slide with the exact oracle: the direct approach is compared by harness::study (kneeform verify/converge --approach direct), and --pitch auto does not choose its pitch yet"
     )]
     DirectApproach,
     /// No start is placed on the part.
@@ -277,6 +281,6 @@ pub(crate) fn in_stage<T>(
 
 /// The stage in which a study's grid slides are compared with the exact
 /// traces of `pairs` start-angle pairs: minutes on a large part.
-fn comparing(pairs: usize) -> String {
+pub(crate) fn comparing(pairs: usize) -> String {
     format!("grid against exact: {pairs} start-angle pairs")
 }

@@ -1,6 +1,7 @@
-//! `verify` as a library call: a part's starts pushed and slid on the grid
-//! and by the exact oracle at one pitch, compared ([`verify`]); the result
-//! is what `verify.csv` and `verify.json` hold ([`Verification`]).
+//! `verify`'s own parts: its options, its summary (`verify.json`), the
+//! starts it selects and the oracle's run with its predicted time. The
+//! study itself runs on [`super::study`]'s one path; its result is what
+//! `verify.csv` and `verify.json` hold ([`Verification`]).
 
 use std::time::Instant;
 
@@ -8,12 +9,8 @@ use kneeform_oracle::{KneeFormDims, OracleOptions, StartTrace};
 use serde::{Deserialize, Serialize};
 
 use super::HarnessError;
-use super::compare::{
-    AreaDistance, CompareOptions, Comparison, Counts, GridSide, StartSelection, compare_grid_with,
-    select_starts,
-};
+use super::compare::{AreaDistance, Comparison, Counts, StartSelection, select_starts};
 use super::metrics::{Stats, TieBand};
-use super::trace::Fault;
 use crate::analysis::Progress;
 use crate::grid::{GridSpec, HeightGrid};
 use crate::input::PartFile;
@@ -223,129 +220,6 @@ pub(super) fn run_oracle(
             .collect();
         Ok((traces, t.elapsed().as_secs_f64()))
     })
-}
-
-/// Verifies the grid against the exact oracle at `setup`'s pitch, on the
-/// starts of `options` (SPEC, "What the harness measures").
-pub fn verify(
-    input: &PartFile,
-    setup: &Setup,
-    options: &VerifyOptions,
-    progress: &dyn Progress,
-) -> Result<Verification, HarnessError> {
-    verify_with(input, setup, options, progress, None)
-}
-
-/// [`verify`] with an optional deliberate mistake on the grid side.
-pub(crate) fn verify_with(
-    input: &PartFile,
-    setup: &Setup,
-    options: &VerifyOptions,
-    progress: &dyn Progress,
-    fault: Option<Fault>,
-) -> Result<Verification, HarnessError> {
-    let traced = Traced::new(input, setup, options, None, progress)?;
-    let Traced {
-        spec,
-        grid,
-        footprints,
-        starts,
-        traces,
-        compare,
-        sample_s,
-        oracle_s,
-        ..
-    } = &traced;
-    // The grid's slides and their comparison: minutes on a large part.
-    let comparison = super::in_stage(progress, &super::comparing(traces.len()), None, || {
-        compare_grid_with(
-            &input.part.triangles,
-            grid,
-            footprints,
-            starts,
-            traces,
-            compare,
-            GridSide { cells: None, fault },
-        )
-    })?;
-    let summary = VerifySummary::new(
-        input,
-        setup,
-        options,
-        spec,
-        &comparison,
-        *sample_s,
-        *oracle_s,
-    );
-    Ok(Verification {
-        comparison,
-        summary,
-    })
-}
-
-/// The first half of a verification, up to the comparison: the options
-/// checked, the grid sampled, the study's starts chosen, and the exact
-/// oracle run on `shard`'s share of them (all of them without a shard).
-/// [`verify`] and [`super::verify_shard`] both begin here.
-pub(super) struct Traced {
-    pub spec: GridSpec,
-    pub grid: HeightGrid,
-    pub footprints: Vec<GridFootprint>,
-    /// Every start of the study, in its order.
-    pub all: Vec<[f64; 2]>,
-    /// The share traced: `all`, or the shard's.
-    pub starts: Vec<[f64; 2]>,
-    /// The oracle's traces of `starts`.
-    pub traces: Vec<StartTrace>,
-    pub compare: CompareOptions,
-    /// Seconds sampling the grid.
-    pub sample_s: f64,
-    /// Seconds of the oracle.
-    pub oracle_s: f64,
-}
-
-impl Traced {
-    pub(super) fn new(
-        input: &PartFile,
-        setup: &Setup,
-        options: &VerifyOptions,
-        shard: Option<crate::partition::Shard>,
-        progress: &dyn Progress,
-    ) -> Result<Traced, HarnessError> {
-        setup.validate()?;
-        if setup.approach == crate::frame::Approach::Direct {
-            return Err(HarnessError::DirectApproach);
-        }
-        options.validate()?;
-        let t = Instant::now();
-        let triangles = &input.part.triangles;
-        let spec = setup.grid_spec(&input.part)?;
-        let grid = HeightGrid::sample(triangles, spec);
-        let footprints = setup.footprints(&spec);
-        let sample_s = t.elapsed().as_secs_f64();
-        let all = start_positions(&grid, &footprints, &options.selection)?;
-        let starts = super::pairs::share(&all, shard)?;
-        let oracle = oracle_options(&setup.knee, setup.pitch, spec.x(0));
-        let (traces, oracle_s) = run_oracle(
-            triangles,
-            &starts,
-            &setup.angles,
-            &oracle,
-            options.budget_s,
-            progress,
-        )?;
-        Ok(Traced {
-            spec,
-            grid,
-            footprints,
-            all,
-            starts,
-            traces,
-            compare: CompareOptions::of(setup, options.tie_band_per_mm),
-            sample_s,
-            oracle_s,
-        })
-    }
 }
 
 impl VerifySummary {

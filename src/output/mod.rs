@@ -49,11 +49,7 @@ pub use self::results::{WriteOptions, write_analysis};
 pub(crate) use self::stl::write_colliding_area;
 pub use self::stl::write_stl;
 #[cfg(feature = "harness")]
-pub use self::studies::{
-    write_convergence, write_convergence_files, write_direct_convergence,
-    write_direct_convergence_files, write_direct_verification, write_direct_verification_files,
-    write_verification, write_verification_files,
-};
+pub use self::studies::{write_study, write_study_files};
 
 /// A run's record of everything it did (`summary.json`): the one name
 /// every reader and writer uses.

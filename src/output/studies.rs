@@ -1,24 +1,34 @@
-//! A verification's and a convergence study's result files
-//! ([`write_verification`], [`write_convergence`]; both also into a staged
-//! directory, for a merge of their shards), and the same two for the
-//! direct approach ([`write_direct_verification`],
-//! [`write_direct_convergence`]). Built with the `harness` feature.
+//! A study's result files, for either study and approach
+//! ([`write_study`]; [`write_study_files`] into a staged directory, for a
+//! merge of its shards): a verification's, a convergence study's, and the
+//! same two for the direct approach. Built with the `harness` feature.
 
 use std::path::Path;
 
 use super::results::write_json;
 use super::{OutputDir, WriteError};
-use crate::harness::{Convergence, DirectConvergence, DirectVerification, Verification};
+use crate::harness::{Convergence, DirectConvergence, DirectVerification, Study, Verification};
 
-/// Writes `verify.csv` (one row per start and angle) and `verify.json`
-/// into `dir`, which appears with both or is left as it was.
-pub fn write_verification(dir: &Path, verification: &Verification) -> Result<(), WriteError> {
-    staged(dir, |out| write_verification_files(out, verification))
+/// Writes `study`'s files into `dir`, which appears with all of them or is
+/// left as it was.
+pub fn write_study(dir: &Path, study: &Study) -> Result<(), WriteError> {
+    staged(dir, |out| write_study_files(out, study))
 }
 
-/// Writes [`write_verification`]'s files into the staged directory `out`
-/// (`kneeform merge` of a verification's shards).
-pub fn write_verification_files(
+/// Writes [`write_study`]'s files into the staged directory `out`
+/// (`kneeform merge` of a study's shards).
+pub fn write_study_files(out: &OutputDir, study: &Study) -> Result<(), WriteError> {
+    match study {
+        Study::Verify(v) => write_verification_files(out, v),
+        Study::Converge(c) => write_convergence_files(out, c),
+        Study::VerifyDirect(v) => write_direct_verification_files(out, v),
+        Study::ConvergeDirect(c) => write_direct_convergence_files(out, c),
+    }
+}
+
+/// A verification's files: `verify.csv` (one row per start and angle) and
+/// `verify.json`.
+fn write_verification_files(
     out: &OutputDir,
     verification: &Verification,
 ) -> Result<(), WriteError> {
@@ -26,20 +36,10 @@ pub fn write_verification_files(
     write_json(&out.path("verify.json"), &verification.summary)
 }
 
-/// Writes a convergence study into `dir`: `converge.csv` (every metric at
-/// every pitch), `verify_<pitch>mm.csv` (each pitch's per-start rows),
-/// `converge.json` and the plots; `dir` appears with all of them or is
-/// left as it was.
-pub fn write_convergence(dir: &Path, convergence: &Convergence) -> Result<(), WriteError> {
-    staged(dir, |out| write_convergence_files(out, convergence))
-}
-
-/// Writes [`write_convergence`]'s files into the staged directory `out`
-/// (`kneeform merge` of a convergence study's shards).
-pub fn write_convergence_files(
-    out: &OutputDir,
-    convergence: &Convergence,
-) -> Result<(), WriteError> {
+/// A convergence study's files: `converge.csv` (every metric at every
+/// pitch), `verify_<pitch>mm.csv` (each pitch's per-start rows),
+/// `converge.json` and the plots.
+fn write_convergence_files(out: &OutputDir, convergence: &Convergence) -> Result<(), WriteError> {
     let results = &convergence.results;
     let tolerance = convergence.summary.tolerance_mm;
     let path = out.path("converge.csv");
@@ -80,20 +80,9 @@ pub fn write_convergence_files(
     super::write_plots(out.path(".").as_path(), results, &convergence.fits)
 }
 
-/// Writes a direct verification into `dir`: `verify.csv` (one row per
-/// position and angle) and `verify.json` (`"approach": "direct"`).
-pub fn write_direct_verification(
-    dir: &Path,
-    verification: &DirectVerification,
-) -> Result<(), WriteError> {
-    staged(dir, |out| {
-        write_direct_verification_files(out, verification)
-    })
-}
-
-/// Writes [`write_direct_verification`]'s files into the staged directory
-/// `out` (`kneeform merge` of a direct verification's shards).
-pub fn write_direct_verification_files(
+/// A direct verification's files: `verify.csv` (one row per position and
+/// angle) and `verify.json` (`"approach": "direct"`).
+fn write_direct_verification_files(
     out: &OutputDir,
     verification: &DirectVerification,
 ) -> Result<(), WriteError> {
@@ -101,19 +90,10 @@ pub fn write_direct_verification_files(
     write_json(&out.path("verify.json"), &verification.summary)
 }
 
-/// Writes a direct convergence study into `dir`: `converge.csv` (both
-/// metrics at every pitch), `verify_<pitch>mm.csv` (each pitch's rows) and
+/// A direct convergence study's files: `converge.csv` (both metrics at
+/// every pitch), `verify_<pitch>mm.csv` (each pitch's rows) and
 /// `converge.json` (`"approach": "direct"`).
-pub fn write_direct_convergence(
-    dir: &Path,
-    convergence: &DirectConvergence,
-) -> Result<(), WriteError> {
-    staged(dir, |out| write_direct_convergence_files(out, convergence))
-}
-
-/// Writes [`write_direct_convergence`]'s files into the staged directory
-/// `out` (`kneeform merge` of a direct convergence study's shards).
-pub fn write_direct_convergence_files(
+fn write_direct_convergence_files(
     out: &OutputDir,
     convergence: &DirectConvergence,
 ) -> Result<(), WriteError> {

@@ -2,8 +2,8 @@
 //! --shard K/N` (with `--approach direct` too) write one
 //! [`crate::harness::StudyPart`] as `shard.json` and `shard.bin`;
 //! [`merge_study`] reads N of them, checks that they are every shard of
-//! one study exactly once, and merges them (the harness's `merge_verify`,
-//! `merge_converge`, `merge_verify_direct`, `merge_converge_direct`).
+//! one study exactly once, and merges them (the harness's one merge, which
+//! the unsharded study goes through too).
 //!
 //! * `shard.json` ([`StudyRecord`]): which shard of how many, the study's
 //!   start count and this shard's start indices, the options
@@ -37,11 +37,8 @@ use super::{
 use crate::grid::GridSpec;
 use crate::harness::metrics::TieBand;
 use crate::harness::pairs::{Pairs, PitchPart};
-use crate::harness::sharded::{
-    StudySettings, StudySummary, merge_converge, merge_converge_direct, merge_verify,
-    merge_verify_direct,
-};
-use crate::harness::{Convergence, DirectConvergence, DirectVerification, StudyPart, Verification};
+use crate::harness::sharded::{StudySettings, StudySummary};
+use crate::harness::{Study, StudyPart};
 use crate::output::{OutputDir, WriteError};
 
 /// `shard.json` of a study's shard.
@@ -82,19 +79,6 @@ const MAGIC: &[u8; 16] = b"kneeform study 4";
 /// The largest `shard.bin` read (bytes): far beyond a study's (a few
 /// hundred bytes per start and angle), short of exhausting memory.
 const MAX_BIN_BYTES: u64 = 8 << 30;
-
-/// A study merged from its shards.
-#[derive(Debug)]
-pub enum MergedStudy {
-    /// `verify`'s.
-    Verify(Box<Verification>),
-    /// `converge`'s.
-    Converge(Box<Convergence>),
-    /// `verify --approach direct`'s.
-    VerifyDirect(Box<DirectVerification>),
-    /// `converge --approach direct`'s.
-    ConvergeDirect(Box<DirectConvergence>),
-}
 
 /// Writes `part` as its shard: `shard.json` and `shard.bin` in the staged
 /// directory `out`.
@@ -222,7 +206,7 @@ impl ShardDir for StudyFiles {
 /// Reads the study shard directories `dirs` (one per shard, in any
 /// order) and merges them into the whole study, as the unsharded command
 /// computes it (clock readings aside).
-pub fn merge_study(dirs: &[PathBuf]) -> Result<MergedStudy, ShardError> {
+pub fn merge_study(dirs: &[PathBuf]) -> Result<Study, ShardError> {
     let first_identity = std::cell::OnceCell::new();
     let shards = read_set(
         dirs,
@@ -244,18 +228,7 @@ pub fn merge_study(dirs: &[PathBuf]) -> Result<MergedStudy, ShardError> {
     let mut shards = shards;
     shards.sort_by_key(|s| s.record.shard.index);
     let parts: Vec<StudyPart> = shards.into_iter().map(|s| s.part).collect();
-    let merged = match parts[0].summary {
-        StudySummary::Verify(_) => merge_verify(&parts).map(|v| MergedStudy::Verify(Box::new(v))),
-        StudySummary::Converge(_) => {
-            merge_converge(&parts).map(|c| MergedStudy::Converge(Box::new(c)))
-        }
-        StudySummary::VerifyDirect(_) => {
-            merge_verify_direct(&parts).map(|v| MergedStudy::VerifyDirect(Box::new(v)))
-        }
-        StudySummary::ConvergeDirect(_) => {
-            merge_converge_direct(&parts).map(|c| MergedStudy::ConvergeDirect(Box::new(c)))
-        }
-    };
+    let merged = crate::harness::study::merge(parts);
     merged.ok_or_else(|| ShardError::Mismatch("the shards hold no study".into()))
 }
 

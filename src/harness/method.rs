@@ -1,0 +1,58 @@
+//! What a study does its own way for each approach ([`Method`]), in a
+//! leaf that the approaches' modules (`converge`, `direct`) implement and
+//! the one study path (`study`) calls, so that neither imports the other.
+
+use super::HarnessError;
+use super::pairs::PitchPart;
+use crate::analysis::Progress;
+use crate::grid::GridSpec;
+
+/// What [`Method::trace`] traces, and within what time.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Tracing {
+    /// The starts (some of [`Method::all_starts`], in their order).
+    pub share: Vec<[f64; 2]>,
+    /// The finest pitch the traces must resolve (mm).
+    pub finest: f64,
+    /// Refuse, before the traces, an oracle predicted (from a sample) to
+    /// take longer (s): `--budget-s`.
+    pub refuse_beyond_s: Option<f64>,
+    /// Give up as soon as this many seconds are spent (a pitch study's
+    /// budget, `--pitch auto`).
+    pub within_s: Option<f64>,
+}
+
+/// What a study does its own way for one approach: its grids, its exact
+/// side and its pairs. The study's steps, in order: [`Method::coarse`]
+/// and [`Method::all_starts`] once laid, [`Method::trace`] on a share of
+/// them, then [`Method::pitch`] at each pitch, coarsest first.
+pub(super) trait Method {
+    /// The coarsest grid (the study's starts are its nodes).
+    fn coarse(&self) -> GridSpec;
+    /// Every start of the study (mm), in its order.
+    fn all_starts(&self) -> &[[f64; 2]];
+    /// Seconds sampling the coarsest grid (the slide's summaries report
+    /// them; 0 where none does).
+    fn sample_s(&self) -> f64;
+    /// Takes the exact side of `what.share` at the study's angles,
+    /// resolving pitches down to `what.finest`; the oracle's seconds.
+    fn trace(&mut self, what: Tracing, progress: &dyn Progress) -> Result<f64, HarnessError>;
+    /// The share's pairs at pitch `p` (mm, dividing the coarsest). A
+    /// convergence study's pitch (`converging`) is a stage named by its
+    /// pitch, with the engine's full run timed; a verification's one pitch
+    /// is the stage comparing the grid with the exact side.
+    fn pitch(
+        &mut self,
+        p: f64,
+        converging: bool,
+        progress: &dyn Progress,
+    ) -> Result<PitchPart, HarnessError>;
+}
+
+/// The grid at pitch `p` over exactly the extent of `coarse`, from its
+/// origin (`p` divides its pitch).
+pub(super) fn spec_at(coarse: &GridSpec, p: f64) -> GridSpec {
+    let c = coarse;
+    let r = (c.pitch / p).round() as usize;
+    GridSpec::explicit(c.x(0), c.z(0), (c.nx - 1) * r + 1, (c.nz - 1) * r + 1, p)
+}
