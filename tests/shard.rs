@@ -359,6 +359,74 @@ fn four_verify_shards_merged_are_the_unsharded_verification_byte_for_byte() {
     );
 }
 
+/// Issue 26: a strip's starts are traced in chains along their rows
+/// (each start joins its -x neighbour's curve), and a chained trace is a
+/// function of its block of the row alone, so shards that split every row
+/// between them merge into the unsharded strip byte for byte.
+#[test]
+fn four_shards_of_a_chained_strip_merged_are_the_unsharded_strip_byte_for_byte() {
+    let dir = scratch_dir("verify-shards-strip");
+    let part = scenario("bump");
+    // Three start rows of the 4 mm grid, every placed start of each.
+    let strip = |out: &Path, shard: Option<&str>| {
+        let mut args = vec![
+            "verify",
+            part.as_str(),
+            "--angles=-30,0,30",
+            "--pitch",
+            "4",
+            "--tolerance",
+            "1",
+            "--starts",
+            "strip:-4:4",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if let Some(shard) = shard {
+            args.extend(["--shard", shard]);
+        }
+        kneeform(&args)
+    };
+    let whole = strip(&dir.join("whole"), None);
+    let code = whole.status.code();
+    assert!(
+        matches!(code, Some(0 | 1)),
+        "{}",
+        String::from_utf8_lossy(&whole.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("whole/verify.json")).unwrap()).unwrap();
+    assert_eq!(
+        summary["oracle_chain"],
+        serde_json::json!({"pitch": 4.0, "block": 64}),
+        "a strip says how its traces were shared"
+    );
+    assert_eq!(summary["starts"], "strip:-4:4");
+    let shards: Vec<PathBuf> = (1..=4)
+        .map(|k| {
+            let out = dir.join(format!("shard-{k}"));
+            ok(strip(&out, Some(&format!("{k}/4"))), "a shard");
+            out
+        })
+        .collect();
+    let merged = dir.join("merged");
+    let order: Vec<&Path> = [3, 1, 0, 2].iter().map(|&k| shards[k].as_path()).collect();
+    let result = merge_study(&order, &merged);
+    assert_eq!(
+        result.status.code(),
+        code,
+        "{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    assert_eq!(assert_same_files(&dir.join("whole"), &merged), 2);
+    let rows = std::fs::read_to_string(merged.join("verify.csv")).unwrap();
+    assert!(
+        rows.lines().count() > 3 * 3 * 20,
+        "three whole rows at three angles"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn four_converge_shards_merged_are_the_unsharded_study_byte_for_byte() {
     let dir = scratch_dir("converge-shards");

@@ -6,14 +6,15 @@
 //! a diagonal ridge, facing -y) refined to the paper's 369,408+ triangles,
 //! then pushes and slides a sample of starts at a few angles,
 //! single-threaded and with 2 rayon threads, and prints shape casts per
-//! second and time per start (push + full slide trace).
+//! second and time per start (push + full slide trace); then a row of
+//! consecutive starts, each alone and chained along the row.
 //!
 //! Run: `cargo run --release -p kneeform-oracle --example oracle_bench`
 
 use std::time::Instant;
 
 use kneeform::scenario::{PAPER_TRIANGLES, builtin};
-use kneeform_oracle::{OracleOptions, Part, StartStatus, StartTrace, evaluate};
+use kneeform_oracle::{Chain, OracleOptions, Part, StartStatus, StartTrace, evaluate};
 
 fn run(part: &Part, starts: &[[f64; 2]], angles: &[f64], options: &OracleOptions, threads: usize) {
     let pool = rayon::ThreadPoolBuilder::new()
@@ -91,5 +92,22 @@ fn main() {
     let angles = [-30.0, 0.0, 30.0];
     for threads in [1, 2] {
         run(&part, &starts, &angles, &options, threads);
+    }
+    // A row of 128 consecutive grid starts (1.24 mm apart, z = 300.08 mm,
+    // a strip's row) at 4 angles: each start alone, then chained along
+    // the row in blocks of 64 (`verify --starts strip:...`).
+    let pitch = 1.24;
+    let row: Vec<[f64; 2]> = (0..128)
+        .map(|k| [pitch * (480 + k) as f64, pitch * 242.0])
+        .collect();
+    let angles = [-13.0, 0.0, 9.0, 30.0];
+    let chained = OracleOptions {
+        chain: Some(Chain { pitch, block: 64 }),
+        ..options
+    };
+    println!("a row of {} starts x {} angles:", row.len(), angles.len());
+    for (what, options) in [("alone", &options), ("chained", &chained)] {
+        print!("  {what}: ");
+        run(&part, &row, &angles, options, 2);
     }
 }

@@ -3,7 +3,7 @@
 use rayon::prelude::*;
 
 use crate::knee_form::KneeForm;
-use crate::trace::trace_validated;
+use crate::trace::{Chain, trace_joining, trace_validated};
 use crate::{OracleError, OracleOptions, Part, StartTrace};
 
 /// Pushes and slides every start at every angle, in parallel on rayon's
@@ -75,12 +75,80 @@ pub fn evaluate_pairs(
         .iter()
         .map(|&angle| KneeForm::new(options.knee_form, angle))
         .collect();
-    Ok(pairs
+    let Some(chain) = options.chain else {
+        return Ok(pairs
+            .par_iter()
+            .map(|&(s, a)| {
+                let trace = trace_validated(part, &knees[a], starts[s], options);
+                traced();
+                trace
+            })
+            .collect());
+    };
+    // Each chain traced from its block's first column to the last column
+    // asked for, its links in order; the chains in parallel.
+    let groups = chain_groups(starts, pairs, &chain);
+    let traced_groups: Vec<Vec<(usize, StartTrace)>> = groups
         .par_iter()
-        .map(|&(s, a)| {
-            let trace = trace_validated(part, &knees[a], starts[s], options);
-            traced();
-            trace
+        .map(|group| {
+            let (s, a) = pairs[group[0]];
+            let z = starts[s][1];
+            let column = |k: usize| chain.column(starts[pairs[k].0][0]);
+            let Some(last) = group.iter().filter_map(|&k| column(k)).max() else {
+                // Off the lattice: one start, traced on its own.
+                let trace = trace_validated(part, &knees[a], starts[s], options);
+                traced();
+                return vec![(group[0], trace)];
+            };
+            let mut out = Vec::with_capacity(group.len());
+            let mut left: Option<StartTrace> = None;
+            for c in chain.head(last)..=last {
+                let start = [chain.x(c), z];
+                let trace = trace_joining(part, &knees[a], start, options, left.as_ref());
+                for &k in group.iter().filter(|&&k| column(k) == Some(c)) {
+                    out.push((k, trace.clone()));
+                    traced();
+                }
+                left = Some(trace);
+            }
+            out
         })
+        .collect();
+    let mut traces: Vec<Option<StartTrace>> = vec![None; pairs.len()];
+    for (k, trace) in traced_groups.into_iter().flatten() {
+        traces[k] = Some(trace);
+    }
+    Ok(traces
+        .into_iter()
+        .map(|t| t.expect("every pair lies in one chain"))
         .collect())
+}
+
+/// The pairs of `pairs` (indices into it) that [`evaluate_pairs`] traces
+/// together under `chain`: one group per angle, row (`z`) and block of
+/// the lattice, in the order of their first pair; a start off the lattice
+/// alone. Tracing whole groups, any subset of them costs no more than its
+/// own chains.
+pub fn chain_groups(
+    starts: &[[f64; 2]],
+    pairs: &[(usize, usize)],
+    chain: &Chain,
+) -> Vec<Vec<usize>> {
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    let mut index: std::collections::HashMap<(usize, u64, i64), usize> = Default::default();
+    for (k, &(s, a)) in pairs.iter().enumerate() {
+        let [x, z] = starts[s];
+        match chain.column(x) {
+            Some(c) => {
+                let key = (a, z.to_bits(), chain.head(c));
+                let g = *index.entry(key).or_insert_with(|| {
+                    groups.push(Vec::new());
+                    groups.len() - 1
+                });
+                groups[g].push(k);
+            }
+            None => groups.push(vec![k]),
+        }
+    }
+    groups
 }

@@ -75,7 +75,7 @@ mod sweep;
 mod trace;
 mod window;
 
-pub use batch::{evaluate, evaluate_pairs, evaluate_reporting};
+pub use batch::{chain_groups, evaluate, evaluate_pairs, evaluate_reporting};
 pub use direct::{
     DirectContact, DirectOptions, DirectStatus, DirectTrace, direct_contact, evaluate_direct,
 };
@@ -84,6 +84,7 @@ pub use knee_form::{KneeForm, KneeFormDims};
 pub use part::{Part, Side};
 pub use rapier::{RapierComparison, RapierContact, RapierOptions, RapierSlide, rapier_slide};
 pub use trace::{
-    ContactPoint, FailureReason, OracleOptions, SlideEnd, StartStatus, StartTrace, trace_start,
+    Chain, ContactPoint, FailureReason, OracleOptions, SlideEnd, StartStatus, StartTrace,
+    trace_start,
 };
 pub use window::{Level, LevelCurve, WindowDrop};

@@ -100,6 +100,58 @@ pub struct OracleOptions {
     /// faster on a console. Off only to check that (default on).
     #[serde(default = "prune_on")]
     pub prune: bool,
+    /// Starts on a lattice traced as chains along their row ([`Chain`]):
+    /// a start's curve joins its -x neighbour's once it has passed it
+    /// below its release level, and from there on its contacts are the
+    /// neighbour's. `None` (the default): every start traced on its own.
+    #[serde(default)]
+    pub chain: Option<Chain>,
+}
+
+/// How starts on a lattice share their traces (SPEC's curve is the same
+/// function whichever start it is sampled from).
+///
+/// The starts of one knee-form row (one `z`, one angle) at the lattice's
+/// columns `c` (x = `pitch * c`) are cut into blocks of `block` columns
+/// (`c.div_euclid(block)`); within a block, start `c` is traced after
+/// start `c - 1` and joins its curve: once one of its own contacts lies
+/// at a travel of at least `pitch` and a level at or below the
+/// neighbour's release level (`yr* - eps`), every lower level travels
+/// the pitch freely (lowering the knee-form only moves it away from a
+/// part that bounds a solid) and then exactly as far as the neighbour
+/// does, so its further contacts are the neighbour's, `pitch` further
+/// along; the gap to the first of them is bisected with its own casts as
+/// any other. The first start of a block, and one whose neighbour is not
+/// placed or failed, is traced on its own. A start's trace is a function
+/// of its block alone, whatever other starts are asked for, so any subset
+/// of starts (a shard's) traces as the whole does; a start off the
+/// lattice is traced on its own.
+#[derive(Copy, Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Chain {
+    /// The lattice's pitch along x (mm, > 0).
+    pub pitch: f64,
+    /// Columns per block (>= 1; 1 traces every start on its own).
+    pub block: usize,
+}
+
+impl Chain {
+    /// The column of `x` on the lattice, when `x` is a node of it
+    /// (`pitch * c` to the bit, as a grid's node is).
+    pub(crate) fn column(&self, x: f64) -> Option<i64> {
+        let c = (x / self.pitch).round();
+        (c.abs() < 9.0e15 && self.pitch * c == x).then_some(c as i64)
+    }
+
+    /// The first column of `c`'s block.
+    pub(crate) fn head(&self, c: i64) -> i64 {
+        let k = self.block as i64;
+        c.div_euclid(k) * k
+    }
+
+    /// The node at column `c` (mm).
+    pub(crate) fn x(&self, c: i64) -> f64 {
+        self.pitch * c as f64
+    }
 }
 
 /// [`OracleOptions::prune`]'s default.
@@ -118,6 +170,7 @@ impl Default for OracleOptions {
             max_casts: 100_000,
             x_min: f64::NEG_INFINITY,
             prune: true,
+            chain: None,
         }
     }
 }
@@ -146,6 +199,14 @@ impl OracleOptions {
         positive("jump_tolerance", self.jump_tolerance)?;
         if self.max_casts == 0 {
             return Err(OracleError::InvalidOptions("max_casts must be > 0".into()));
+        }
+        if let Some(chain) = self.chain {
+            positive("chain pitch", chain.pitch)?;
+            if chain.block == 0 {
+                return Err(OracleError::InvalidOptions(
+                    "a chain's block must hold at least one column".into(),
+                ));
+            }
         }
         if self.x_min.is_nan() || self.x_min == f64::INFINITY {
             return Err(OracleError::InvalidOptions(format!(
@@ -298,6 +359,33 @@ pub(crate) fn trace_validated(
     start: [f64; 2],
     options: &OracleOptions,
 ) -> StartTrace {
+    trace_joining(part, knee, start, options, None)
+}
+
+/// [`trace_validated`], joining the curve of `left` (the trace of the
+/// start on the same row `pitch` to the -x, at the same angle, with the
+/// same options) where the two meet ([`Chain`]).
+pub(crate) fn trace_joining(
+    part: &Part,
+    knee: &KneeForm,
+    start: [f64; 2],
+    options: &OracleOptions,
+    left: Option<&StartTrace>,
+) -> StartTrace {
+    let join = left.and_then(|left| {
+        let shift = start[0] - left.start[0];
+        let joinable = left.status == StartStatus::Placed
+            && left.start[1] == start[1]
+            && shift > 0.0
+            && left.slide_end != SlideEnd::NotRun;
+        Some(Join {
+            contacts: &left.contacts,
+            end: left.slide_end,
+            shift,
+            release: left.yr_star? - options.eps,
+        })
+        .filter(|_| joinable)
+    });
     let mut tracer = Tracer {
         part,
         knee: *knee,
@@ -306,6 +394,7 @@ pub(crate) fn trace_validated(
         casts: 0,
         contacts: Vec::new(),
         end: None,
+        join,
     };
     let mut trace = StartTrace {
         angle_deg: knee.angle_deg(),
@@ -353,6 +442,21 @@ struct Tracer<'a> {
     casts: usize,
     contacts: Vec<ContactPoint>,
     end: Option<SlideEnd>,
+    /// The -x neighbour's curve to join, until joined ([`Chain`]).
+    join: Option<Join<'a>>,
+}
+
+/// The curve of a start's -x neighbour on its row ([`Chain`]).
+struct Join<'a> {
+    /// Its contacts, by increasing travel.
+    contacts: &'a [ContactPoint],
+    /// How its slide ended.
+    end: SlideEnd,
+    /// How far it lies to the -x (mm, > 0).
+    shift: f64,
+    /// Its release level `yr* - eps` (mm): its trace covers every level
+    /// at or below it.
+    release: f64,
 }
 
 impl Tracer<'_> {
@@ -465,6 +569,50 @@ impl Tracer<'_> {
         }
         if let Some(hit) = hit_b {
             self.emit(b, hit);
+            self.join_if_met(b, hit)?;
+        }
+        Ok(())
+    }
+
+    /// Joins the neighbour's curve ([`Chain`]) when the contact just
+    /// emitted at `level` (`hit`) lies a pitch or more along and at or
+    /// below the neighbour's release level: every lower level travels the
+    /// pitch freely, then as the neighbour does. Its contacts below
+    /// `level`, shifted by the pitch, end the trace, after the gap to the
+    /// first of them is bisected with this start's own casts; the trace
+    /// ends as the neighbour's did. Nothing happens when the neighbour has
+    /// no contact below `level`.
+    fn join_if_met(&mut self, level: f64, hit: Hit) -> Result<(), FailureReason> {
+        let met = self.end.is_none()
+            && self.contacts.last().is_some_and(|c| c.face_level == level)
+            && self
+                .join
+                .as_ref()
+                .is_some_and(|j| hit.travel >= j.shift && level <= j.release);
+        if !met {
+            return Ok(());
+        }
+        let Some(join) = self.join.take() else {
+            return Ok(());
+        };
+        let below = join.contacts.partition_point(|c| c.face_level >= level);
+        let Some(first) = join.contacts.get(below) else {
+            // Nothing to join below this level: trace on alone.
+            return Ok(());
+        };
+        let shifted = |c: &ContactPoint| Hit {
+            travel: c.travel + join.shift,
+            witness: Vector::from_array(c.witness),
+        };
+        self.refine(level, Some(hit), first.face_level, Some(shifted(first)))?;
+        for c in &join.contacts[below + 1..] {
+            if self.end.is_some() {
+                break;
+            }
+            self.emit(c.face_level, shifted(c));
+        }
+        if self.end.is_none() {
+            self.end = Some(join.end);
         }
         Ok(())
     }
@@ -478,7 +626,10 @@ impl Tracer<'_> {
                 self.end = Some(SlideEnd::Cleared);
                 return Ok(());
             }
-            Some(h) => self.emit(level, h),
+            Some(h) => {
+                self.emit(level, h);
+                self.join_if_met(level, h)?;
+            }
         }
         while self.end.is_none() {
             let next = level - self.options.level_step;

@@ -158,6 +158,11 @@ pub struct ConvergeSummary {
     /// tolerance.
     #[serde(default)]
     pub verdicts: Vec<PitchVerdict>,
+    /// How the exact traces were shared between the starts of a row (a
+    /// strip's: [`kneeform_oracle::Chain`]); absent where each start was
+    /// traced on its own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub oracle_chain: Option<kneeform_oracle::Chain>,
 }
 
 /// One pitch's verdict in a convergence study.
@@ -196,6 +201,25 @@ pub(super) struct Ladder<'a> {
     compare: CompareOptions,
     /// A deliberate mistake on the grid side (tests only).
     fault: Option<Fault>,
+    /// How the oracle shares traces between the starts of a row: along
+    /// every row of a strip of starts ([`chain_of`]), else not at all.
+    chain: Option<kneeform_oracle::Chain>,
+}
+
+/// Starts per block of a row whose traces are chained
+/// ([`kneeform_oracle::Chain`]): one start in 64 is traced whole, each
+/// other joins its -x neighbour's curve after a few casts of its own.
+pub(crate) const CHAIN_BLOCK: usize = 64;
+
+/// How the exact traces of `selection`'s starts on the grid of pitch
+/// `pitch` share work: a strip (every placed start of whole rows) is
+/// traced in chains along its rows; scattered starts share nothing, and
+/// are traced each on its own.
+pub(crate) fn chain_of(selection: &StartSelection, pitch: f64) -> Option<kneeform_oracle::Chain> {
+    matches!(selection, StartSelection::Strip { .. }).then_some(kneeform_oracle::Chain {
+        pitch,
+        block: CHAIN_BLOCK,
+    })
 }
 
 /// The exact traces of `starts` at `angles` (in [`run_oracle`]'s order),
@@ -273,6 +297,7 @@ impl<'a> Ladder<'a> {
             traces: Vec::new(),
             compare: CompareOptions::of(setup, tie_band_per_mm),
             fault,
+            chain: chain_of(selection, coarse.pitch),
         })
     }
 
@@ -384,7 +409,10 @@ impl Method for Ladder<'_> {
             refuse_beyond_s,
             within_s,
         } = what;
-        let oracle = oracle_options(&self.setup.knee, finest, self.coarse.x(0));
+        let oracle = kneeform_oracle::OracleOptions {
+            chain: self.chain,
+            ..oracle_options(&self.setup.knee, finest, self.coarse.x(0))
+        };
         let (traces, oracle_s) = match within_s {
             None => run_oracle(
                 self.triangles,
@@ -528,6 +556,7 @@ impl ConvergeSummary {
             starts,
             seconds: Vec::new(),
             verdicts: Vec::new(),
+            oracle_chain: chain_of(&options.selection, options.pitches[0]),
         };
         summary.set_results(results);
         summary

@@ -180,11 +180,31 @@ pub(super) fn run_oracle(
         // lowest start rows) predicted the console's 167 s as 44 s, every
         // twentieth start at every angle as 317 s: a trace's cost varies
         // more between starts than between angles.
+        // Starts traced in chains along their rows are sampled a whole
+        // chain at a time (by its first pair), so that no chain is traced
+        // twice; without chains every pair is its own.
         let n = starts.len();
-        let is_sampled = |(s, a): (usize, usize)| (s + a) % SAMPLE_EVERY == 0;
-        let (first, rest): (Vec<_>, Vec<_>) = (0..pairs)
-            .map(|k| (k % n, k / n))
-            .partition(|&p| is_sampled(p));
+        let all: Vec<(usize, usize)> = (0..pairs).map(|k| (k % n, k / n)).collect();
+        let groups = match options.chain {
+            Some(chain) => kneeform_oracle::chain_groups(starts, &all, &chain),
+            None => (0..pairs).map(|k| vec![k]).collect(),
+        };
+        let mut sampled = vec![false; pairs];
+        for group in groups {
+            let (s, a) = all[group[0]];
+            if (s + a) % SAMPLE_EVERY == 0 {
+                for k in group {
+                    sampled[k] = true;
+                }
+            }
+        }
+        let pick = |want: bool| -> Vec<(usize, usize)> {
+            (0..pairs)
+                .filter(|&k| sampled[k] == want)
+                .map(|k| all[k])
+                .collect()
+        };
+        let (first, rest) = (pick(true), pick(false));
         let sample = trace(&first)?;
         let sample_s = t.elapsed().as_secs_f64();
         let predicted_s = sample_s * pairs as f64 / first.len().max(1) as f64;
@@ -211,7 +231,7 @@ pub(super) fn run_oracle(
         let (mut sample, mut rest) = (sample.into_iter(), rest.into_iter());
         let traces = (0..pairs)
             .filter_map(|k| {
-                if is_sampled((k % n, k / n)) {
+                if sampled[k] {
                     sample.next()
                 } else {
                     rest.next()
@@ -269,6 +289,7 @@ impl VerifySummary {
                 grid_s: comparison.grid_s,
                 oracle_s,
             },
+            oracle_chain: super::converge::chain_of(&options.selection, setup.pitch),
         };
         summary.set_comparison(comparison, spec);
         summary
@@ -409,6 +430,11 @@ pub struct VerifySummary {
     pub worst_starts: Vec<WorstStart>,
     /// Seconds on each side.
     pub timings: VerifyTimings,
+    /// How the exact traces were shared between the starts of a row (a
+    /// strip's: [`kneeform_oracle::Chain`]); absent where each start was
+    /// traced on its own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub oracle_chain: Option<kneeform_oracle::Chain>,
 }
 
 /// `scale` of files written before it was recorded.
