@@ -11,11 +11,15 @@
 #                                           # the commit REV, end to end, in one run
 #     bash results/regenerate.sh strip      # results/converge-strip/: the wave's
 #                                           # study over a whole strip of 21 start
-#                                           # rows, every start (about 1.5 minutes)
+#                                           # rows, every start (about 2 minutes)
 #     bash results/regenerate.sh strip-console  # results/converge-strip/console-row/:
 #                                           # every start of one console start row
 #                                           # (z = 300 mm), all 61 angles at 1.24 mm
-#                                           # (about 25 minutes)
+#                                           # (about 9 minutes)
+#     bash results/regenerate.sh strip-console-20  # results/converge-strip/
+#                                           # console-20-rows/: every start of 20
+#                                           # console start rows at 3 angles
+#                                           # (about 10 minutes)
 #     bash results/regenerate.sh pitch      # results/pitch.md: the bundled console
 #                                           # at 0.5 mm (61 angles) and 0.25 mm
 #                                           # (3 angles), about 6 minutes
@@ -76,6 +80,20 @@ if [[ "$what" == strip-console ]]; then
     echo "== console row, angles $group"
     "$bin" verify scenarios/console_side.stl --starts strip:299.5:300.5 \
       --angles="$group:1" --out "$out/angles_${group/:/_to_}" || [[ $? == 1 ]]
+  done
+fi
+
+if [[ "$what" == strip-console-20 ]]; then
+  # Every start of 20 start rows of the console (z = 288.92 to 312.48 mm,
+  # about 29,000 starts, the row above in the middle), at -30, 0 and 30
+  # degrees and the paper's pitch: the rows' traces chained (issue 26).
+  # One verification per angle, so that one angle's traces (about 10 GiB)
+  # fit in memory. Exit 1 (a failing verdict) is a result here.
+  out=results/converge-strip/console-20-rows
+  for angle in -30 0 30; do
+    echo "== console, 20 rows, angle $angle"
+    "$bin" verify scenarios/console_side.stl --starts strip:288.5:312.6 \
+      --angles="$angle" --out "$out/angle_$angle" || [[ $? == 1 ]]
   done
 fi
 

@@ -55,8 +55,10 @@ fn same(a: &StartTrace, b: &StartTrace) -> bool {
     format!("{a:?}") == format!("{b:?}")
 }
 
-#[test]
-fn the_skip_changes_no_trace_on_any_scenario() {
+/// Every scenario of `scenarios/` but the paper-sized console (370,448
+/// triangles, the benchmark's), and the console side (the same design),
+/// by name.
+fn scenario_parts() -> Vec<(String, Part)> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(repo().join("scenarios"))
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -64,26 +66,25 @@ fn the_skip_changes_no_trace_on_any_scenario() {
         .collect();
     files.sort();
     assert!(files.len() >= 10, "{files:?}");
-    let mut contacts = 0;
+    let mut parts = Vec::new();
     for path in &files {
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
         if name == "console" {
-            // The paper-sized console (370,448 triangles) is the
-            // benchmark's; console_side.stl below is the same design.
             continue;
         }
         let read = kneeform::read_part(path, 1.0, kneeform::Side::Left).unwrap();
-        let part = Part::from_triangles(&read.part.triangles).unwrap();
-        contacts += agree(&name, &part);
+        parts.push((name, Part::from_triangles(&read.part.triangles).unwrap()));
     }
     let console =
         Part::from_stl_path(&repo().join("scenarios/console_side.stl"), 1.0, Side::Left).unwrap();
-    contacts += agree("console_side", &console);
-    assert!(contacts > 1000, "{contacts} contacts compared");
+    parts.push(("console_side".into(), console));
+    parts
 }
 
-#[test]
-fn the_skip_changes_no_trace_on_the_real_meshes() {
+/// Every third-party mesh of `shared/meshes/` that loads, scaled to about
+/// 600 mm as a user's part (`tests/real_meshes.rs`; an empty or broken one
+/// is refused, as that file checks), by path.
+fn real_mesh_parts() -> Vec<(String, Part)> {
     let dir = repo().join("../shared/meshes");
     let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap()
@@ -91,16 +92,31 @@ fn the_skip_changes_no_trace_on_the_real_meshes() {
         .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("stl")))
         .collect();
     files.sort();
-    let mut compared = 0;
-    for path in &files {
-        // Scaled to about 600 mm, as a user's part (tests/real_meshes.rs).
-        let Ok(part) = util::stl_at_size(path, 600.0, Side::Left) else {
-            continue; // empty or broken: refused, as real_meshes.rs checks
-        };
-        agree(&path.display().to_string(), &part);
-        compared += 1;
+    let parts: Vec<(String, Part)> = files
+        .iter()
+        .filter_map(|path| {
+            let part = util::stl_at_size(path, 600.0, Side::Left).ok()?;
+            Some((path.display().to_string(), part))
+        })
+        .collect();
+    assert!(parts.len() >= 5, "{} meshes load", parts.len());
+    parts
+}
+
+#[test]
+fn the_skip_changes_no_trace_on_any_scenario() {
+    let contacts: usize = scenario_parts()
+        .iter()
+        .map(|(name, part)| agree(name, part))
+        .sum();
+    assert!(contacts > 1000, "{contacts} contacts compared");
+}
+
+#[test]
+fn the_skip_changes_no_trace_on_the_real_meshes() {
+    for (name, part) in real_mesh_parts() {
+        agree(&name, &part);
     }
-    assert!(compared >= 5, "{compared} meshes compared");
 }
 
 /// `evaluate_pairs` traces any subset of `evaluate`'s pairs, in the order
@@ -256,27 +272,9 @@ fn chained_agree(name: &str, part: &Part) -> (usize, usize, usize) {
 /// every scenario and on the console side, for far fewer casts.
 #[test]
 fn chained_rows_trace_the_curves_of_starts_traced_alone() {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(repo().join("scenarios"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
     let (mut contacts, mut alone, mut chained) = (0, 0, 0);
-    let mut parts: Vec<(String, Part)> = Vec::new();
-    for path in &files {
-        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
-        if name == "console" {
-            continue; // console_side.stl below is the same design
-        }
-        let read = kneeform::read_part(path, 1.0, kneeform::Side::Left).unwrap();
-        parts.push((name, Part::from_triangles(&read.part.triangles).unwrap()));
-    }
-    let console =
-        Part::from_stl_path(&repo().join("scenarios/console_side.stl"), 1.0, Side::Left).unwrap();
-    parts.push(("console_side".into(), console));
-    for (name, part) in &parts {
-        let (n, a, b) = chained_agree(name, part);
+    for (name, part) in scenario_parts() {
+        let (n, a, b) = chained_agree(&name, &part);
         contacts += n;
         alone += a;
         chained += b;
@@ -293,22 +291,9 @@ fn chained_rows_trace_the_curves_of_starts_traced_alone() {
 /// The same on the third-party meshes (open sheets, facets, thin walls).
 #[test]
 fn chained_rows_trace_the_curves_of_starts_traced_alone_on_real_meshes() {
-    let dir = repo().join("../shared/meshes");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("stl")))
-        .collect();
-    files.sort();
-    let mut compared = 0;
-    for path in &files {
-        let Ok(part) = util::stl_at_size(path, 600.0, Side::Left) else {
-            continue;
-        };
-        chained_agree(&path.display().to_string(), &part);
-        compared += 1;
+    for (name, part) in real_mesh_parts() {
+        chained_agree(&name, &part);
     }
-    assert!(compared >= 5, "{compared} meshes compared");
 }
 
 /// A chained start's trace is a function of its block alone: any subset

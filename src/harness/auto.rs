@@ -117,7 +117,7 @@ pub fn choose_pitch(
         None,
     )?;
     let tracing = Tracing {
-        share: ladder.all_starts().to_vec(),
+        share: ladder.laid().starts.clone(),
         finest,
         within_s: Some(auto.budget_s),
         refuse_beyond_s: None,

@@ -11,7 +11,7 @@ use super::HarnessError;
 use super::compare::{
     CompareOptions, Comparison, GridSide, PairResult, StartSelection, assemble, pair_results,
 };
-use super::method::{Method, Tracing, spec_at};
+use super::method::{Laid, Method, Pitch, Tracing, spec_at};
 use super::metrics::{METRICS, TieBand};
 use super::pairs::{Pairs, PitchPart};
 use super::trace::Fault;
@@ -186,14 +186,11 @@ pub(super) struct Ladder<'a> {
     triangles: &'a [Triangle],
     /// The study's setup at the coarsest pitch.
     setup: Setup,
-    coarse: GridSpec,
+    /// The coarsest grid, every start of the study on it.
+    laid: Laid,
     /// The coarsest grid, kept until its pitch is measured (a
     /// verification's one grid is sampled once).
     coarse_grid: Option<HeightGrid>,
-    /// Seconds sampling the coarsest grid.
-    sample_s: f64,
-    /// Every start of the study (mm), in its order.
-    all_starts: Vec<[f64; 2]>,
     /// The starts traced (mm), nodes of every grid of the ladder: a
     /// shard's share of `all_starts`, or all of them.
     pub starts: Vec<[f64; 2]>,
@@ -289,10 +286,12 @@ impl<'a> Ladder<'a> {
         Ok(Ladder {
             triangles,
             setup: setup.clone(),
-            coarse,
+            laid: Laid {
+                coarse,
+                starts: all_starts,
+                sample_s,
+            },
             coarse_grid: Some(coarse_grid),
-            sample_s,
-            all_starts,
             starts: Vec::new(),
             traces: Vec::new(),
             compare: CompareOptions::of(setup, tie_band_per_mm),
@@ -304,7 +303,7 @@ impl<'a> Ladder<'a> {
     /// The grid at pitch `p`: exactly the coarse grid's extent from its
     /// origin.
     pub(super) fn spec_at(&self, p: f64) -> GridSpec {
-        spec_at(&self.coarse, p)
+        spec_at(&self.laid.coarse, p)
     }
 
     /// The grid at pitch `p` sampled, the engine timed over the ladder's
@@ -390,16 +389,8 @@ impl<'a> Ladder<'a> {
 }
 
 impl Method for Ladder<'_> {
-    fn coarse(&self) -> GridSpec {
-        self.coarse
-    }
-
-    fn all_starts(&self) -> &[[f64; 2]] {
-        &self.all_starts
-    }
-
-    fn sample_s(&self) -> f64 {
-        self.sample_s
+    fn laid(&self) -> &Laid {
+        &self.laid
     }
 
     fn trace(&mut self, what: Tracing, progress: &dyn Progress) -> Result<f64, HarnessError> {
@@ -411,7 +402,7 @@ impl Method for Ladder<'_> {
         } = what;
         let oracle = kneeform_oracle::OracleOptions {
             chain: self.chain,
-            ..oracle_options(&self.setup.knee, finest, self.coarse.x(0))
+            ..oracle_options(&self.setup.knee, finest, self.laid.coarse.x(0))
         };
         let (traces, oracle_s) = match within_s {
             None => run_oracle(
@@ -436,13 +427,8 @@ impl Method for Ladder<'_> {
         Ok(oracle_s)
     }
 
-    fn pitch(
-        &mut self,
-        p: f64,
-        converging: bool,
-        progress: &dyn Progress,
-    ) -> Result<PitchPart, HarnessError> {
-        let (pairs, pitch, _, _) = self.measure_raw(p, converging, progress)?;
+    fn pitch(&mut self, at: Pitch, progress: &dyn Progress) -> Result<PitchPart, HarnessError> {
+        let (pairs, pitch, _, _) = self.measure_raw(at.p, at.converging, progress)?;
         Ok(PitchPart {
             pairs: Pairs::Slide(pairs),
             ..pitch

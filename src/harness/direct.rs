@@ -43,7 +43,7 @@ use serde::{Deserialize, Serialize};
 use super::HarnessError;
 use super::compare::{StartSelection, choose_nodes, node_at};
 use super::converge::{Fit, fit_power_law};
-use super::method::{Method, Tracing, spec_at};
+use super::method::{Laid, Method, Pitch, Tracing, spec_at};
 use super::metrics::{nearest_rank, sorted_abs};
 pub(crate) use super::pairs::{DirectPair, DirectRow};
 use super::pairs::{NO_BAND, Pairs, PitchPart};
@@ -52,7 +52,7 @@ use crate::analysis::Progress;
 use crate::direct::{DirectFootprint, contact_levels};
 use crate::frame::Approach;
 use crate::frame::to_direct;
-use crate::grid::{GridSpec, HeightGrid};
+use crate::grid::HeightGrid;
 use crate::input::PartFile;
 use crate::kneeform::KneeForm;
 use crate::mesh::{Part, Triangle};
@@ -409,11 +409,10 @@ pub(super) struct DirectMethod<'a> {
     part: Part,
     /// The study's setup at the coarsest pitch, of the direct approach.
     setup: Setup,
-    coarse: GridSpec,
+    /// The coarsest grid, every position of the study on it.
+    laid: Laid,
     /// The coarsest grid, kept until its pitch is measured.
     coarse_grid: Option<HeightGrid>,
-    /// Every position of the study (mm), in its order.
-    positions: Vec<[f64; 2]>,
     /// The positions cast: a shard's share of `positions`, or all.
     share: Vec<[f64; 2]>,
     traces: Vec<DirectTrace>,
@@ -456,9 +455,13 @@ impl<'a> DirectMethod<'a> {
             input,
             part,
             setup,
-            coarse: spec,
+            laid: Laid {
+                coarse: spec,
+                starts: positions,
+                // The direct approach's summaries report no sampling time.
+                sample_s: 0.0,
+            },
             coarse_grid: Some(grid),
-            positions,
             share: Vec::new(),
             traces: Vec::new(),
         })
@@ -466,17 +469,8 @@ impl<'a> DirectMethod<'a> {
 }
 
 impl Method for DirectMethod<'_> {
-    fn coarse(&self) -> GridSpec {
-        self.coarse
-    }
-
-    fn all_starts(&self) -> &[[f64; 2]] {
-        &self.positions
-    }
-
-    fn sample_s(&self) -> f64 {
-        // The direct approach's summaries report no sampling time.
-        0.0
+    fn laid(&self) -> &Laid {
+        &self.laid
     }
 
     /// One exact cast per position and angle: no bisection to resolve a
@@ -500,13 +494,9 @@ impl Method for DirectMethod<'_> {
         Ok(t.elapsed().as_secs_f64())
     }
 
-    fn pitch(
-        &mut self,
-        p: f64,
-        converging: bool,
-        progress: &dyn Progress,
-    ) -> Result<PitchPart, HarnessError> {
-        let spec = spec_at(&self.coarse, p);
+    fn pitch(&mut self, at: Pitch, progress: &dyn Progress) -> Result<PitchPart, HarnessError> {
+        let Pitch { p, converging } = at;
+        let spec = spec_at(&self.laid.coarse, p);
         let what = if converging {
             format!("pitch {p} mm: {} x {} grid (direct)", spec.nx, spec.nz)
         } else {
@@ -757,6 +747,7 @@ impl DirectConvergeSummary {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::grid::GridSpec;
 
     #[test]
     fn placed_nodes_are_the_positions_with_a_first_contact() {

@@ -22,31 +22,41 @@ pub(super) struct Tracing {
     pub within_s: Option<f64>,
 }
 
-/// What a study does its own way for one approach: its grids, its exact
-/// side and its pairs. The study's steps, in order: [`Method::coarse`]
-/// and [`Method::all_starts`] once laid, [`Method::trace`] on a share of
-/// them, then [`Method::pitch`] at each pitch, coarsest first.
-pub(super) trait Method {
+/// One pitch of a study, as [`Method::pitch`] compares it.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Pitch {
+    /// The pitch (mm, dividing the coarsest).
+    pub p: f64,
+    /// Whether it is one of a convergence study's pitches: a stage named
+    /// by its pitch, with the engine's full run timed. A verification's
+    /// one pitch is the stage comparing the grid with the exact side.
+    pub converging: bool,
+}
+
+/// The coarsest grid of a study and its starts, as a [`Method`] lays them.
+#[derive(Debug, Clone)]
+pub(super) struct Laid {
     /// The coarsest grid (the study's starts are its nodes).
-    fn coarse(&self) -> GridSpec;
+    pub coarse: GridSpec,
     /// Every start of the study (mm), in its order.
-    fn all_starts(&self) -> &[[f64; 2]];
+    pub starts: Vec<[f64; 2]>,
     /// Seconds sampling the coarsest grid (the slide's summaries report
     /// them; 0 where none does).
-    fn sample_s(&self) -> f64;
+    pub sample_s: f64,
+}
+
+/// What a study does its own way for one approach: its grids, its exact
+/// side and its pairs. The study's steps, in order: the coarsest grid
+/// and the starts laid ([`Method::laid`]), [`Method::trace`] on a share
+/// of them, then [`Method::pitch`] at each pitch, coarsest first.
+pub(super) trait Method {
+    /// The coarsest grid and the study's starts on it, as laid.
+    fn laid(&self) -> &Laid;
     /// Takes the exact side of `what.share` at the study's angles,
     /// resolving pitches down to `what.finest`; the oracle's seconds.
     fn trace(&mut self, what: Tracing, progress: &dyn Progress) -> Result<f64, HarnessError>;
-    /// The share's pairs at pitch `p` (mm, dividing the coarsest). A
-    /// convergence study's pitch (`converging`) is a stage named by its
-    /// pitch, with the engine's full run timed; a verification's one pitch
-    /// is the stage comparing the grid with the exact side.
-    fn pitch(
-        &mut self,
-        p: f64,
-        converging: bool,
-        progress: &dyn Progress,
-    ) -> Result<PitchPart, HarnessError>;
+    /// The share's pairs at `at.p`.
+    fn pitch(&mut self, at: Pitch, progress: &dyn Progress) -> Result<PitchPart, HarnessError>;
 }
 
 /// The grid at pitch `p` over exactly the extent of `coarse`, from its

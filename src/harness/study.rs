@@ -22,7 +22,7 @@ use super::direct::{
     DirectConvergeSummary, DirectConvergence, DirectMethod, DirectPitchResult, DirectVerification,
     DirectVerifySummary, assemble_direct,
 };
-use super::method::{Method, Tracing, spec_at};
+use super::method::{Laid, Method, Pitch, Tracing, spec_at};
 use super::pairs::{Pairs, PitchPart, share};
 use super::sharded::{StudyPart, StudySummary, oracle_s, study_settings, unsharded_pairs};
 use super::trace::Fault;
@@ -167,7 +167,7 @@ fn run(
         )?),
         Approach::Direct => Box::new(DirectMethod::lay(input, &coarse_setup, selection)?),
     };
-    let coarse = method.coarse();
+    let coarse = method.laid().coarse;
     let converging = matches!(options, StudyOptions::Converge(_));
     if converging {
         for &p in &pitches {
@@ -175,7 +175,7 @@ fn run(
         }
     }
     let tracing = Tracing {
-        share: share(method.all_starts(), Some(shard))?,
+        share: share(&method.laid().starts, Some(shard))?,
         finest: pitches[pitches.len() - 1],
         refuse_beyond_s: options.budget_s(),
         within_s: None,
@@ -183,9 +183,13 @@ fn run(
     let oracle_s = method.trace(tracing, progress)?;
     let mut parts = Vec::with_capacity(pitches.len());
     for &p in &pitches {
-        parts.push(method.pitch(p, converging, progress)?);
+        parts.push(method.pitch(Pitch { p, converging }, progress)?);
     }
-    let all_starts = method.all_starts().to_vec();
+    let Laid {
+        starts: all_starts,
+        sample_s,
+        ..
+    } = method.laid().clone();
     let summary = summary_as_known(
         input,
         setup,
@@ -193,7 +197,7 @@ fn run(
         &coarse,
         all_starts.len(),
         &parts,
-        method.sample_s(),
+        sample_s,
         oracle_s,
     );
     Ok(StudyPart {
@@ -209,7 +213,7 @@ fn run(
             pitches,
         ),
         summary,
-        sample_s: method.sample_s(),
+        sample_s,
         oracle_s,
     })
 }
