@@ -121,6 +121,7 @@ pub fn choose_pitch(
         finest,
         within_s: Some(auto.budget_s),
         refuse_beyond_s: None,
+        memory: None,
     };
     ladder.trace(tracing, progress)?;
     let scale = setup.angles.len() as f64 / angles.len() as f64;

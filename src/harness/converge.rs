@@ -399,6 +399,7 @@ impl Method for Ladder<'_> {
             finest,
             refuse_beyond_s,
             within_s,
+            memory,
         } = what;
         let oracle = kneeform_oracle::OracleOptions {
             chain: self.chain,
@@ -410,7 +411,7 @@ impl Method for Ladder<'_> {
                 &share,
                 &self.setup.angles,
                 &oracle,
-                refuse_beyond_s,
+                (refuse_beyond_s, memory),
                 progress,
             )?,
             Some(budget_s) => traces_within(

@@ -20,6 +20,20 @@ pub(super) struct Tracing {
     /// Give up as soon as this many seconds are spent (a pitch study's
     /// budget, `--pitch auto`).
     pub within_s: Option<f64>,
+    /// Refuse, before the traces, a study predicted (from the sample) to
+    /// hold more than this many bytes of traces and comparisons, over its
+    /// pitches (`--max-memory`); none when `None`.
+    pub memory: Option<MemoryLimit>,
+}
+
+/// The memory a study's traces and comparisons may take.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct MemoryLimit {
+    /// Bytes allowed (`--max-memory`; the machine's memory is checked
+    /// too).
+    pub bytes: f64,
+    /// Pitches whose comparisons the study holds at once.
+    pub pitches: usize,
 }
 
 /// One pitch of a study, as [`Method::pitch`] compares it.

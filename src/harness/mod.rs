@@ -217,6 +217,20 @@ pub enum HarnessError {
         /// Shards that would each fit the budget.
         shards: usize,
     },
+    /// A study's exact traces and comparisons would not fit in memory.
+    #[error(
+        "the exact traces and their comparison would hold about {need_gib:.1} GiB for {pairs} start-angle pairs (predicted from a sample), beyond the {limit_gib:.1} GiB allowed (--max-memory, or this machine's memory): fan it out with --shard K/{shards} (K = 1..{shards}, then `kneeform merge`), or compare fewer angles or starts"
+    )]
+    StudyMemory {
+        /// The predicted memory (GiB).
+        need_gib: f64,
+        /// The memory allowed (GiB).
+        limit_gib: f64,
+        /// Start-angle pairs to trace.
+        pairs: usize,
+        /// Shards that would each fit.
+        shards: usize,
+    },
     /// The exact traces of a pitch study would take longer than its
     /// budget.
     #[error(

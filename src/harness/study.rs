@@ -22,7 +22,7 @@ use super::direct::{
     DirectConvergeSummary, DirectConvergence, DirectMethod, DirectPitchResult, DirectVerification,
     DirectVerifySummary, assemble_direct,
 };
-use super::method::{Laid, Method, Pitch, Tracing, spec_at};
+use super::method::{Laid, MemoryLimit, Method, Pitch, Tracing, spec_at};
 use super::pairs::{Pairs, PitchPart, share};
 use super::sharded::{StudyPart, StudySummary, oracle_s, study_settings, unsharded_pairs};
 use super::trace::Fault;
@@ -179,6 +179,10 @@ fn run(
         finest: pitches[pitches.len() - 1],
         refuse_beyond_s: options.budget_s(),
         within_s: None,
+        memory: Some(MemoryLimit {
+            bytes: setup.max_memory_bytes,
+            pitches: pitches.len(),
+        }),
     };
     let oracle_s = method.trace(tracing, progress)?;
     let mut parts = Vec::with_capacity(pitches.len());

@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use super::HarnessError;
 use super::compare::{AreaDistance, Comparison, Counts, StartSelection, select_starts};
+use super::method::MemoryLimit;
 use super::metrics::{Stats, TieBand};
 use crate::analysis::Progress;
 use crate::grid::{GridSpec, HeightGrid};
@@ -148,18 +149,28 @@ pub(super) fn start_positions(
 /// oracle's time: one in twenty, spread over the starts and angles.
 const SAMPLE_EVERY: usize = 20;
 
+/// The memory a study holds per exact contact of its traces, with the
+/// comparison's per-strike distances and points (bytes): measured as peak
+/// RSS over exact strikes on the console, 333 for one start row at four
+/// angles (2.1 GB, 6.3 million strikes) and 326 for 20 rows at one angle
+/// (10.7 GB, 32.8 million). Counted per contact (every strike is one), it
+/// over-estimates a little.
+const BYTES_PER_CONTACT: f64 = 340.0;
+
 /// The oracle's traces of `starts` at `angles`, reported as one stage,
 /// angle-major. A sample of the pairs, spread over the starts and angles,
 /// is traced first: its time predicts the whole (said as a note), and a
-/// prediction beyond `budget_s` is refused before the rest is traced.
+/// prediction beyond `budget_s` (`limits.0`), or a predicted memory
+/// beyond `limits.1`, is refused before the rest is traced.
 pub(super) fn run_oracle(
     triangles: &[Triangle],
     starts: &[[f64; 2]],
     angles: &[f64],
     options: &OracleOptions,
-    budget_s: Option<f64>,
+    limits: (Option<f64>, Option<MemoryLimit>),
     progress: &dyn Progress,
 ) -> Result<(Vec<StartTrace>, f64), HarnessError> {
+    let (budget_s, memory) = limits;
     let pairs = starts.len() * angles.len();
     let what = format!(
         "exact oracle: {} starts x {} angles",
@@ -215,6 +226,24 @@ pub(super) fn run_oracle(
                 first.len(),
                 sample_s
             ));
+        }
+        if let Some(memory) = memory {
+            let contacts: usize = sample.iter().map(|t| t.contacts.len()).sum();
+            let need = BYTES_PER_CONTACT * memory.pitches as f64 * contacts as f64 * pairs as f64
+                / first.len().max(1) as f64;
+            let limit = match crate::memory::limit_bytes() {
+                Some((machine, _)) => memory.bytes.min(machine),
+                None => memory.bytes,
+            };
+            if need > limit {
+                let gib = f64::from(1u32 << 30);
+                return Err(HarnessError::StudyMemory {
+                    need_gib: need / gib,
+                    limit_gib: limit / gib,
+                    pairs,
+                    shards: ((need / limit).ceil() as usize).clamp(2, starts.len().max(2)),
+                });
+            }
         }
         if let Some(budget_s) = budget_s
             && predicted_s > budget_s
@@ -478,4 +507,36 @@ pub struct VerifyTimings {
     pub grid_s: f64,
     /// The oracle's traces.
     pub oracle_s: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::{axis, tessellate};
+
+    #[test]
+    fn a_study_beyond_its_memory_is_refused_naming_the_shards_that_fit() {
+        // A wall rising towards the knee ahead of the slide (y = x / 5),
+        // 300 x 200 mm: every slide is deflected. Two starts, one angle.
+        let (xs, zs) = (
+            axis((-150.0, 150.0), 10.0, &[]),
+            axis((-100.0, 100.0), 10.0, &[]),
+        );
+        let tris = tessellate(&xs, &zs, |i, _| 0.2 * xs[i]);
+        let starts = [[0.0, 0.0], [20.0, 10.0]];
+        let options = oracle_options(&KneeForm::default(), 4.0, -150.0);
+        let run = |bytes: f64| {
+            let memory = MemoryLimit { bytes, pitches: 1 };
+            run_oracle(&tris, &starts, &[0.0], &options, (None, Some(memory)), &())
+        };
+        match run(1.0) {
+            Err(HarnessError::StudyMemory { pairs, shards, .. }) => {
+                assert_eq!((pairs, shards), (2, 2));
+            }
+            other => panic!("not refused: {other:?}"),
+        }
+        let (traces, _) = run(1e12).unwrap();
+        assert_eq!(traces.len(), 2);
+        assert!(traces.iter().all(|t| !t.contacts.is_empty()));
+    }
 }
