@@ -37,7 +37,5 @@ pub fn run(args: &ConvergeArgs) -> anyhow::Result<ExitCode> {
         &args.study,
         &args.out,
         harness::StudyOptions::Converge(&options),
-        options.validate(),
-        args.budget_s,
     )
 }

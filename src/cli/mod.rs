@@ -76,22 +76,19 @@ pub fn study_shard(study: &StudyArgs) -> anyhow::Result<Option<Shard>> {
 }
 
 /// Runs a study command (`verify`, `converge`): reads its part and setup
-/// (and the command's `check` of its own options), then its shard when
-/// `--shard` is given (written to `out`), else the whole study, of the
-/// setup's approach, written to `out` and printed as `kneeform merge`
-/// prints it. `--budget-s` does not apply to the direct approach, which
-/// says so.
+/// (its own options checked first), then its shard when `--shard` is
+/// given (written to `out`), else the whole study, of the setup's
+/// approach, written to `out` and printed as `kneeform merge` prints it.
+/// `--budget-s` does not apply to the direct approach, which says so.
 pub fn run_study(
     study: &StudyArgs,
     out: &Path,
     options: harness::StudyOptions,
-    check: Result<(), HarnessError>,
-    budget_s: Option<f64>,
 ) -> anyhow::Result<ExitCode> {
     let shard = study_shard(study)?;
-    let (input, setup) = study_inputs(study, check)?;
+    let (input, setup) = study_inputs(study, options.validate())?;
     let direct = setup.approach == kneeform::Approach::Direct;
-    if direct && budget_s.is_some() {
+    if direct && options.budget_s().is_some() {
         // The direct study casts once per position: no sample predicts it.
         eprintln!(
             "kneeform: warning: --budget-s is not applied with --approach direct (one cast per knee position; --shard fans it out)"

@@ -21,8 +21,6 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<ExitCode> {
         &args.study,
         &args.out,
         harness::StudyOptions::Verify(&options),
-        options.validate(),
-        args.budget_s,
     )
 }
 

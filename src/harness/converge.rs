@@ -11,7 +11,7 @@ use super::HarnessError;
 use super::compare::{
     CompareOptions, Comparison, GridSide, PairResult, StartSelection, assemble, pair_results,
 };
-use super::method::{Laid, Method, Pitch, Tracing, spec_at};
+use super::method::{Laid, Method, Pitch, Tracing, grid_at, spec_at};
 use super::metrics::{METRICS, TieBand};
 use super::pairs::{Pairs, PitchPart};
 use super::trace::Fault;
@@ -314,7 +314,11 @@ impl<'a> Ladder<'a> {
         p: f64,
         progress: &dyn Progress,
     ) -> Result<(PitchResult, Vec<AngleMask>, HeightGrid), HarnessError> {
-        let (pairs, pitch, masks, grid) = self.measure_raw(p, true, progress)?;
+        let at = Pitch {
+            p,
+            converging: true,
+        };
+        let (pairs, pitch, masks, grid) = self.measure_raw(at, progress)?;
         let result = PitchResult {
             pitch: p,
             comparison: assemble(pairs, &self.setup.angles, pitch.band, pitch.grid_s),
@@ -324,28 +328,20 @@ impl<'a> Ladder<'a> {
         Ok((result, masks, grid))
     }
 
-    /// The pairs of pitch `p`, and the pitch's part without them (its
-    /// timings), its masks (none unless `time_engine`, a convergence
-    /// study's pitch, whose stage is named by its pitch) and grid.
+    /// The pairs of pitch `at`, and the pitch's part without them (its
+    /// timings), its masks (none but for a convergence study's pitch,
+    /// whose engine is timed) and grid.
     fn measure_raw(
         &mut self,
-        p: f64,
-        time_engine: bool,
+        at: Pitch,
         progress: &dyn Progress,
     ) -> Result<(Vec<PairResult>, PitchPart, Vec<AngleMask>, HeightGrid), HarnessError> {
+        let p = at.p;
         let spec = self.spec_at(p);
-        let stage = if time_engine {
-            format!("pitch {p} mm: {} x {} grid", spec.nx, spec.nz)
-        } else {
-            super::comparing(self.traces.len())
-        };
-        progress.begin(&stage, None);
-        let grid = match self.coarse_grid.take() {
-            Some(grid) if grid.spec == spec => grid,
-            _ => HeightGrid::sample(self.triangles, spec),
-        };
+        progress.begin(&at.stage(&spec, self.traces.len(), ""), None);
+        let grid = grid_at(&mut self.coarse_grid, self.triangles, spec);
         let footprints = self.setup.footprints(&spec);
-        let (masks, seconds) = if time_engine {
+        let (masks, seconds) = if at.converging {
             let t = Instant::now();
             let masks = colliding_masks(
                 &grid,
@@ -429,7 +425,7 @@ impl Method for Ladder<'_> {
     }
 
     fn pitch(&mut self, at: Pitch, progress: &dyn Progress) -> Result<PitchPart, HarnessError> {
-        let (pairs, pitch, _, _) = self.measure_raw(at.p, at.converging, progress)?;
+        let (pairs, pitch, _, _) = self.measure_raw(at, progress)?;
         Ok(PitchPart {
             pairs: Pairs::Slide(pairs),
             ..pitch

@@ -43,7 +43,7 @@ use serde::{Deserialize, Serialize};
 use super::HarnessError;
 use super::compare::{StartSelection, choose_nodes, node_at};
 use super::converge::{Fit, fit_power_law};
-use super::method::{Laid, Method, Pitch, Tracing, spec_at};
+use super::method::{Laid, Method, Pitch, Tracing, grid_at, spec_at};
 use super::metrics::{nearest_rank, sorted_abs};
 pub(crate) use super::pairs::{DirectPair, DirectRow};
 use super::pairs::{NO_BAND, Pairs, PitchPart};
@@ -478,13 +478,13 @@ impl Method for DirectMethod<'_> {
     fn trace(&mut self, what: Tracing, progress: &dyn Progress) -> Result<f64, HarnessError> {
         let share = what.share;
         let angles = &self.setup.angles;
-        let what = format!(
+        let stage = format!(
             "exact oracle (direct): {} positions x {} angles",
             share.len(),
             angles.len()
         );
         let t = Instant::now();
-        let traces = super::in_stage(progress, &what, None, || {
+        let traces = super::in_stage(progress, &stage, None, || {
             let part = kneeform_oracle::Part::from_triangles(&self.input.part.triangles)?;
             let options = direct_oracle_options(&self.setup.knee, self.setup.rule.e0);
             kneeform_oracle::evaluate_direct(&part, &share, angles, &options)
@@ -495,18 +495,11 @@ impl Method for DirectMethod<'_> {
     }
 
     fn pitch(&mut self, at: Pitch, progress: &dyn Progress) -> Result<PitchPart, HarnessError> {
-        let Pitch { p, converging } = at;
+        let p = at.p;
         let spec = spec_at(&self.laid.coarse, p);
-        let what = if converging {
-            format!("pitch {p} mm: {} x {} grid (direct)", spec.nx, spec.nz)
-        } else {
-            super::comparing(self.traces.len())
-        };
-        let (pairs, grid_s) = super::in_stage(progress, &what, None, || {
-            let grid = match self.coarse_grid.take() {
-                Some(grid) if grid.spec == spec => grid,
-                _ => HeightGrid::sample(&self.part.triangles, spec),
-            };
+        let stage = at.stage(&spec, self.traces.len(), " (direct)");
+        let (pairs, grid_s) = super::in_stage(progress, &stage, None, || {
+            let grid = grid_at(&mut self.coarse_grid, &self.part.triangles, spec);
             direct_pairs(
                 &grid,
                 &footprints(&self.setup, p),

@@ -5,7 +5,8 @@
 use super::HarnessError;
 use super::pairs::PitchPart;
 use crate::analysis::Progress;
-use crate::grid::GridSpec;
+use crate::grid::{GridSpec, HeightGrid};
+use crate::mesh::Triangle;
 
 /// What [`Method::trace`] traces, and within what time.
 #[derive(Debug, Clone, Default)]
@@ -45,6 +46,36 @@ pub(super) struct Pitch {
     /// by its pitch, with the engine's full run timed. A verification's
     /// one pitch is the stage comparing the grid with the exact side.
     pub converging: bool,
+}
+
+impl Pitch {
+    /// The progress stage of this pitch on the grid `spec`, comparing
+    /// `pairs` start-angle pairs; `approach` follows a convergence
+    /// study's stage name (` (direct)`, or nothing).
+    pub fn stage(self, spec: &GridSpec, pairs: usize, approach: &str) -> String {
+        if self.converging {
+            format!(
+                "pitch {} mm: {} x {} grid{approach}",
+                self.p, spec.nx, spec.nz
+            )
+        } else {
+            super::comparing(pairs)
+        }
+    }
+}
+
+/// The grid of `triangles` at `spec`: `kept` (the coarsest grid, sampled
+/// when the study was laid) when it is that grid, else sampled. `kept` is
+/// taken either way: the coarsest pitch is measured first.
+pub(super) fn grid_at(
+    kept: &mut Option<HeightGrid>,
+    triangles: &[Triangle],
+    spec: GridSpec,
+) -> HeightGrid {
+    match kept.take() {
+        Some(grid) if grid.spec == spec => grid,
+        _ => HeightGrid::sample(triangles, spec),
+    }
 }
 
 /// The coarsest grid of a study and its starts, as a [`Method`] lays them.

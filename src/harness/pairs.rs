@@ -32,6 +32,22 @@ impl Pairs {
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
+
+    /// Push-and-slide's pairs (`None` for the direct approach's).
+    pub(super) fn slide_mut(&mut self) -> Option<&mut Vec<PairResult>> {
+        match self {
+            Pairs::Slide(p) => Some(p),
+            Pairs::Direct(_) => None,
+        }
+    }
+
+    /// The direct approach's pairs (`None` for push-and-slide's).
+    pub(super) fn direct_mut(&mut self) -> Option<&mut Vec<DirectPair>> {
+        match self {
+            Pairs::Direct(p) => Some(p),
+            Pairs::Slide(_) => None,
+        }
+    }
 }
 
 /// The tie band of a direct study's pitch, which has none (the knee does

@@ -21,6 +21,7 @@
 use super::compare::StartSelection;
 use super::converge::ConvergeSummary;
 use super::direct::{DirectConvergeSummary, DirectVerifySummary};
+use super::metrics::TieBand;
 use super::pairs::{Pairs, PitchPart};
 use super::verify::VerifySummary;
 use crate::grid::GridSpec;
@@ -137,21 +138,30 @@ pub(super) fn unsharded_pairs<T>(
     Some(out)
 }
 
-/// Pitch `k` of the shares without its pairs: the grid seconds summed
-/// over the shards, the engine's seconds (which every shard measures
-/// alike) their longest.
-pub(super) fn merged_clocks(parts: &[StudyPart], k: usize) -> PitchPart {
+/// What a merged pitch `k` says besides its pairs: the first share's
+/// pitch, tie band and node count, the grid seconds summed over the
+/// shards, the engine's seconds (which every shard measures alike) their
+/// longest.
+pub(super) struct MergedClocks {
+    pub pitch: f64,
+    pub band: TieBand,
+    pub nodes: usize,
+    pub grid_s: f64,
+    pub seconds: f64,
+}
+
+/// [`MergedClocks`] of pitch `k` of the shares `parts`.
+pub(super) fn merged_clocks(parts: &[StudyPart], k: usize) -> MergedClocks {
     let first = &parts[0].pitches[k];
-    PitchPart {
+    MergedClocks {
         pitch: first.pitch,
-        pairs: Pairs::Slide(Vec::new()),
         band: first.band,
+        nodes: first.nodes,
         grid_s: parts.iter().map(|p| p.pitches[k].grid_s).sum(),
         seconds: parts
             .iter()
             .map(|p| p.pitches[k].seconds)
             .fold(0.0, f64::max),
-        nodes: first.nodes,
     }
 }
 

@@ -12,9 +12,10 @@
 //! What differs per approach is its [`Method`] (declared in the leaf
 //! `method`, so that this module alone calls down into the approaches):
 //! [`super::converge::Ladder`] for push-and-slide,
-//! [`super::direct::DirectMethod`] for the direct approach. What differs per study is its options ([`StudyOptions`]) and
-//! its summary; the four summaries (`verify.json` and `converge.json` of
-//! each approach) are made and set in [`summary_as_known`] and [`merge`].
+//! [`super::direct::DirectMethod`] for the direct approach. What differs
+//! per study is its options ([`StudyOptions`]) and its summary; the four
+//! summaries (`verify.json` and `converge.json` of each approach) are made
+//! and set in [`summary_as_known`] and [`merge`].
 
 use super::HarnessError;
 use super::converge::{ConvergeOptions, ConvergeSummary, Convergence, PitchResult};
@@ -24,7 +25,9 @@ use super::direct::{
 };
 use super::method::{Laid, MemoryLimit, Method, Pitch, Tracing, spec_at};
 use super::pairs::{Pairs, PitchPart, share};
-use super::sharded::{StudyPart, StudySummary, oracle_s, study_settings, unsharded_pairs};
+use super::sharded::{
+    MergedClocks, StudyPart, StudySummary, merged_clocks, oracle_s, study_settings, unsharded_pairs,
+};
 use super::trace::Fault;
 use super::verify::{Verification, VerifyOptions, VerifySummary};
 use crate::analysis::Progress;
@@ -62,7 +65,7 @@ impl StudyOptions<'_> {
     }
 
     /// The longest the oracle may take (s): beyond it, refused.
-    fn budget_s(&self) -> Option<f64> {
+    pub fn budget_s(&self) -> Option<f64> {
         match self {
             StudyOptions::Verify(o) => o.budget_s,
             StudyOptions::Converge(o) => o.budget_s,
@@ -272,45 +275,26 @@ pub(crate) fn merge(mut parts: Vec<StudyPart>) -> Option<Study> {
     let (angles, spec) = (first.angles_deg.clone(), first.spec);
     let oracle_s = oracle_s(&parts);
     let sample_s = parts.iter().map(|p| p.sample_s).fold(0.0, f64::max);
-    let pitches = first.pitches.len();
-    let mut slide = Vec::new();
-    let mut direct = Vec::new();
-    for k in 0..pitches {
-        let clocks = super::sharded::merged_clocks(&parts, k);
-        match &first_pairs(&parts, k)? {
-            Pairs::Slide(_) => {
-                let pairs = unsharded_pairs(&mut parts, k, |p| match p {
-                    Pairs::Slide(p) => Some(p),
-                    Pairs::Direct(_) => None,
-                })?;
-                slide.push(PitchResult {
-                    pitch: clocks.pitch,
-                    comparison: super::compare::assemble(
-                        pairs,
-                        &angles,
-                        clocks.band,
-                        clocks.grid_s,
-                    ),
-                    seconds: clocks.seconds,
-                    nodes: clocks.nodes,
-                });
+    let slide = |parts: &mut [StudyPart]| {
+        merged_pitches(parts, Pairs::slide_mut, |clocks, pairs| PitchResult {
+            pitch: clocks.pitch,
+            comparison: super::compare::assemble(pairs, &angles, clocks.band, clocks.grid_s),
+            seconds: clocks.seconds,
+            nodes: clocks.nodes,
+        })
+    };
+    let direct = |parts: &mut [StudyPart]| {
+        merged_pitches(parts, Pairs::direct_mut, |clocks, pairs| {
+            DirectPitchResult {
+                pitch: clocks.pitch,
+                comparison: assemble_direct(pairs, clocks.grid_s),
+                nodes: clocks.nodes,
             }
-            Pairs::Direct(_) => {
-                let pairs = unsharded_pairs(&mut parts, k, |p| match p {
-                    Pairs::Direct(p) => Some(p),
-                    Pairs::Slide(_) => None,
-                })?;
-                direct.push(DirectPitchResult {
-                    pitch: clocks.pitch,
-                    comparison: assemble_direct(pairs, clocks.grid_s),
-                    nodes: clocks.nodes,
-                });
-            }
-        }
-    }
+        })
+    };
     Some(match summary {
         StudySummary::Verify(mut summary) => {
-            let result = slide.pop().filter(|_| pitches == 1)?;
+            let result = only(slide(&mut parts)?)?;
             summary.set_comparison(&result.comparison, &spec);
             summary.timings.sample_s = sample_s;
             summary.timings.oracle_s = oracle_s;
@@ -320,41 +304,51 @@ pub(crate) fn merge(mut parts: Vec<StudyPart>) -> Option<Study> {
             }))
         }
         StudySummary::Converge(mut summary) => {
-            (slide.len() == pitches).then_some(())?;
-            summary.set_results(&slide);
+            let results = slide(&mut parts)?;
+            summary.set_results(&results);
             Study::Converge(Box::new(Convergence {
-                fits: super::converge::fits(&slide),
-                results: slide,
+                fits: super::converge::fits(&results),
+                results,
                 summary,
                 oracle_s,
             }))
         }
         StudySummary::VerifyDirect(mut summary) => {
-            let comparison = direct.pop().filter(|_| pitches == 1)?.comparison;
-            summary.set_comparison(&comparison, oracle_s);
+            let result = only(direct(&mut parts)?)?;
+            summary.set_comparison(&result.comparison, oracle_s);
             Study::VerifyDirect(Box::new(DirectVerification {
-                comparison,
+                comparison: result.comparison,
                 summary,
             }))
         }
         StudySummary::ConvergeDirect(mut summary) => {
-            (direct.len() == pitches).then_some(())?;
+            let results = direct(&mut parts)?;
             summary.oracle_s = oracle_s;
-            summary.set_results(&direct);
-            Study::ConvergeDirect(Box::new(DirectConvergence {
-                results: direct,
-                summary,
-            }))
+            summary.set_results(&results);
+            Study::ConvergeDirect(Box::new(DirectConvergence { results, summary }))
         }
     })
 }
 
-/// The first share's pairs of pitch `k` (which tell the approach).
-fn first_pairs(parts: &[StudyPart], k: usize) -> Option<Pairs> {
-    Some(match &parts.first()?.pitches.get(k)?.pairs {
-        Pairs::Slide(_) => Pairs::Slide(Vec::new()),
-        Pairs::Direct(_) => Pairs::Direct(Vec::new()),
-    })
+/// Every pitch of the shares `parts`, its pairs (those `pick` takes:
+/// `None` for the other approach's, which makes the merge `None`) moved
+/// back in the unsharded order and made a pitch's result by `result`.
+fn merged_pitches<T, R>(
+    parts: &mut [StudyPart],
+    pick: fn(&mut Pairs) -> Option<&mut Vec<T>>,
+    result: impl Fn(MergedClocks, Vec<T>) -> R,
+) -> Option<Vec<R>> {
+    (0..parts.first()?.pitches.len())
+        .map(|k| {
+            let clocks = merged_clocks(parts, k);
+            Some(result(clocks, unsharded_pairs(parts, k, pick)?))
+        })
+        .collect()
+}
+
+/// The one pitch of a verification (`None` for more or none).
+fn only<T>(mut results: Vec<T>) -> Option<T> {
+    results.pop().filter(|_| results.is_empty())
 }
 
 /// `verify`'s study of push-and-slide: refused for the direct approach,
