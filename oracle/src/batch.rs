@@ -93,19 +93,25 @@ pub fn evaluate_pairs(
         .map(|group| {
             let (s, a) = pairs[group[0]];
             let z = starts[s][1];
-            let column = |k: usize| chain.column(starts[pairs[k].0][0]);
-            let Some(last) = group.iter().filter_map(|&k| column(k)).max() else {
+            // Each pair's column, in column order.
+            let mut columns: Vec<(i64, usize)> = group
+                .iter()
+                .filter_map(|&k| Some((chain.column(starts[pairs[k].0][0])?, k)))
+                .collect();
+            columns.sort_unstable();
+            let Some(&(last, _)) = columns.last() else {
                 // Off the lattice: one start, traced on its own.
                 let trace = trace_validated(part, &knees[a], starts[s], options);
                 traced();
                 return vec![(group[0], trace)];
             };
             let mut out = Vec::with_capacity(group.len());
+            let mut asked = columns.iter().peekable();
             let mut left: Option<StartTrace> = None;
             for c in chain.head(last)..=last {
                 let start = [chain.x(c), z];
                 let trace = trace_joining(part, &knees[a], start, options, left.as_ref());
-                for &k in group.iter().filter(|&&k| column(k) == Some(c)) {
+                while let Some(&(_, k)) = asked.next_if(|&&(col, _)| col == c) {
                     out.push((k, trace.clone()));
                     traced();
                 }

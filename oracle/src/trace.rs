@@ -372,20 +372,18 @@ pub(crate) fn trace_joining(
     options: &OracleOptions,
     left: Option<&StartTrace>,
 ) -> StartTrace {
-    let join = left.and_then(|left| {
-        let shift = start[0] - left.start[0];
-        let joinable = left.status == StartStatus::Placed
-            && left.start[1] == start[1]
-            && shift > 0.0
-            && left.slide_end != SlideEnd::NotRun;
-        Some(Join {
-            contacts: &left.contacts,
-            end: left.slide_end,
-            shift,
-            release: left.yr_star? - options.eps,
-        })
-        .filter(|_| joinable)
-    });
+    // A placed start's slide has run (its end is never `NotRun`).
+    let join = left
+        .filter(|l| l.status == StartStatus::Placed && l.start[1] == start[1])
+        .filter(|l| start[0] > l.start[0])
+        .and_then(|l| {
+            Some(Join {
+                contacts: &l.contacts,
+                end: l.slide_end,
+                shift: start[0] - l.start[0],
+                release: l.yr_star? - options.eps,
+            })
+        });
     let mut tracer = Tracer {
         part,
         knee: *knee,
@@ -583,16 +581,14 @@ impl Tracer<'_> {
     /// ends as the neighbour's did. Nothing happens when the neighbour has
     /// no contact below `level`.
     fn join_if_met(&mut self, level: f64, hit: Hit) -> Result<(), FailureReason> {
-        let met = self.end.is_none()
-            && self.contacts.last().is_some_and(|c| c.face_level == level)
-            && self
-                .join
-                .as_ref()
-                .is_some_and(|j| hit.travel >= j.shift && level <= j.release);
-        if !met {
-            return Ok(());
-        }
-        let Some(join) = self.join.take() else {
+        // Only a contact this start has just recorded (not one skipped,
+        // nor past the end) can join.
+        let recorded =
+            self.end.is_none() && self.contacts.last().is_some_and(|c| c.face_level == level);
+        let Some(join) = self
+            .join
+            .take_if(|j| recorded && hit.travel >= j.shift && level <= j.release)
+        else {
             return Ok(());
         };
         let below = join.contacts.partition_point(|c| c.face_level >= level);
