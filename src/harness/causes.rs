@@ -177,9 +177,33 @@ impl Cells {
     /// by which the grid's best node near a touched point can misjudge it.
     /// Only the nodes the grid meets in the slide count: those under the
     /// knee-form at the push are never struck (SPEC).
+    #[cfg(test)]
     pub fn rise_of_lowest_near(&self, p: [f64; 3], rows: &[FootprintSpan], travel: f64) -> f64 {
         self.rises_near(p, Some((rows, travel, true)))
             .map_or(f64::INFINITY, |(lowest, _)| lowest.max(0.0))
+    }
+
+    /// [`Cells::samples_near`] then [`Cells::rise_near`] (`+inf` where
+    /// not sampled), and [`Cells::rise_of_lowest_near`], of one point in
+    /// one walk over the nodes near it: what the level-error bound asks of
+    /// every exact contact. The same figures to the bit: each is folded
+    /// over the same nodes in the same order.
+    pub fn rises_at(&self, p: [f64; 3], rows: &[FootprintSpan], travel: f64) -> (f64, f64) {
+        let (mut sampled, mut highest, mut lowest) = (false, None::<f64>, None::<f64>);
+        for (i, j, _, h) in self.nodes_near(p) {
+            let r = h - p[1];
+            highest = Some(highest.map_or(r, |hi| hi.max(r)));
+            let met = met_at(rows, i, j, self.spec.x(i)).filter(|&m| m <= travel + CELL_TOL);
+            sampled |= met.is_some();
+            if met.is_some_and(|m| m > CELL_TOL) {
+                lowest = Some(lowest.map_or(r, |lo| lo.min(r)));
+            }
+        }
+        let rise = match (sampled, highest) {
+            (true, Some(hi)) => hi.max(0.0),
+            _ => f64::INFINITY,
+        };
+        (rise, lowest.map_or(f64::INFINITY, |lo| lo.max(0.0)))
     }
 
     /// When the slide meets the node of the part nearest `p` in xz (within
@@ -247,11 +271,14 @@ impl Cells {
 }
 
 /// When the slide meets node `(i, j)` (its x `x_i`), by the start's
-/// footprint rows at the push `rows` ([`FootprintSpan::meets`]); `None`
-/// where it never does.
+/// footprint rows at the push `rows` ([`FootprintSpan::meets`]; sorted by
+/// row, as [`super::trace::GridTrace::push_rows`] are); `None` where it
+/// never does.
 fn met_at(rows: &[FootprintSpan], i: usize, j: usize, x_i: f64) -> Option<f64> {
-    rows.iter()
-        .filter(|r| r.j == j)
+    debug_assert!(rows.is_sorted_by_key(|r| r.j), "push rows by row");
+    rows[rows.partition_point(|r| r.j < j)..]
+        .iter()
+        .take_while(|r| r.j == j)
         .find_map(|r| r.meets(i as i64, x_i))
 }
 
@@ -523,6 +550,41 @@ mod tests {
             cells.nearest_node_met_at([500.0, 0.0, 5.0], &rows),
             f64::INFINITY
         );
+    }
+
+    #[test]
+    fn one_walk_gives_the_three_rises_of_the_separate_queries_to_the_bit() {
+        // A sloped part with a rib (rises of both signs and zero), points
+        // on and off the nodes, travels from the push to past every row.
+        let (triangles, grid) = ribbed(0.3);
+        let cells = Cells::of(&triangles, &grid, 0.5);
+        let row = |j, lo, hi, front| FootprintSpan { j, lo, hi, front };
+        let rows = [row(2, 3, 6, 5.0), row(3, 4, 7, 7.5), row(4, 3, 5, 4.2)];
+        let mut checked = [0; 3];
+        for k in 0..40 {
+            for m in 0..30 {
+                let (x, z) = (0.55 * f64::from(k) - 1.0, 0.37 * f64::from(m));
+                for y in [-5.0, 0.0, 4.0] {
+                    for travel in [0.0, 0.5, 1.0, 3.0, 7.7, 40.0] {
+                        let p = [x, y, z];
+                        let sampled = cells.samples_near(p, &rows, travel);
+                        let rise = if sampled {
+                            cells.rise_near(p)
+                        } else {
+                            f64::INFINITY
+                        };
+                        let lowest = cells.rise_of_lowest_near(p, &rows, travel);
+                        let (a, b) = cells.rises_at(p, &rows, travel);
+                        assert_eq!(a.to_bits(), rise.to_bits(), "{p:?} {travel}");
+                        assert_eq!(b.to_bits(), lowest.to_bits(), "{p:?} {travel}");
+                        checked[0] += usize::from(sampled);
+                        checked[1] += usize::from(lowest.is_finite());
+                        checked[2] += usize::from(rise > 0.0 && rise.is_finite());
+                    }
+                }
+            }
+        }
+        assert!(checked.iter().all(|&n| n > 100), "{checked:?}");
     }
 
     #[test]

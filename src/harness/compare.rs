@@ -16,7 +16,7 @@ use super::metrics::{
     ExactRule, METRICS, StartComparison, StartPoints, Stats, TieBand, compare, metric_index,
 };
 use super::nearest::PointSet;
-use super::trace::{Fault, grid_trace};
+use super::trace::{Fault, GridTrace, grid_trace, grid_trace_joining};
 use crate::grid::{GridSpec, HeightGrid};
 use crate::kneeform::{GridFootprint, KneeForm};
 use crate::mesh::Triangle;
@@ -596,62 +596,103 @@ pub(crate) fn pair_results(
             &owned
         }
     };
-    let pairs: Vec<(usize, usize)> = (0..footprints.len())
-        .flat_map(|a| (0..nodes.len()).map(move |s| (a, s)))
-        .collect();
-    let bands = HalfPitchBands::new(triangles, options.blind_depth);
-    Ok(pairs
-        .par_iter()
-        .map(|&(a, s)| {
-            let (i, j) = nodes[s];
-            let fp = &footprints[a];
-            let trace = &traces[a * nodes.len() + s];
-            let g = grid_trace(grid, fp, i, j, &options.rule, fault);
-            let mut cmp = compare(&g, trace, &band, ExactRule::of(&options.rule), cells);
-            // An inside miss beyond the pitch's sampling error is tested
-            // by refinement; one that halves is set apart as sampling.
-            let reach = super::causes::RISE_REACH * spec.pitch;
-            if trace.status == StartStatus::Placed
-                && cmp
-                    .inside_miss()
-                    .is_some_and(|d| d.is_finite() && d > reach)
-            {
-                cmp.miss_half_pitch = Some(inside_miss_at_half_pitch(
-                    &bands,
-                    grid,
-                    fp.angle_deg,
-                    (i, j),
-                    trace,
-                    options,
-                    fault,
-                ));
-                if cmp.halves() {
-                    cmp.points.decided_refined = std::mem::take(&mut cmp.points.decided_inside);
+    // Runs of starts one pitch apart along a row at one angle, in pair
+    // order (angle-major): each start's grid trace joins the one before
+    // it (`grid_trace_joining`: the same trace as alone), so a strip's row
+    // walks its nodes in front about once instead of once per start. At
+    // most `JOINED_RUN` starts a run, so that a row spreads over threads.
+    let mut runs: Vec<std::ops::Range<usize>> = Vec::new();
+    for a in 0..footprints.len() {
+        for s in 0..nodes.len() {
+            let pair = a * nodes.len() + s;
+            match runs.last_mut() {
+                Some(run)
+                    if s > 0
+                        && run.len() < JOINED_RUN
+                        && fault.is_none()
+                        && nodes[s] == (nodes[s - 1].0 + 1, nodes[s - 1].1) =>
+                {
+                    run.end = pair + 1;
                 }
+                _ => runs.push(pair..pair + 1),
             }
-            let grid_placed = g.yr.is_finite();
-            let status = match (trace.status, grid_placed) {
-                (StartStatus::Failed { .. }, _) => "oracle_failed",
-                (StartStatus::Placed, true) => "compared",
-                (StartStatus::Placed, false) => "grid_not_placed",
-                (StartStatus::NotPlaced, true) => "oracle_not_placed",
-                (StartStatus::NotPlaced, false) => "not_placed",
-            };
-            let snapped: Vec<(usize, usize)> = cmp
-                .points
-                .strikes
-                .iter()
-                .filter_map(|p| node_of(p[0], p[1]))
-                .collect();
-            PairResult {
-                row: row_of(i, j, fp.angle_deg, status, &cmp),
-                grid_nodes: g.colliding.iter().map(|c| c.node).collect(),
-                snapped,
-                cmp,
+        }
+    }
+    let bands = HalfPitchBands::new(triangles, options.blind_depth);
+    let one = |(a, s): (usize, usize), g: &GridTrace| {
+        let (i, j) = nodes[s];
+        let fp = &footprints[a];
+        let trace = &traces[a * nodes.len() + s];
+        let mut cmp = compare(g, trace, &band, ExactRule::of(&options.rule), cells);
+        // An inside miss beyond the pitch's sampling error is tested
+        // by refinement; one that halves is set apart as sampling.
+        let reach = super::causes::RISE_REACH * spec.pitch;
+        if trace.status == StartStatus::Placed
+            && cmp
+                .inside_miss()
+                .is_some_and(|d| d.is_finite() && d > reach)
+        {
+            cmp.miss_half_pitch = Some(inside_miss_at_half_pitch(
+                &bands,
+                grid,
+                fp.angle_deg,
+                (i, j),
+                trace,
+                options,
+                fault,
+            ));
+            if cmp.halves() {
+                cmp.points.decided_refined = std::mem::take(&mut cmp.points.decided_inside);
             }
+        }
+        let grid_placed = g.yr.is_finite();
+        let status = match (trace.status, grid_placed) {
+            (StartStatus::Failed { .. }, _) => "oracle_failed",
+            (StartStatus::Placed, true) => "compared",
+            (StartStatus::Placed, false) => "grid_not_placed",
+            (StartStatus::NotPlaced, true) => "oracle_not_placed",
+            (StartStatus::NotPlaced, false) => "not_placed",
+        };
+        let snapped: Vec<(usize, usize)> = cmp
+            .points
+            .strikes
+            .iter()
+            .filter_map(|p| node_of(p[0], p[1]))
+            .collect();
+        PairResult {
+            row: row_of(i, j, fp.angle_deg, status, &cmp),
+            grid_nodes: g.colliding.iter().map(|c| c.node).collect(),
+            snapped,
+            cmp,
+        }
+    };
+    let results: Vec<Vec<PairResult>> = runs
+        .par_iter()
+        .map(|run| {
+            let mut before: Option<GridTrace> = None;
+            run.clone()
+                .map(|pair| {
+                    let (a, s) = (pair / nodes.len(), pair % nodes.len());
+                    let (i, j) = nodes[s];
+                    let g = match &before {
+                        Some(b) => {
+                            grid_trace_joining(grid, &footprints[a], (i, j), &options.rule, b)
+                        }
+                        None => grid_trace(grid, &footprints[a], i, j, &options.rule, fault),
+                    };
+                    let result = one((a, s), &g);
+                    before = Some(g);
+                    result
+                })
+                .collect()
         })
-        .collect())
+        .collect();
+    Ok(results.into_iter().flatten().collect())
 }
+
+/// The most starts of a row whose grid traces [`pair_results`] joins one
+/// to the next: the first of each run slides alone.
+const JOINED_RUN: usize = 64;
 
 /// The largest decided miss inside the footprint
 /// ([`StartComparison::inside_miss`]) of the start at node `(i, j)` of

@@ -576,25 +576,16 @@ impl<'a> LevelErrorBound<'a> {
         // not one the outline reaches only later, where it runs almost
         // along the slide.
         let ahead = |c: &ContactPoint| c.travel + MEETING_REACH * pitch;
+        let (rises, lowest) = exact
+            .contacts
+            .iter()
+            .map(|c| cells.rises_at(c.witness, push_rows, ahead(c)))
+            .unzip();
         Some(LevelErrorBound {
             curve,
             travels: exact.contacts.iter().map(|c| c.travel).collect(),
-            rises: exact
-                .contacts
-                .iter()
-                .map(|c| {
-                    if cells.samples_near(c.witness, push_rows, ahead(c)) {
-                        cells.rise_near(c.witness)
-                    } else {
-                        f64::INFINITY
-                    }
-                })
-                .collect(),
-            lowest: exact
-                .contacts
-                .iter()
-                .map(|c| cells.rise_of_lowest_near(c.witness, push_rows, ahead(c)))
-                .collect(),
+            rises,
+            lowest,
             push_rise: exact.push_witness.map_or(0.0, |w| {
                 if cells.samples_near(w, push_rows, 0.0) {
                     cells.rise_near(w)

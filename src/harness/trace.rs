@@ -46,6 +46,10 @@ pub(crate) struct GridTrace {
     pub colliding: Vec<GridContact>,
     /// The footprint's rows at the push, one per row of the grid.
     pub push_rows: Vec<FootprintSpan>,
+    /// `(travel, level)` after each tie group that lowered the level, by
+    /// travel: the level curve, which the start one pitch to its +x joins
+    /// ([`grid_trace_joining`]).
+    pub levels: Vec<(f64, f64)>,
 }
 
 /// One row of a start's footprint at the push.
@@ -87,6 +91,57 @@ pub(crate) fn grid_trace(
     j0: usize,
     rule: &StrikeRule,
     fault: Option<Fault>,
+) -> GridTrace {
+    slide(grid, fp, (i0, j0), rule, fault, None)
+}
+
+/// [`grid_trace`] of the start at node `(i0, j0)`, given `neighbour`, the
+/// trace of the start one pitch to its -x (node `(i0 - 1, j0)`) at the same
+/// footprint: the same trace, for a few hundred nodes where the start
+/// alone walks every node in front of it (10^5 on the console).
+///
+/// Why it is the same. Call the start A and its neighbour B, `p` the
+/// pitch. A's footprint after `s` mm of travel covers B's after `s - p`,
+/// so for `s >= p` the nodes A has met are those it met by `p` (B's push
+/// footprint among them) and those B met by `s - p`, and A's level is
+/// `f_A(s) = min(f_A(p), f_B(s - p))`. Once B's level has come down to A's
+/// (at B's travel `J`), the two curves are the same, shifted by `p`; from
+/// `W` mm later on, so are the windows' earlier levels, and each node is
+/// met at the same level with the same earlier level: A strikes exactly
+/// the nodes B strikes from there, each `p` further along. So A slides on
+/// its own until it reaches `J + W` plus a pitch to spare (the levels
+/// A has reached bound `J` from above: a lower level only moves `J`
+/// later), and takes B's strikes and level curve from there, with each
+/// strike's travel computed as A's own slide computes it. A test compares
+/// every start of whole rows with its trace alone, to the bit.
+pub(crate) fn grid_trace_joining(
+    grid: &HeightGrid,
+    fp: &GridFootprint,
+    (i0, j0): (usize, usize),
+    rule: &StrikeRule,
+    neighbour: &GridTrace,
+) -> GridTrace {
+    slide(grid, fp, (i0, j0), rule, None, Some(neighbour))
+}
+
+/// The layers of nodes in front that [`grid_trace_joining`] lays first
+/// beyond the window and two pitches, doubled while its own slide needs
+/// more.
+const JOIN_SPARE_LAYERS: i64 = 4;
+
+/// How far (mm) below a front's last complete layer a tie group must start
+/// to be judged from it: far above rounding, far below a pitch.
+const FRONT_SLACK: f64 = 1e-6;
+
+/// [`grid_trace`], joining the trace of the start one pitch to its -x
+/// where given ([`grid_trace_joining`]).
+fn slide(
+    grid: &HeightGrid,
+    fp: &GridFootprint,
+    (i0, j0): (usize, usize),
+    rule: &StrikeRule,
+    fault: Option<Fault>,
+    neighbour: Option<&GridTrace>,
 ) -> GridTrace {
     crate::engine::assert_same_pitch(grid, std::slice::from_ref(fp));
     let spec = grid.spec;
@@ -136,19 +191,63 @@ pub(crate) fn grid_trace(
         }
         in_order.push((row.d0, i0 as i64 + i64::from(row.kf), j));
     }
-    let front = front_in_distance_order(&in_order, p, spec.nx);
     let mut trace = GridTrace {
         yr,
         colliding: Vec::new(),
         push_rows,
+        levels: Vec::new(),
     };
     if yr == f64::INFINITY {
         return trace;
     }
+    // Every node in front when alone; when joining, the first layers, more
+    // as the slide needs them: all nodes nearer than `layers * p` are laid
+    // (a row's first node in front lies in `(0, p]`, up to rounding), and
+    // the front's order up to there is the whole front's.
+    let neighbour = neighbour.filter(|b| b.yr.is_finite());
+    let all_layers = in_order.iter().map(|r| r.1).max().unwrap_or(-1) + 1;
+    let mut layers = match neighbour {
+        Some(_) => ((rule.window / p).ceil() as i64 + 2 + JOIN_SPARE_LAYERS).min(all_layers),
+        None => all_layers,
+    };
+    let laid_up_to = |layers: i64| {
+        if layers >= all_layers {
+            f64::INFINITY
+        } else {
+            layers as f64 * p - FRONT_SLACK
+        }
+    };
+    let mut front = front_in_distance_order(&in_order, p, spec.nx, layers);
+    // Where the neighbour's level curve has come down to `f`: the first of
+    // its levels at or below it.
+    let mut joined = 0;
     let mut f = yr;
     let mut history = LevelHistory::new(yr);
     let mut k = 0;
-    while k < front.len() {
+    loop {
+        if k == front.len() && layers == all_layers {
+            break;
+        }
+        if k == front.len() || front[k].0 >= laid_up_to(layers) - FRONT_SLACK {
+            layers = (2 * layers).min(all_layers);
+            front = front_in_distance_order(&in_order, p, spec.nx, layers);
+            continue;
+        }
+        let s = front[k].0;
+        if let Some(b) = neighbour {
+            while joined < b.levels.len() && b.levels[joined].1 > f {
+                joined += 1;
+            }
+            let meets = if b.yr <= f {
+                0.0
+            } else {
+                b.levels.get(joined).map_or(f64::INFINITY, |l| l.0)
+            };
+            if s >= meets + rule.window + 2.0 * p {
+                join(&mut trace, b, s, f, &in_order, p);
+                return trace;
+            }
+        }
         let mut end = k + 1;
         if fault != Some(Fault::IgnoreTies) {
             while end < front.len() && front[end].0 - front[end - 1].0 <= NODE_TOL {
@@ -182,18 +281,59 @@ pub(crate) fn grid_trace(
             }
             gmin = gmin.min(hv);
         }
-        f = f.min(gmin);
+        if gmin < f {
+            f = gmin;
+            trace.levels.push((s, f));
+        }
         history.push(s, f);
         k = end;
     }
     trace
 }
 
-/// Every node in front of a start, `(distance, i, j)`, in the order the
+/// Completes `trace`, slid on its own up to the tie group at travel `s`
+/// (exclusive) and level `f`, with the strikes and the level curve of
+/// `neighbour` from there ([`grid_trace_joining`]). `rows` are the
+/// trace's rows in front, `(d0, first column in front, row)`.
+fn join(
+    trace: &mut GridTrace,
+    neighbour: &GridTrace,
+    s: f64,
+    f: f64,
+    rows: &[(f64, i64, usize)],
+    p: f64,
+) {
+    // A node's distance as this start's own slide computes it.
+    let distance = |(i, j): (usize, usize)| {
+        let &(d0, first, _) = rows.iter().find(|r| r.2 == j)?;
+        Some(d0 + (first - i as i64) as f64 * p)
+    };
+    let start = trace.colliding.len();
+    trace
+        .colliding
+        .extend(neighbour.colliding.iter().filter_map(|c| {
+            let travel = distance(c.node).filter(|&d| d >= s)?;
+            Some(GridContact { travel, ..*c })
+        }));
+    // In this start's order: by distance, ties by row.
+    trace.colliding[start..]
+        .sort_by(|a, b| a.travel.total_cmp(&b.travel).then(a.node.1.cmp(&b.node.1)));
+    trace.levels.extend(
+        neighbour
+            .levels
+            .iter()
+            .filter(|l| l.1 < f)
+            .map(|&(t, level)| (t + p, level)),
+    );
+}
+
+/// The nodes in front of a start, `(distance, i, j)`, in the order the
 /// slide meets them: by distance, ties by row. `rows` holds each row's
 /// `d0` (in `(0, p]`, up to rounding), the column of its first node in
 /// front and its grid row, in the order of `d0` then row; the row meets
-/// its columns `first, first - 1, ... 0` at `d0, d0 + p, ...`.
+/// its columns `first, first - 1, ... 0` at `d0, d0 + p, ...`. Only the
+/// first `layers` nodes of each row: every node nearer than `layers * p`
+/// (all of them from the deepest row's `first + 1` on).
 ///
 /// Generated layer by layer (the `m`-th node in front of every row, rows
 /// in `d0` order), which is that order up to rounding at the layers'
@@ -204,10 +344,10 @@ fn front_in_distance_order(
     rows: &[(f64, i64, usize)],
     p: f64,
     nx: usize,
+    layers: i64,
 ) -> Vec<(f64, usize, usize)> {
-    let deepest = rows.iter().map(|r| r.1).max().unwrap_or(-1);
     let mut front: Vec<(f64, usize, usize)> = Vec::new();
-    for m in 0..=deepest {
+    for m in 0..layers {
         for &(d0, first, j) in rows {
             let i = first - m;
             if (0..nx as i64).contains(&i) {
@@ -278,7 +418,8 @@ mod tests {
                     }
                 }
                 sorted.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
-                let layered = front_in_distance_order(&rows, pitch, spec.nx);
+                let all = rows.iter().map(|r| r.1).max().unwrap_or(-1) + 1;
+                let layered = front_in_distance_order(&rows, pitch, spec.nx, all);
                 met += layered.len();
                 assert_eq!(
                     layered, sorted,
@@ -331,5 +472,76 @@ mod tests {
             assert_eq!(masks[0].mask, union, "angle {angle}");
             assert!(masks[0].colliding > 0);
         }
+    }
+
+    /// A start's trace joined to its -x neighbour's is its trace alone, to
+    /// the bit: every start of every row, at angles and pitches where the
+    /// level curves join at once, late and never, both rate rules.
+    #[test]
+    fn a_trace_joined_to_its_neighbours_is_its_trace_alone() {
+        let knee = KneeForm {
+            triangle_side: 50.0,
+            radius: 15.0,
+            thickness: 100.0,
+        };
+        let mut joined = 0;
+        for (pitch, amplitude, slope) in [(3.0, 4.0, 0.15), (1.24, 9.0, -0.2), (2.0, 0.0, -0.05)] {
+            let spec = GridSpec {
+                pitch,
+                i_origin: -10,
+                j_origin: -5,
+                nx: (160.0 / pitch) as usize,
+                nz: (90.0 / pitch) as usize,
+            };
+            // A slope (down towards -x, where the level joins the
+            // neighbour's at once, or towards +x, where it joins late),
+            // waves, and a step down towards -x.
+            let h: Vec<f64> = (0..spec.len())
+                .map(|n| {
+                    let (x, z) = (spec.x(n % spec.nx), spec.z(n / spec.nx));
+                    let step = if x < 60.0 { -6.0 } else { 0.0 };
+                    slope * x
+                        + amplitude * (0.11 * x).sin() * (0.07 * z).cos()
+                        + step
+                        + 0.5 * (1.3 * x).sin()
+                })
+                .collect();
+            let grid = HeightGrid { spec, h };
+            let rules = [
+                StrikeRule::default(),
+                StrikeRule {
+                    rate: crate::strike::RateEstimate::XSlope,
+                    ..StrikeRule::default()
+                },
+            ];
+            for rule in &rules {
+                for angle in [-30.0, -7.0, 12.0, 30.0] {
+                    let fp = GridFootprint::new(&knee, angle, &spec);
+                    for j0 in (0..spec.nz).step_by(4) {
+                        let mut before: Option<GridTrace> = None;
+                        for i0 in 0..spec.nx {
+                            let alone = grid_trace(&grid, &fp, i0, j0, rule, None);
+                            if let Some(b) = &before {
+                                let chained = grid_trace_joining(&grid, &fp, (i0, j0), rule, b);
+                                let at = format!("pitch {pitch}, angle {angle}, start {i0} {j0}");
+                                assert_eq!(chained.yr, alone.yr, "{at}");
+                                assert_eq!(chained.colliding, alone.colliding, "{at}");
+                                assert_eq!(chained.push_rows, alone.push_rows, "{at}");
+                                // The level curve: the same levels, at
+                                // travels the neighbour's plus a pitch.
+                                assert_eq!(chained.levels.len(), alone.levels.len(), "{at}");
+                                for (c, a) in chained.levels.iter().zip(&alone.levels) {
+                                    assert_eq!(c.1, a.1, "{at}");
+                                    assert!((c.0 - a.0).abs() < 1e-9, "{at}");
+                                }
+                                joined += usize::from(!alone.colliding.is_empty());
+                            }
+                            before = Some(alone);
+                        }
+                    }
+                }
+            }
+        }
+        assert!(joined > 1000, "{joined}");
     }
 }
