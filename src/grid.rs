@@ -168,6 +168,18 @@ pub struct HeightGrid {
     pub h: Vec<f64>,
 }
 
+#[cfg(test)]
+impl HeightGrid {
+    /// The grid on `spec` whose height at the node at `(x, z)` (mm) is
+    /// `height(x, z)`: the tests' synthetic parts.
+    pub(crate) fn from_fn(spec: GridSpec, height: impl Fn(f64, f64) -> f64) -> HeightGrid {
+        let h = (0..spec.len())
+            .map(|n| height(spec.x(n % spec.nx), spec.z(n / spec.nx)))
+            .collect();
+        HeightGrid { spec, h }
+    }
+}
+
 impl HeightGrid {
     /// Samples `triangles` (analysis frame) on `spec` with a depth-buffer
     /// rasterizer: each triangle visits only the nodes under its xz

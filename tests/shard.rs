@@ -847,3 +847,72 @@ fn a_bad_manifest_is_one_line() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Runs of adjacent starts (`--starts runs:N:L`): L starts one pitch apart
+/// on a row, from a chain block's first column, traced in chains; the
+/// summary names them; an empty, over-long or half-written run is refused
+/// in one line naming `--starts`.
+#[test]
+fn runs_of_starts_are_chained_and_bad_runs_are_refused() {
+    let dir = scratch_dir("verify-runs");
+    let part = scenario("bump");
+    let verify = |starts: &str, out: &str| {
+        kneeform(&[
+            "verify",
+            part.as_str(),
+            "--angles=-30,30",
+            "--pitch",
+            "4",
+            "--tolerance",
+            "1",
+            "--starts",
+            starts,
+            "--out",
+            dir.join(out).to_str().unwrap(),
+        ])
+    };
+    let run = verify("runs:3:4", "runs");
+    assert!(
+        matches!(run.status.code(), Some(0 | 1)),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("runs/verify.json")).unwrap()).unwrap();
+    assert_eq!(summary["starts"], "runs:3:4");
+    assert_eq!(summary["seed"], 1);
+    assert_eq!(
+        summary["oracle_chain"],
+        serde_json::json!({"pitch": 4.0, "block": 64})
+    );
+    let csv = std::fs::read_to_string(dir.join("runs/verify.csv")).unwrap();
+    let rows: Vec<(i64, i64)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[0].parse().unwrap(), f[1].parse().unwrap())
+        })
+        .collect();
+    assert_eq!(rows.len(), 2 * 3 * 4, "two angles of 3 runs of 4");
+    for run in rows[..12].chunks(4) {
+        assert!(
+            run.windows(2).all(|w| w[1] == (w[0].0 + 1, w[0].1)),
+            "{run:?}"
+        );
+    }
+    for (bad, says) in [
+        ("runs:0:4", "at least one start"),
+        ("runs:3:65", "1 to 64 starts"),
+        ("runs:3", "expected runs:N:L"),
+    ] {
+        let out = verify(bad, "bad");
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("--starts") && err.contains(says),
+            "{bad}: {err}"
+        );
+        assert_eq!(err.trim().lines().count(), 1, "{bad}: {err}");
+    }
+}

@@ -365,11 +365,13 @@ pub struct ReportArgs {
 #[derive(Debug, Args)]
 pub struct StartArgs {
     /// Starts to compare: `all` (every node whose start is placed at some
-    /// angle), a number N for a seeded random sample of them, or
+    /// angle), a number N for a seeded random sample of them,
     /// `strip:Z0:Z1` for every placed start with Z0 <= z <= Z1 (mm): a
     /// whole strip of start rows, whose area distance is the colliding
-    /// area a user sees there.
-    #[arg(long, default_value = "100", value_name = "all|N|strip:Z0:Z1")]
+    /// area a user sees there, or `runs:N:L` for N seeded runs of L
+    /// adjacent starts along a row (1 <= L <= 64): small strips, each
+    /// costing the oracle about one start (their traces are chained).
+    #[arg(long, default_value = "100", value_name = "all|N|strip:Z0:Z1|runs:N:L")]
     pub starts: String,
     /// Seed of the start sample.
     #[arg(long, default_value_t = 1, value_name = "S")]
@@ -399,6 +401,22 @@ impl StartArgs {
                     format!("--starts {:?}: expected strip:Z0:Z1 in mm", self.starts)
                 })?;
             return Ok(StartSelection::Strip { z: [lo, hi] });
+        }
+        if let Some(runs) = self.starts.strip_prefix("runs:") {
+            let (count, length) = runs
+                .split_once(':')
+                .and_then(|(n, l)| Some((n.trim().parse().ok()?, l.trim().parse().ok()?)))
+                .with_context(|| {
+                    format!(
+                        "--starts {:?}: expected runs:N:L (N runs of L starts)",
+                        self.starts
+                    )
+                })?;
+            return Ok(StartSelection::Runs {
+                count,
+                length,
+                seed: self.seed,
+            });
         }
         let count: usize = self
             .starts

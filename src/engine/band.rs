@@ -731,18 +731,14 @@ mod tests {
             nx: 150,
             nz: 60,
         };
-        let h: Vec<f64> = (0..spec.len())
-            .map(|n| {
-                let (x, z) = (spec.x(n % spec.nx), spec.z(n / spec.nx));
-                let hole = (x - 60.0).hypot(z - 10.0) < 25.0;
-                if hole {
-                    f64::INFINITY
-                } else {
-                    0.1 * x + 3.0 * (0.07 * x).sin() * (0.05 * z).cos()
-                }
-            })
-            .collect();
-        let grid = HeightGrid { spec, h };
+        let grid = HeightGrid::from_fn(spec, |x, z| {
+            let hole = (x - 60.0).hypot(z - 10.0) < 25.0;
+            if hole {
+                f64::INFINITY
+            } else {
+                0.1 * x + 3.0 * (0.07 * x).sin() * (0.05 * z).cos()
+            }
+        });
         let knee = KneeForm {
             triangle_side: 80.0,
             radius: 20.0,
@@ -931,17 +927,13 @@ mod tests {
             nx: 90,
             nz: 3 * BAND_ROWS + 11,
         };
-        let h: Vec<f64> = (0..spec.len())
-            .map(|n| {
-                let (x, z) = (spec.x(n % spec.nx), spec.z(n / spec.nx));
-                if (x - 40.0).hypot(z - 30.0) < 12.0 {
-                    f64::INFINITY
-                } else {
-                    (0.5 * (0.9 * x).sin() * (0.13 * z).cos() + 0.02 * x).round() * 0.5
-                }
-            })
-            .collect();
-        let grid = HeightGrid { spec, h };
+        let grid = HeightGrid::from_fn(spec, |x, z| {
+            if (x - 40.0).hypot(z - 30.0) < 12.0 {
+                f64::INFINITY
+            } else {
+                (0.5 * (0.9 * x).sin() * (0.13 * z).cos() + 0.02 * x).round() * 0.5
+            }
+        });
         let knee = KneeForm {
             triangle_side: 60.0,
             radius: 15.0,

@@ -22,6 +22,26 @@ use crate::kneeform::{GridFootprint, KneeForm};
 use crate::mesh::Triangle;
 use crate::strike::StrikeRule;
 
+/// Starts per block of a row whose traces are chained
+/// ([`kneeform_oracle::Chain`]): one start in 64 is traced whole, each
+/// other joins its -x neighbour's curve after a few casts of its own.
+pub(crate) const CHAIN_BLOCK: usize = 64;
+
+/// How the exact traces of `selection`'s starts on the grid of pitch
+/// `pitch` share work: a strip (every placed start of whole rows) and
+/// runs of starts are traced in chains along their rows; scattered starts
+/// share nothing, and are traced each on its own.
+pub(crate) fn chain_of(selection: &StartSelection, pitch: f64) -> Option<kneeform_oracle::Chain> {
+    matches!(
+        selection,
+        StartSelection::Strip { .. } | StartSelection::Runs { .. }
+    )
+    .then_some(kneeform_oracle::Chain {
+        pitch,
+        block: CHAIN_BLOCK,
+    })
+}
+
 /// Which starts to compare.
 #[derive(Debug, Clone, PartialEq)]
 pub enum StartSelection {
@@ -39,6 +59,18 @@ pub enum StartSelection {
     Strip {
         /// The strip's z range (mm).
         z: [f64; 2],
+    },
+    /// A seeded random sample of `count` runs of `length` starts one pitch
+    /// apart along a row, each beginning at a chain block's first column
+    /// ([`CHAIN_BLOCK`]): small strips, whose exact traces are chained
+    /// (each run costs about one start traced alone).
+    Runs {
+        /// How many runs.
+        count: usize,
+        /// Starts per run (1 to [`CHAIN_BLOCK`]).
+        length: usize,
+        /// The seed.
+        seed: u64,
     },
     /// These starts (x, z in mm), placed or not; each must be a node of
     /// the grid compared (of the coarsest one in a convergence study).
@@ -118,7 +150,8 @@ pub(crate) fn select_starts(
 }
 
 /// The nodes of `selection` among `nodes` (row-major): all of them, those
-/// of a strip, or a seeded sample, back in row-major order. The slide's
+/// of a strip, a seeded sample, or seeded runs along rows, back in
+/// row-major order. The slide's
 /// starts and the direct approach's positions are chosen alike.
 pub(super) fn choose_nodes(
     spec: &crate::grid::GridSpec,
@@ -132,18 +165,50 @@ pub(super) fn choose_nodes(
             _ => true,
         })
         .collect();
-    if let &StartSelection::Sample { count, seed } = selection {
-        // A partial Fisher-Yates shuffle, then back to row-major order.
-        let mut rng = SplitMix(seed);
-        let count = count.min(nodes.len());
-        for k in 0..count {
-            let pick = k + (rng.next() % (nodes.len() - k) as u64) as usize;
-            nodes.swap(k, pick);
+    match *selection {
+        StartSelection::Sample { count, seed } => {
+            let mut picked: Vec<usize> = (0..nodes.len()).collect();
+            sample(&mut picked, count, seed);
+            nodes = picked.iter().map(|&n| nodes[n]).collect();
         }
-        nodes.truncate(count);
-        nodes.sort_by_key(|&(i, j)| (j, i));
+        StartSelection::Runs {
+            count,
+            length,
+            seed,
+        } => {
+            // The runs' first nodes: at a block's first lattice column,
+            // followed on their row by `length - 1` nodes of `nodes`.
+            let block = CHAIN_BLOCK as i64;
+            let mut heads: Vec<usize> = (0..nodes.len())
+                .filter(|&n| {
+                    let (i, j) = nodes[n];
+                    (spec.i_origin + i as i64).rem_euclid(block) == 0
+                        && (1..length).all(|k| nodes.get(n + k) == Some(&(i + k, j)))
+                })
+                .collect();
+            sample(&mut heads, count, seed);
+            nodes = heads
+                .iter()
+                .flat_map(|&n| nodes[n..n + length].iter().copied())
+                .collect();
+        }
+        _ => {}
     }
     nodes
+}
+
+/// Keeps a seeded random sample of `count` of the indices `items` (all
+/// where fewer), in increasing order: a partial Fisher-Yates shuffle, then
+/// sorted back.
+fn sample(items: &mut Vec<usize>, count: usize, seed: u64) {
+    let mut rng = SplitMix(seed);
+    let count = count.min(items.len());
+    for k in 0..count {
+        let pick = k + (rng.next() % (items.len() - k) as u64) as usize;
+        items.swap(k, pick);
+    }
+    items.truncate(count);
+    items.sort_unstable();
 }
 
 /// The node nearest `(x, z)` (mm), if it lies within half a pitch of one.
@@ -1322,6 +1387,53 @@ mod tests {
 
     use crate::harness::verify::oracle_options;
     use crate::scenario::{axis, tessellate};
+
+    /// Runs are whole: `length` nodes one pitch apart on a row, the first
+    /// at a chain block's first lattice column, none across a gap;
+    /// seeded, in row-major order, all of them where fewer exist than
+    /// asked.
+    #[test]
+    fn runs_of_starts_are_adjacent_nodes_from_a_block_head() {
+        let spec = crate::grid::GridSpec {
+            pitch: 1.24,
+            i_origin: -100,
+            j_origin: 3,
+            nx: 300,
+            nz: 40,
+        };
+        // Every node but a gap on row 7 (which breaks that row's run
+        // from column 128) and the rows beyond 30.
+        let nodes: Vec<(usize, usize)> = (0..spec.nz)
+            .flat_map(|j| (0..spec.nx).map(move |i| (i, j)))
+            .filter(|&(i, j)| j <= 30 && !(j == 7 && spec.i_origin + i as i64 == 130))
+            .collect();
+        let runs = |count, length, seed| {
+            choose_nodes(
+                &spec,
+                nodes.clone(),
+                &StartSelection::Runs {
+                    count,
+                    length,
+                    seed,
+                },
+            )
+        };
+        let picked = runs(12, 5, 3);
+        assert_eq!(picked.len(), 60);
+        assert!(picked.is_sorted_by_key(|&(i, j)| (j, i)));
+        for run in picked.chunks(5) {
+            let (i, j) = run[0];
+            assert_eq!((spec.i_origin + i as i64).rem_euclid(64), 0, "{run:?}");
+            assert!(run.iter().zip(i..).all(|(&n, c)| n == (c, j)), "{run:?}");
+            assert!(j <= 30 && !(j == 7 && i as i64 + spec.i_origin == 128));
+        }
+        assert_eq!(picked, runs(12, 5, 3), "seeded");
+        assert_ne!(picked, runs(12, 5, 4));
+        // Whole blocks: heads at lattice columns -64, 0, 64 and 128 (nodes
+        // 36, 100, 164, 228; the next, 192, ends past the grid): 4 a
+        // row, 31 rows, less row 7's last.
+        assert_eq!(runs(1000, 64, 1).len(), (4 * 31 - 1) * 64);
+    }
 
     /// The refinement's finer grid holds only the rows the footprint
     /// covers from the start: on a part with creases between node rows

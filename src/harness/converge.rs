@@ -9,7 +9,8 @@ use serde::{Deserialize, Serialize};
 
 use super::HarnessError;
 use super::compare::{
-    CompareOptions, Comparison, GridSide, PairResult, StartSelection, assemble, pair_results,
+    CompareOptions, Comparison, GridSide, PairResult, StartSelection, assemble, chain_of,
+    pair_results,
 };
 use super::method::{Laid, Method, Pitch, Tracing, grid_at, spec_at};
 use super::metrics::{METRICS, TieBand};
@@ -199,24 +200,8 @@ pub(super) struct Ladder<'a> {
     /// A deliberate mistake on the grid side (tests only).
     fault: Option<Fault>,
     /// How the oracle shares traces between the starts of a row: along
-    /// every row of a strip of starts ([`chain_of`]), else not at all.
+    /// every row of a strip or run of starts ([`chain_of`]), else not at all.
     chain: Option<kneeform_oracle::Chain>,
-}
-
-/// Starts per block of a row whose traces are chained
-/// ([`kneeform_oracle::Chain`]): one start in 64 is traced whole, each
-/// other joins its -x neighbour's curve after a few casts of its own.
-pub(crate) const CHAIN_BLOCK: usize = 64;
-
-/// How the exact traces of `selection`'s starts on the grid of pitch
-/// `pitch` share work: a strip (every placed start of whole rows) is
-/// traced in chains along its rows; scattered starts share nothing, and
-/// are traced each on its own.
-pub(crate) fn chain_of(selection: &StartSelection, pitch: f64) -> Option<kneeform_oracle::Chain> {
-    matches!(selection, StartSelection::Strip { .. }).then_some(kneeform_oracle::Chain {
-        pitch,
-        block: CHAIN_BLOCK,
-    })
 }
 
 /// The exact traces of `starts` at `angles` (in [`run_oracle`]'s order),

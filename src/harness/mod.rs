@@ -164,6 +164,14 @@ pub enum HarnessError {
     /// A start sample of no start.
     #[error("a start sample must hold at least one start")]
     EmptySample,
+    /// Runs of starts longer than a chain block, or empty.
+    #[error("a run of starts must hold 1 to {max} starts (one chain block), got {length}")]
+    RunLength {
+        /// The run's length asked for.
+        length: usize,
+        /// The longest run.
+        max: usize,
+    },
     /// The time budget is not a finite positive number of seconds.
     #[error("the time budget must be a finite number of seconds > 0, got {0}")]
     Budget(f64),

@@ -440,13 +440,9 @@ mod tests {
             nx: 70,
             nz: 30,
         };
-        let h: Vec<f64> = (0..spec.len())
-            .map(|n| {
-                let (x, z) = (spec.x(n % spec.nx), spec.z(n / spec.nx));
-                0.15 * x + 4.0 * (0.11 * x).sin() * (0.07 * z).cos()
-            })
-            .collect();
-        let grid = HeightGrid { spec, h };
+        let grid = HeightGrid::from_fn(spec, |x, z| {
+            0.15 * x + 4.0 * (0.11 * x).sin() * (0.07 * z).cos()
+        });
         let knee = KneeForm {
             triangle_side: 50.0,
             radius: 15.0,
@@ -496,17 +492,13 @@ mod tests {
             // A slope (down towards -x, where the level joins the
             // neighbour's at once, or towards +x, where it joins late),
             // waves, and a step down towards -x.
-            let h: Vec<f64> = (0..spec.len())
-                .map(|n| {
-                    let (x, z) = (spec.x(n % spec.nx), spec.z(n / spec.nx));
-                    let step = if x < 60.0 { -6.0 } else { 0.0 };
-                    slope * x
-                        + amplitude * (0.11 * x).sin() * (0.07 * z).cos()
-                        + step
-                        + 0.5 * (1.3 * x).sin()
-                })
-                .collect();
-            let grid = HeightGrid { spec, h };
+            let grid = HeightGrid::from_fn(spec, |x, z| {
+                let step = if x < 60.0 { -6.0 } else { 0.0 };
+                slope * x
+                    + amplitude * (0.11 * x).sin() * (0.07 * z).cos()
+                    + step
+                    + 0.5 * (1.3 * x).sin()
+            });
             let rules = [
                 StrikeRule::default(),
                 StrikeRule {

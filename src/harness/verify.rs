@@ -9,7 +9,9 @@ use kneeform_oracle::{KneeFormDims, OracleOptions, StartTrace};
 use serde::{Deserialize, Serialize};
 
 use super::HarnessError;
-use super::compare::{AreaDistance, Comparison, Counts, StartSelection, select_starts};
+use super::compare::{
+    AreaDistance, CHAIN_BLOCK, Comparison, Counts, StartSelection, select_starts,
+};
 use super::method::MemoryLimit;
 use super::metrics::{Stats, TieBand};
 use crate::analysis::Progress;
@@ -49,7 +51,15 @@ impl VerifyOptions {
 
 pub(super) fn check_selection(selection: &StartSelection) -> Result<(), HarnessError> {
     match *selection {
-        StartSelection::Sample { count: 0, .. } => Err(HarnessError::EmptySample),
+        StartSelection::Sample { count: 0, .. } | StartSelection::Runs { count: 0, .. } => {
+            Err(HarnessError::EmptySample)
+        }
+        StartSelection::Runs { length, .. } if !(1..=CHAIN_BLOCK).contains(&length) => {
+            Err(HarnessError::RunLength {
+                length,
+                max: CHAIN_BLOCK,
+            })
+        }
         StartSelection::At(ref starts) if starts.is_empty() => Err(HarnessError::EmptySample),
         StartSelection::Strip { z } if !(z[0].is_finite() && z[1].is_finite() && z[0] <= z[1]) => {
             Err(HarnessError::Strip(z))
@@ -318,7 +328,7 @@ impl VerifySummary {
                 grid_s: comparison.grid_s,
                 oracle_s,
             },
-            oracle_chain: super::converge::chain_of(&options.selection, setup.pitch),
+            oracle_chain: super::compare::chain_of(&options.selection, setup.pitch),
         };
         summary.set_comparison(comparison, spec);
         summary
@@ -379,12 +389,18 @@ impl VerifySummary {
 }
 
 /// `selection` as `verify.json` says it: `all`, the sample size,
-/// `strip:Z0:Z1` or `N given`; and the sample's seed (0 for no sample).
+/// `strip:Z0:Z1`, `runs:N:L` or `N given`; and the sample's seed (0 for
+/// no sample).
 pub(super) fn selection_words(selection: &StartSelection) -> (String, u64) {
     match *selection {
         StartSelection::All => ("all".into(), 0),
         StartSelection::Sample { count, seed } => (count.to_string(), seed),
         StartSelection::Strip { z } => (format!("strip:{}:{}", z[0], z[1]), 0),
+        StartSelection::Runs {
+            count,
+            length,
+            seed,
+        } => (format!("runs:{count}:{length}"), seed),
         StartSelection::At(ref starts) => (format!("{} given", starts.len()), 0),
     }
 }

@@ -142,17 +142,13 @@ pub enum PngError {
 /// (bright = small `h`, the first to meet the knee; the bar's ends say
 /// which is closer), in the part's own y (mm), nodes that miss the part in
 /// a pale neutral (in the key), mm axes, the side and viewing direction in
-/// the title, cropped to the part (see the module docs).
+/// the title, cropped to the part (see the module docs). Returns where it
+/// put things.
 pub fn write_depth_png(
     path: &Path,
     grid: &HeightGrid,
     placement: &Placement,
-) -> Result<(), PngError> {
-    depth_png(path, grid, placement).map(drop)
-}
-
-/// [`write_depth_png`], returning where it put things.
-fn depth_png(path: &Path, grid: &HeightGrid, placement: &Placement) -> Result<Layout, PngError> {
+) -> Result<Layout, PngError> {
     let side = placement.side;
     let frame = placement.frame.record().map(|r| r.given);
     let direct = placement.approach == Approach::Direct;
@@ -269,21 +265,9 @@ pub fn composite_key(ringed: bool, blind: bool) -> Vec<(RGBColor, &'static str)>
 /// part is missed), both in the key, mm axes, `title` with the side and
 /// viewing direction under it, cropped to the part and what was struck;
 /// few struck pixels are circled, and the cells `blind` (each by its first
-/// corner node `(i, j)`: [`crate::blind`]) crossed.
+/// corner node `(i, j)`: [`crate::blind`]) crossed. Returns where it put
+/// things.
 pub fn write_composite_png(
-    path: &Path,
-    grid: &HeightGrid,
-    composite: &[u16],
-    n_angles: usize,
-    title: &str,
-    placement: &Placement,
-    blind: &[(usize, usize)],
-) -> Result<(), PngError> {
-    composite_png(path, grid, composite, n_angles, title, placement, blind).map(drop)
-}
-
-/// [`write_composite_png`], returning where it put things.
-fn composite_png(
     path: &Path,
     grid: &HeightGrid,
     composite: &[u16],
@@ -651,7 +635,7 @@ fn text_size(text: &str, pt: u32) -> Result<(usize, usize), PngError> {
 /// nothing is cut at the image's edge however small, narrow or flat the
 /// part and however long the words.
 #[derive(Debug, Clone, PartialEq)]
-struct Layout {
+pub struct Layout {
     /// Image width.
     width: usize,
     /// Image height.
@@ -981,8 +965,8 @@ mod tests {
         let mut composite = vec![0u16; g.spec.len()];
         composite[30 * 120 + 60] = 3;
         composite[10 * 120 + 20] = 61;
-        let depth = depth_png(&dir.join("depth.png"), &g, &Side::Left.into()).unwrap();
-        let comp = composite_png(
+        let depth = write_depth_png(&dir.join("depth.png"), &g, &Side::Left.into()).unwrap();
+        let comp = write_composite_png(
             &dir.join("composite.png"),
             &g,
             &composite,
@@ -1201,7 +1185,7 @@ mod tests {
         let g = grid(60, 60, |i, _| i as f64);
         for side in [Side::Left, Side::Right] {
             let path = dir.join("depth.png");
-            let layout = depth_png(&path, &g, &side.into()).unwrap();
+            let layout = write_depth_png(&path, &g, &side.into()).unwrap();
             let (w, h, pixels) = decode_png(&path);
             let bar = layout.chart_w..layout.chart_w + layout.bar_w;
             // The bar: the image's right strip; its brightest (closest)
@@ -1295,10 +1279,10 @@ mod tests {
             for (n, placement) in placements.iter().enumerate() {
                 let what = format!("{nx} x {nz}, placement {n}");
                 let path = dir.join("depth.png");
-                let layout = depth_png(&path, &g, placement).unwrap();
+                let layout = write_depth_png(&path, &g, placement).unwrap();
                 assert_inside(&path, &layout, &format!("depth {what}"));
                 let path = dir.join("composite.png");
-                let layout = composite_png(
+                let layout = write_composite_png(
                     &path,
                     &g,
                     &composite,
