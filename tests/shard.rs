@@ -850,19 +850,19 @@ fn a_bad_manifest_is_one_line() {
 
 /// Runs of adjacent starts (`--starts runs:N:L`): L starts one pitch apart
 /// on a row, from a chain block's first column, traced in chains; the
-/// summary names them; an empty, over-long or half-written run is refused
-/// in one line naming `--starts`.
+/// summary names them; an empty, over-long, half-written or unfitting run
+/// (or a strip off the part) is refused in one line naming `--starts`.
 #[test]
 fn runs_of_starts_are_chained_and_bad_runs_are_refused() {
     let dir = scratch_dir("verify-runs");
     let part = scenario("bump");
-    let verify = |starts: &str, out: &str| {
+    let verify_at = |pitch: &str, starts: &str, out: &str| {
         kneeform(&[
             "verify",
             part.as_str(),
             "--angles=-30,30",
             "--pitch",
-            "4",
+            pitch,
             "--tolerance",
             "1",
             "--starts",
@@ -871,7 +871,7 @@ fn runs_of_starts_are_chained_and_bad_runs_are_refused() {
             dir.join(out).to_str().unwrap(),
         ])
     };
-    let run = verify("runs:3:4", "runs");
+    let run = verify_at("4", "runs:3:4", "runs");
     assert!(
         matches!(run.status.code(), Some(0 | 1)),
         "{}",
@@ -901,12 +901,15 @@ fn runs_of_starts_are_chained_and_bad_runs_are_refused() {
             "{run:?}"
         );
     }
-    for (bad, says) in [
-        ("runs:0:4", "at least one start"),
-        ("runs:3:65", "1 to 64 starts"),
-        ("runs:3", "expected runs:N:L"),
+    for (pitch, bad, says) in [
+        ("4", "runs:0:4", "at least one start"),
+        ("4", "runs:3:65", "1 to 64 starts"),
+        ("4", "runs:3", "expected runs:N:L"),
+        // No row of the bump at 16 mm holds 64 placed starts.
+        ("16", "runs:3:64", "no 64 adjacent placed starts"),
+        ("4", "strip:5000:6000", "no placed start lies in the strip"),
     ] {
-        let out = verify(bad, "bad");
+        let out = verify_at(pitch, bad, "bad");
         assert_eq!(out.status.code(), Some(2), "{bad}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(

@@ -161,9 +161,10 @@ pub fn harness_error(err: HarnessError) -> anyhow::Error {
         HarnessError::Tolerance(_) => Some("--tolerance".into()),
         HarnessError::TieBand(_) => Some("--tie-band".into()),
         HarnessError::Pitches(_) => Some("--pitches".into()),
-        HarnessError::EmptySample | HarnessError::Strip(_) | HarnessError::RunLength { .. } => {
-            Some("--starts".into())
-        }
+        HarnessError::EmptySample
+        | HarnessError::Strip(_)
+        | HarnessError::RunLength { .. }
+        | HarnessError::NoneChosen(_) => Some("--starts".into()),
         HarnessError::DirectApproach => Some("--approach".into()),
         HarnessError::TooManyShards { .. } => Some("--shard".into()),
         _ => None,

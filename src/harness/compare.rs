@@ -61,9 +61,10 @@ pub enum StartSelection {
         z: [f64; 2],
     },
     /// A seeded random sample of `count` runs of `length` starts one pitch
-    /// apart along a row, each beginning at a chain block's first column
-    /// ([`CHAIN_BLOCK`]): small strips, whose exact traces are chained
-    /// (each run costs about one start traced alone).
+    /// apart along a row within one chain block ([`CHAIN_BLOCK`] lattice
+    /// columns), each beginning at the block's first start: small strips,
+    /// whose exact traces are chained (each run costs about one start
+    /// traced alone).
     Runs {
         /// How many runs.
         count: usize,
@@ -176,13 +177,19 @@ pub(super) fn choose_nodes(
             length,
             seed,
         } => {
-            // The runs' first nodes: at a block's first lattice column,
-            // followed on their row by `length - 1` nodes of `nodes`.
-            let block = CHAIN_BLOCK as i64;
+            // The runs' first nodes: each the first node of its chain
+            // block on its row (where a chain starts), followed on the row
+            // and in the block by `length - 1` nodes of `nodes`.
+            let block = |i: usize| (spec.i_origin + i as i64).div_euclid(CHAIN_BLOCK as i64);
             let mut heads: Vec<usize> = (0..nodes.len())
                 .filter(|&n| {
                     let (i, j) = nodes[n];
-                    (spec.i_origin + i as i64).rem_euclid(block) == 0
+                    let first = n == 0 || {
+                        let (pi, pj) = nodes[n - 1];
+                        pj != j || block(pi) != block(i)
+                    };
+                    first
+                        && block(i + length - 1) == block(i)
                         && (1..length).all(|k| nodes.get(n + k) == Some(&(i + k, j)))
                 })
                 .collect();
@@ -195,6 +202,21 @@ pub(super) fn choose_nodes(
         _ => {}
     }
     nodes
+}
+
+/// The error for a `selection` that chose no start: none is placed on the
+/// part, or none lies in the strip, or no run fits.
+pub(super) fn none_chosen(selection: &StartSelection) -> HarnessError {
+    match *selection {
+        StartSelection::Strip { z } => HarnessError::NoneChosen(format!(
+            "no placed start lies in the strip {} <= z <= {} mm",
+            z[0], z[1]
+        )),
+        StartSelection::Runs { length, .. } => HarnessError::NoneChosen(format!(
+            "no {length} adjacent placed starts lie in one chain block ({CHAIN_BLOCK} columns) of a row: ask for shorter runs"
+        )),
+        _ => HarnessError::NoStarts,
+    }
 }
 
 /// Keeps a seeded random sample of `count` of the indices `items` (all
@@ -1389,7 +1411,7 @@ mod tests {
     use crate::scenario::{axis, tessellate};
 
     /// Runs are whole: `length` nodes one pitch apart on a row, the first
-    /// at a chain block's first lattice column, none across a gap;
+    /// the first node of its chain block on the row, none across a gap;
     /// seeded, in row-major order, all of them where fewer exist than
     /// asked.
     #[test]
@@ -1423,16 +1445,37 @@ mod tests {
         assert!(picked.is_sorted_by_key(|&(i, j)| (j, i)));
         for run in picked.chunks(5) {
             let (i, j) = run[0];
-            assert_eq!((spec.i_origin + i as i64).rem_euclid(64), 0, "{run:?}");
+            let column = spec.i_origin + i as i64;
+            assert!(column.rem_euclid(64) == 0 || i == 0, "{run:?}");
             assert!(run.iter().zip(i..).all(|(&n, c)| n == (c, j)), "{run:?}");
             assert!(j <= 30 && !(j == 7 && i as i64 + spec.i_origin == 128));
         }
         assert_eq!(picked, runs(12, 5, 3), "seeded");
         assert_ne!(picked, runs(12, 5, 4));
         // Whole blocks: heads at lattice columns -64, 0, 64 and 128 (nodes
-        // 36, 100, 164, 228; the next, 192, ends past the grid): 4 a
-        // row, 31 rows, less row 7's last.
+        // 36, 100, 164, 228; the row's first node, column -100, has 36
+        // nodes left in its block and the last block 8): 4 a row, 31 rows,
+        // less row 7's last.
         assert_eq!(runs(1000, 64, 1).len(), (4 * 31 - 1) * 64);
+        // A part narrower than a block still has runs: from its rows'
+        // first nodes.
+        let narrow: Vec<(usize, usize)> = nodes
+            .iter()
+            .copied()
+            .filter(|&(i, _)| (3..40).contains(&i))
+            .collect();
+        let picked = choose_nodes(
+            &spec,
+            narrow,
+            &StartSelection::Runs {
+                count: 5,
+                length: 8,
+                seed: 1,
+            },
+        );
+        assert_eq!(picked.len(), 40);
+        // (Node 36 starts the next block, which holds 4 of them.)
+        assert!(picked.chunks(8).all(|run| run[0].0 == 3));
     }
 
     /// The refinement's finer grid holds only the rows the footprint

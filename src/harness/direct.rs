@@ -449,7 +449,7 @@ impl<'a> DirectMethod<'a> {
             }
         };
         if positions.is_empty() {
-            return Err(HarnessError::NoStarts);
+            return Err(super::compare::none_chosen(selection));
         }
         Ok(DirectMethod {
             input,

@@ -134,6 +134,9 @@ pub enum HarnessError {
     /// No start is placed on the part.
     #[error("no start is placed on this part: nothing to compare")]
     NoStarts,
+    /// The strip or the runs asked for hold no start.
+    #[error("{0}: nothing to compare")]
+    NoneChosen(String),
     /// A start given is not a node of the grid compared.
     #[error("start ({}, {}) mm is not a node of the {} mm grid: the pitches must nest", crate::limits::short(*x), crate::limits::short(*z), crate::limits::short(*pitch))]
     StartNotANode {

@@ -150,7 +150,7 @@ pub(super) fn start_positions(
         .map(|&(i, j)| [spec.x(i), spec.z(j)])
         .collect();
     if starts.is_empty() {
-        return Err(HarnessError::NoStarts);
+        return Err(super::compare::none_chosen(selection));
     }
     Ok(starts)
 }
