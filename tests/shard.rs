@@ -848,9 +848,9 @@ fn a_bad_manifest_is_one_line() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// Runs of adjacent starts (`--starts runs:N:L`): L starts one pitch apart
-/// on a row, from a chain block's first column, traced in chains; the
-/// summary names them; an empty, over-long, half-written or unfitting run
+/// Runs of adjacent starts (`--starts runs:N:L`, by default 20 runs of
+/// 5): L starts one pitch apart on a row, from a chain block's first
+/// start, traced in chains; the summary names them; an empty, over-long, half-written or unfitting run
 /// (or a strip off the part) is refused in one line naming `--starts`.
 #[test]
 fn runs_of_starts_are_chained_and_bad_runs_are_refused() {
@@ -901,6 +901,23 @@ fn runs_of_starts_are_chained_and_bad_runs_are_refused() {
             "{run:?}"
         );
     }
+    // The default: 20 runs of 5.
+    let default = kneeform(&[
+        "verify",
+        part.as_str(),
+        "--angles=0",
+        "--pitch",
+        "4",
+        "--tolerance",
+        "1",
+        "--out",
+        dir.join("default").to_str().unwrap(),
+    ]);
+    assert!(matches!(default.status.code(), Some(0 | 1)));
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("default/verify.json")).unwrap()).unwrap();
+    assert_eq!(summary["starts"], "runs:20:5");
+    assert_eq!(summary["counts"]["pairs"], 100);
     for (pitch, bad, says) in [
         ("4", "runs:0:4", "at least one start"),
         ("4", "runs:3:65", "1 to 64 starts"),

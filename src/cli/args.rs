@@ -364,16 +364,22 @@ pub struct ReportArgs {
 /// Which starts a comparison uses.
 #[derive(Debug, Args)]
 pub struct StartArgs {
-    /// Starts to compare: `all` (every node whose start is placed at some
-    /// angle), a number N for a seeded random sample of them,
-    /// `strip:Z0:Z1` for every placed start with Z0 <= z <= Z1 (mm): a
-    /// whole strip of start rows, whose area distance is the colliding
-    /// area a user sees there, or `runs:N:L` for N seeded runs of L
-    /// adjacent starts along a row (1 <= L <= 64): small strips, each
-    /// costing the oracle about one start (their traces are chained).
-    #[arg(long, default_value = "100", value_name = "all|N|strip:Z0:Z1|runs:N:L")]
+    /// Starts to compare: `runs:N:L` for N seeded runs of L adjacent
+    /// starts along a row (1 <= L <= 64; the default, 20 runs of 5: small
+    /// strips spread over the part, each costing the oracle about one
+    /// start, their traces chained), `strip:Z0:Z1` for every placed start
+    /// with Z0 <= z <= Z1 (mm): a whole strip of start rows, whose area
+    /// distance is the colliding area a user sees there, a number N for a
+    /// seeded random sample of N scattered starts (each traced on its own:
+    /// about 4x the oracle's time of the same number in runs), or `all`
+    /// (every node whose start is placed at some angle).
+    #[arg(
+        long,
+        default_value = "runs:20:5",
+        value_name = "runs:N:L|strip:Z0:Z1|N|all"
+    )]
     pub starts: String,
-    /// Seed of the start sample.
+    /// Seed of the start sample or of the runs.
     #[arg(long, default_value_t = 1, value_name = "S")]
     pub seed: u64,
     /// Growth of the tie band with the pitch (per mm): exact contacts whose
