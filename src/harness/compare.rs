@@ -61,14 +61,14 @@ pub enum StartSelection {
         z: [f64; 2],
     },
     /// A seeded random sample of `count` runs of `length` starts one pitch
-    /// apart along a row within one chain block ([`CHAIN_BLOCK`] lattice
+    /// apart along a row within one chain block (64 lattice
     /// columns), each beginning at the block's first start: small strips,
     /// whose exact traces are chained (each run costs about one start
     /// traced alone).
     Runs {
         /// How many runs.
         count: usize,
-        /// Starts per run (1 to [`CHAIN_BLOCK`]).
+        /// Starts per run (1 to 64, a chain block).
         length: usize,
         /// The seed.
         seed: u64,
