@@ -26,7 +26,10 @@ use crate::strike::StrikeRule;
 /// ([`kneeform_oracle::Chain`]): one start in 64 is traced whole, each
 /// other joins its -x neighbour's curve after a few casts of its own.
 pub(crate) const CHAIN_BLOCK: usize = 64;
-const _: () = assert!(CHAIN_BLOCK == 64, "`StartSelection::Runs` and `--starts` say 64");
+const _: () = assert!(
+    CHAIN_BLOCK == 64,
+    "`StartSelection::Runs` and `--starts` say 64"
+);
 
 /// How the exact traces of `selection`'s starts on the grid of pitch
 /// `pitch` share work: a strip (every placed start of whole rows) and
