@@ -428,7 +428,13 @@ fn verdict_first(k: usize, json: &Value, verdict: Verdict, blind_cells: usize) -
                 _ => "not every decided exact strike was found within ",
             }
             (c("/tolerance_mm")) " mm of the grid's colliding area at pitch " (c("/pitch_mm")) " mm ("
-            (c("/starts")) " starts x " (json.get("angles_deg").and_then(Value::as_array).map_or(0, Vec::len))
+            // A sample's size reads as a count; a strip or runs by name.
+            @if json.pointer("/starts").and_then(Value::as_str).is_some_and(|s| s.parse::<usize>().is_ok()) {
+                (c("/starts")) " starts x "
+            } @else {
+                "starts " (c("/starts")) " x "
+            }
+            (json.get("angles_deg").and_then(Value::as_array).map_or(0, Vec::len))
             " angles against the exact oracle; the largest distance from a decided exact strike to the grid's area: "
             (c("/metrics/area_miss_distance_decided/max")) " mm); "
             (c("/counts/exact_undecided")) " exact contacts undecided (either answer is right at this pitch); "
