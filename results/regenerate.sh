@@ -19,7 +19,7 @@
 #     bash results/regenerate.sh strip-console-20  # results/converge-strip/
 #                                           # console-20-rows/: every start of 20
 #                                           # console start rows, all 61 angles
-#                                           # at 1.24 mm (about 90 minutes)
+#                                           # at 1.24 mm (about 1.5 to 2 hours)
 #     bash results/regenerate.sh pitch      # results/pitch.md: the bundled console
 #                                           # at 0.5 mm (61 angles) and 0.25 mm
 #                                           # (3 angles), about 6 minutes
