@@ -228,7 +228,7 @@ fn slide(
         if k == front.len() && layers == all_layers {
             break;
         }
-        if k == front.len() || front[k].0 >= laid_up_to(layers) - FRONT_SLACK {
+        if k == front.len() || front[k].0 >= laid_up_to(layers) {
             layers = (2 * layers).min(all_layers);
             front = front_in_distance_order(&in_order, p, spec.nx, layers);
             continue;
