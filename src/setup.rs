@@ -68,7 +68,7 @@ impl Default for Setup {
             rule: StrikeRule::default(),
             grid: GridPlacement::AroundPart,
             algorithm: Algorithm::Fast,
-            max_memory_bytes: 16.0 * f64::from(1u32 << 30),
+            max_memory_bytes: 16.0 * GIB,
             blind_depth: Setup::DEFAULT_BLIND_DEPTH,
             approach: Approach::Slide,
         }

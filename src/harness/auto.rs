@@ -39,7 +39,7 @@ use crate::analysis::Progress;
 use crate::engine::AngleMask;
 use crate::grid::{GridSpec, HeightGrid};
 use crate::input::PartFile;
-use crate::setup::Setup;
+use crate::setup::{GIB, Setup};
 use crate::summary::{PitchChoice, PitchStudyRow};
 
 /// How to choose the pitch.
@@ -166,9 +166,9 @@ pub fn choose_pitch(
                 tolerance: auto.tolerance,
                 pitch: p,
                 predicted_s: predicted_here,
-                memory_gib: need / f64::from(1u32 << 30),
+                memory_gib: need / GIB,
                 budget_s: auto.budget_s,
-                max_memory_gib: setup.max_memory_bytes / f64::from(1u32 << 30),
+                max_memory_gib: setup.max_memory_bytes / GIB,
                 studied: studied(&rows),
             });
         }
@@ -198,7 +198,7 @@ pub fn choose_pitch(
                 .as_ref()
                 .and_then(|prev| area_change(prev, &struck)),
             predicted_s: seconds * scale,
-            memory_gib: need / f64::from(1u32 << 30),
+            memory_gib: need / GIB,
             meets: finite && decided <= auto.tolerance,
         };
         rows.push(row);

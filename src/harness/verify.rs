@@ -19,6 +19,7 @@ use crate::grid::{GridSpec, HeightGrid};
 use crate::input::PartFile;
 use crate::kneeform::{GridFootprint, KneeForm};
 use crate::mesh::Triangle;
+use crate::setup::GIB;
 use crate::setup::Setup;
 
 /// How to verify, beside the analysis [`Setup`].
@@ -246,10 +247,9 @@ pub(super) fn run_oracle(
                 None => memory.bytes,
             };
             if need > limit {
-                let gib = f64::from(1u32 << 30);
                 return Err(HarnessError::StudyMemory {
-                    need_gib: need / gib,
-                    limit_gib: limit / gib,
+                    need_gib: need / GIB,
+                    limit_gib: limit / GIB,
                     pairs,
                     shards: ((need / limit).ceil() as usize).clamp(2, starts.len().max(2)),
                 });
