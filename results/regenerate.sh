@@ -20,6 +20,8 @@
 #                                           # console-20-rows/: every start of 20
 #                                           # console start rows, all 61 angles
 #                                           # at 1.24 mm (about 1.5 to 2 hours)
+#     bash results/regenerate.sh strip-console-20-table  # its README's table
+#                                           # alone, from the angles' verify.json
 #     bash results/regenerate.sh pitch      # results/pitch.md: the bundled console
 #                                           # at 0.5 mm (61 angles) and 0.25 mm
 #                                           # (3 angles), about 6 minutes
@@ -95,6 +97,45 @@ if [[ "$what" == strip-console-20 ]]; then
     "$bin" verify scenarios/console_side.stl --starts strip:288.5:312.6 \
       --angles="$angle" --out "$out/angle_$angle" || [[ $? == 1 ]]
   done
+fi
+
+if [[ "$what" == strip-console-20 || "$what" == strip-console-20-table ]]; then
+  # The table of console-20-rows/README.md, one row per angle, from each
+  # angle's verify.json: written in place of the README's table (the
+  # lines from its header row to the 30 degrees row).
+  python3 - results/converge-strip/console-20-rows <<'PY'
+import json, os, sys
+out = sys.argv[1]
+
+def named(d, metric, value):
+    """The mechanism verify.json names for `metric` at `value`, or ''."""
+    for f in d["failures"]:
+        if f["metric"] == metric and abs(f["value"] - value) < 1e-9:
+            return f" ({f['mechanism']})"
+    return ""
+
+rows = ["| angle (deg) | verdict | decided area miss (mm) | decided area false alarm (mm) "
+        "| decided miss per start (max, p95; mm) | oracle (s) | comparison (s) |",
+        "| --- | --- | --- | --- | --- | --- | --- |"]
+for angle in range(-30, 31):
+    d = json.load(open(os.path.join(out, f"angle_{angle}", "verify.json")))
+    m, t = d["metrics"], d["timings"]
+    am = m["area_miss_distance_decided"]["max"]
+    af = m["area_false_alarm_distance_decided"]["max"]
+    pm = m["miss_distance_decided"]
+    rows.append(
+        f"| {angle} | {'PASS' if d['pass'] else 'FAIL'} "
+        f"| {am:.3f}{named(d, 'area_miss_distance_decided', am)} "
+        f"| {af:.3f}{named(d, 'area_false_alarm_distance_decided', af)} "
+        f"| {pm['max']:.3f}{named(d, 'miss_distance_decided', pm['max'])}, {pm['p95']:.3f} "
+        f"| {t['oracle_s']:.1f} | {t['grid_s']:.1f} |")
+readme = os.path.join(out, "README.md")
+lines = open(readme).read().split("\n")
+first = next(n for n, l in enumerate(lines) if l.startswith("| angle (deg) |"))
+last = next(n for n, l in enumerate(lines) if l.startswith("| 30 |"))
+lines[first:last + 1] = rows
+open(readme, "w").write("\n".join(lines))
+PY
 fi
 
 if [[ "$what" == all || "$what" == bench ]]; then

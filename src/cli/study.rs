@@ -167,7 +167,7 @@ fn print_verification(result: &Verification, out: &Path) -> ExitCode {
                     if s.unexplained.miss_brief >= w.value - 1e-9 {
                         "; a strike lasting less than sqrt 2 pitches of travel before the knee-form touches elsewhere (brief): the grid meets its nodes after it; a pitch finer than the touch resolves it".to_string()
                     } else {
-                        "; it falls to half or less with the grid sampled at half the pitch against the same exact trace (first order), as where the exact knee-form strikes along a crease of the part between node rows that the grid's strikes meet later; a finer pitch resolves it".to_string()
+                        "; it falls with the pitch against the same exact trace (to half or less at half the pitch, or to a quarter or less at a quarter: first order), as where the exact knee-form strikes along a crease of the part between node rows that the grid's strikes meet later; a finer pitch resolves it".to_string()
                     }
                 }
                 _ => resolving_pitch(s.pitch_mm, s.tolerance_mm, &w.metric, w.value),

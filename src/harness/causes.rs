@@ -29,8 +29,9 @@
 //! * **Sampling.** An unexplained residual within `sqrt 2` pitches: the
 //!   grid's first-order error at this pitch; or a start's miss inside the
 //!   footprint beyond that which, slid again with the grid sampled at half
-//!   the pitch against the same exact trace, falls to at most half
-//!   (shown by refinement: on trimesh's teapot and the console, exact
+//!   the pitch against the same exact trace, falls to at most half, or,
+//!   where it falls but not to half, at a quarter of the pitch to at most
+//!   a quarter (shown by refinement: on trimesh's teapot and the console, exact
 //!   strikes along a crease of the mesh between two node rows, which the
 //!   grid's strikes meet later); or a brief strike, lasting less than
 //!   `sqrt 2` pitches of travel before the knee-form touches elsewhere,
@@ -305,9 +306,9 @@ pub enum Mechanism {
     /// A residual no mechanism above explains, within `sqrt 2` pitches:
     /// the size of error the grid makes at this pitch, which a finer pitch
     /// shrinks where the figure converges (`results/`); beyond it, a
-    /// start's miss that halves at half the pitch against the same exact
-    /// trace (`StartComparison::halves`), or a brief
-    /// strike. It fails the verdict: the pitch is too coarse for the
+    /// start's miss that falls with the pitch against the same exact
+    /// trace (to half at half the pitch, or to a quarter at a quarter:
+    /// `StartComparison::falls_with_the_pitch`), or a brief strike. It fails the verdict: the pitch is too coarse for the
     /// tolerance.
     Sampling,
     /// A real disagreement.

@@ -326,6 +326,11 @@ pub struct VerifyRow {
     /// names the miss `sampling`.
     #[serde(default)]
     pub miss_distance_half_pitch: Option<f64>,
+    /// Where that falls, but not to half: the same at a quarter of the
+    /// pitch (mm; empty otherwise). At most a quarter of the miss names
+    /// it `sampling`.
+    #[serde(default)]
+    pub miss_distance_quarter_pitch: Option<f64>,
     /// Why the oracle failed on this pair (`oracle_failed` rows).
     #[serde(default)]
     pub oracle_failure: Option<String>,
@@ -405,7 +410,7 @@ pub struct AreaDistance {
     #[serde(default)]
     pub miss_inside: f64,
     /// `miss_decided` from the decided exact strikes inside the footprint
-    /// of starts whose miss halves at half the pitch (sampling).
+    /// of starts whose miss falls with the pitch (sampling).
     #[serde(default)]
     pub miss_refined: f64,
     /// `miss` from decided exact strikes downstream of a blind spot.
@@ -464,7 +469,7 @@ pub struct Unexplained {
     pub unmatched_grid: usize,
     /// `miss_distance_decided` over the exact strikes inside the grid's
     /// footprint (not in the knee-form's rim), not brief, of starts whose
-    /// miss does not halve at half the pitch (`null` when infinite).
+    /// miss does not fall with the pitch (`null` when infinite).
     #[serde(default, with = "crate::harness::compare::infinite_as_null")]
     pub miss_distance: f64,
     /// `area_miss_distance_decided` from those strikes.
@@ -491,7 +496,8 @@ pub struct Unexplained {
     #[serde(default)]
     pub miss_brief: f64,
     /// The largest one inside the footprint, not brief, of a start whose
-    /// inside miss halves at half the pitch ([`StartComparison::halves`]):
+    /// inside miss falls with the pitch
+    /// ([`StartComparison::falls_with_the_pitch`]):
     /// sampling, shown by refinement.
     #[serde(default)]
     pub miss_refined: f64,
@@ -609,6 +615,7 @@ pub(crate) fn row_of(
         ),
         level_error_clearance: worst(&cmp.level_clearance),
         miss_distance_half_pitch: cmp.miss_half_pitch.filter(|v| v.is_finite()),
+        miss_distance_quarter_pitch: cmp.miss_quarter_pitch.filter(|v| v.is_finite()),
         oracle_failure: cmp.oracle_failure.map(|r| r.to_string()),
     }
 }
@@ -709,30 +716,37 @@ pub(crate) fn pair_results(
             }
         }
     }
-    let bands = HalfPitchBands::new(triangles, options.blind_depth);
+    let bands = FinerBands::new(triangles, options.blind_depth);
     let one = |(a, s): (usize, usize), g: &GridTrace| {
         let (i, j) = nodes[s];
         let fp = &footprints[a];
         let trace = &traces[a * nodes.len() + s];
         let mut cmp = compare(g, trace, &band, ExactRule::of(&options.rule), cells);
         // An inside miss beyond the pitch's sampling error is tested
-        // by refinement; one that halves is set apart as sampling.
+        // by refinement; one that falls with the pitch is set apart as
+        // sampling. Where the first halving falls, but not to half, a
+        // second one shows whether it falls to a quarter.
         let reach = super::causes::RISE_REACH * spec.pitch;
-        if trace.status == StartStatus::Placed
-            && cmp
-                .inside_miss()
-                .is_some_and(|d| d.is_finite() && d > reach)
-        {
-            cmp.miss_half_pitch = Some(inside_miss_at_half_pitch(
-                &bands,
-                grid,
-                fp.angle_deg,
-                (i, j),
-                trace,
-                options,
-                fault,
-            ));
-            if cmp.halves() {
+        let inside = cmp.inside_miss().filter(|d| d.is_finite() && *d > reach);
+        if let Some(d) = inside.filter(|_| trace.status == StartStatus::Placed) {
+            let refined = |halvings| {
+                inside_miss_refined(
+                    &bands,
+                    grid,
+                    fp.angle_deg,
+                    (i, j),
+                    trace,
+                    options,
+                    fault,
+                    halvings,
+                )
+            };
+            let half = refined(1);
+            cmp.miss_half_pitch = Some(half);
+            if half < d && !cmp.falls_with_the_pitch() {
+                cmp.miss_quarter_pitch = Some(refined(2));
+            }
+            if cmp.falls_with_the_pitch() {
                 cmp.points.decided_refined = std::mem::take(&mut cmp.points.decided_inside);
             }
         }
@@ -788,30 +802,27 @@ const JOINED_RUN: usize = 64;
 /// The largest decided miss inside the footprint
 /// ([`StartComparison::inside_miss`]) of the start at node `(i, j)` of
 /// `grid` (sampled from `triangles`) and `angle_deg`, with the grid
-/// sampled at half its pitch, against the same exact `trace` (mm; `+inf`
-/// where the finer grid strikes nothing in the start, 0 where it misses
-/// nothing). The finer grid holds the nodes of `grid` (its origin's
-/// indices doubled) and only the rows the footprint covers from the start:
-/// the slide of this start sees the same nodes as on the whole finer grid.
-fn inside_miss_at_half_pitch(
-    bands: &HalfPitchBands,
+/// sampled at its pitch halved `halvings` times (1 or 2), against the
+/// same exact `trace` (mm; `+inf` where the finer grid strikes nothing in
+/// the start, 0 where it misses nothing). The finer grid holds the nodes
+/// of `grid` (its origin's indices multiplied) and only the rows the
+/// footprint covers from the start: the slide of this start sees the same
+/// nodes as on the whole finer grid.
+#[allow(clippy::too_many_arguments)]
+fn inside_miss_refined(
+    bands: &FinerBands,
     grid: &HeightGrid,
     angle_deg: f64,
     (i, j): (usize, usize),
     trace: &StartTrace,
     options: &CompareOptions,
     fault: Option<Fault>,
+    halvings: u32,
 ) -> f64 {
-    let spec = grid.spec;
-    let whole = GridSpec {
-        pitch: spec.pitch / 2.0,
-        i_origin: 2 * spec.i_origin,
-        j_origin: 2 * spec.j_origin,
-        nx: 2 * spec.nx - 1,
-        nz: 2 * spec.nz - 1,
-    };
+    let whole = finer(grid.spec, halvings);
+    let k = 1usize << halvings;
     let fp = GridFootprint::new(&options.knee, angle_deg, &whole);
-    let j2 = 2 * j as i64;
+    let j2 = (k * j) as i64;
     let (lo, hi) = fp.rows.iter().fold((j2, j2), |(lo, hi), r| {
         (lo.min(j2 + i64::from(r.dj)), hi.max(j2 + i64::from(r.dj)))
     });
@@ -821,26 +832,39 @@ fn inside_miss_at_half_pitch(
         nz: (hi - lo + 1) as usize,
         ..whole
     };
-    let sampled = bands.get((angle_deg.to_bits(), lo, hi), band);
+    let sampled = bands.get((angle_deg.to_bits(), halvings, lo, hi), band);
     let (fine, cells) = sampled.get().expect("the band is made");
-    let g = grid_trace(fine, &fp, 2 * i, (j2 - lo) as usize, &options.rule, fault);
+    let g = grid_trace(fine, &fp, k * i, (j2 - lo) as usize, &options.rule, fault);
     let ties = TieBand::new(options.rule.sigma, band.pitch, options.tie_band_per_mm);
     compare(&g, trace, &ties, ExactRule::of(&options.rule), cells)
         .inside_miss()
         .unwrap_or(0.0)
 }
 
-/// A band of the half-pitch grid: the angle (its bits) and the band's
-/// first and last rows.
-type BandKey = (u64, i64, i64);
+/// The grid `spec` with its pitch halved `halvings` times: its nodes and
+/// those between them, over the same extent.
+fn finer(spec: GridSpec, halvings: u32) -> GridSpec {
+    let k = 1usize << halvings;
+    GridSpec {
+        pitch: spec.pitch / k as f64,
+        i_origin: k as i64 * spec.i_origin,
+        j_origin: k as i64 * spec.j_origin,
+        nx: k * (spec.nx - 1) + 1,
+        nz: k * (spec.nz - 1) + 1,
+    }
+}
 
-/// The half-pitch bands [`inside_miss_at_half_pitch`] sampled last, with
+/// A band of a finer grid: the angle (its bits), how many times the pitch
+/// is halved, and the band's first and last rows.
+type BandKey = (u64, u32, i64, i64);
+
+/// The bands of the finer grids [`inside_miss_refined`] sampled last, with
 /// their cells: every start of one start row at one angle needs the same
 /// band (a strip's row measured them again for each of its 1,467 starts),
 /// and a band's heights and cells depend on its key alone, so a kept one
 /// is the one sampling would give. At most [`KEPT_BANDS`] are kept, the
 /// most recent first: pairs come angle by angle, start row by start row.
-struct HalfPitchBands<'a> {
+struct FinerBands<'a> {
     /// The part the bands are sampled from.
     triangles: &'a [Triangle],
     /// The blind-spot threshold of their cells (mm).
@@ -848,16 +872,17 @@ struct HalfPitchBands<'a> {
     recent: Mutex<Vec<(BandKey, Band)>>,
 }
 
-/// A half-pitch band, sampled once: its heights and its cells.
+/// A finer band, sampled once: its heights and its cells.
 type Band = Arc<OnceLock<(HeightGrid, Cells)>>;
 
-/// How many half-pitch bands are kept (each about 20 bytes per node of a
-/// band as wide as the grid).
+/// How many finer bands are kept (each about 20 bytes per node of a band
+/// as wide as the grid: at a quarter of the pitch, 16 times a band of the
+/// grid's own).
 const KEPT_BANDS: usize = 4;
 
-impl<'a> HalfPitchBands<'a> {
-    fn new(triangles: &'a [Triangle], blind_depth: f64) -> HalfPitchBands<'a> {
-        HalfPitchBands {
+impl<'a> FinerBands<'a> {
+    fn new(triangles: &'a [Triangle], blind_depth: f64) -> FinerBands<'a> {
+        FinerBands {
             triangles,
             blind_depth,
             recent: Mutex::new(Vec::new()),
@@ -979,9 +1004,9 @@ pub(crate) fn assemble(
         let unmatched_exact = push("miss_distance", &cmp.miss);
         let unmatched_exact_decided = push("miss_distance_decided", &cmp.miss_decided);
         push("miss_distance_blind", &cmp.miss_blind);
-        // Whether this start's inside miss halves: once per start, not
-        // per strike (it reads every strike of the start).
-        let halves = cmp.halves();
+        // Whether this start's inside miss falls with the pitch: once per
+        // start, not per strike (it reads every strike of the start).
+        let falls = cmp.falls_with_the_pitch();
         for ((&d, &rim), &brief) in cmp
             .miss_decided
             .iter()
@@ -994,12 +1019,12 @@ pub(crate) fn assemble(
                 continue;
             }
             // Inside the footprint and not brief, sampling is shown by
-            // refinement: a start's miss that halves at half the pitch.
+            // refinement: a start's miss that falls with the pitch.
             if rim {
                 unexplained.miss_rim = unexplained.miss_rim.max(d);
             } else if brief {
                 unexplained.miss_brief = unexplained.miss_brief.max(d);
-            } else if halves {
+            } else if falls {
                 unexplained.miss_refined = unexplained.miss_refined.max(d);
             } else {
                 unexplained.miss_distance = unexplained.miss_distance.max(d);
@@ -1485,9 +1510,10 @@ mod tests {
     /// The refinement's finer grid holds only the rows the footprint
     /// covers from the start: on a part with creases between node rows
     /// (a 5 mm lattice, rows 2 mm apart), each start's inside miss at half
-    /// the pitch is bit for bit the one the whole finer grid gives.
+    /// and at a quarter of the pitch is bit for bit the one the whole
+    /// finer grid gives.
     #[test]
-    fn the_half_pitch_band_gives_the_whole_finer_grid_s_answer() {
+    fn a_finer_band_gives_the_whole_finer_grid_s_answer() {
         let (xs, zs) = (
             axis((-160.0, 160.0), 5.0, &[]),
             axis((-110.0, 110.0), 5.0, &[]),
@@ -1503,16 +1529,6 @@ mod tests {
             tie_band_per_mm: TieBand::DEFAULT_PER_MM,
             blind_depth: 0.5,
         };
-        let whole = GridSpec {
-            pitch: 1.0,
-            i_origin: 2 * grid.spec.i_origin,
-            j_origin: 2 * grid.spec.j_origin,
-            nx: 2 * grid.spec.nx - 1,
-            nz: 2 * grid.spec.nz - 1,
-        };
-        let fine = HeightGrid::sample(&tris, whole);
-        let cells = Cells::of(&tris, &fine, options.blind_depth);
-        let ties = TieBand::new(options.rule.sigma, 1.0, options.tie_band_per_mm);
         let nodes = [(120, 50), (100, 30), (140, 70), (90, 55)];
         let starts: Vec<[f64; 2]> = nodes
             .iter()
@@ -1521,40 +1537,62 @@ mod tests {
         let angles = [-20.0, 10.0];
         let oracle = oracle_options(&options.knee, 1.0, grid.spec.x(0));
         let traces = exact_traces(&tris, &starts, &angles, &oracle).unwrap();
-        let mut struck = 0;
-        let bands = HalfPitchBands::new(&tris, options.blind_depth);
-        for (a, &angle) in angles.iter().enumerate() {
-            let fp = GridFootprint::new(&options.knee, angle, &whole);
-            for (s, &(i, j)) in nodes.iter().enumerate() {
-                let trace = &traces[a * nodes.len() + s];
-                let g = grid_trace(&fine, &fp, 2 * i, 2 * j, &options.rule, None);
-                struck += usize::from(!g.colliding.is_empty());
-                let expected = compare(&g, trace, &ties, ExactRule::of(&options.rule), &cells)
-                    .inside_miss()
-                    .unwrap_or(0.0);
-                // The bands kept across starts and angles, as the pairs
-                // use them.
-                let banded =
-                    inside_miss_at_half_pitch(&bands, &grid, angle, (i, j), trace, &options, None);
-                assert_eq!(banded.to_bits(), expected.to_bits(), "{angle} {i} {j}");
+        // The bands kept across starts, angles and pitches, as the pairs
+        // use them.
+        let bands = FinerBands::new(&tris, options.blind_depth);
+        for halvings in [1, 2] {
+            let whole = finer(grid.spec, halvings);
+            assert_eq!(whole.x(whole.nx - 1), grid.spec.x(grid.spec.nx - 1));
+            let k = 1 << halvings;
+            let fine = HeightGrid::sample(&tris, whole);
+            let cells = Cells::of(&tris, &fine, options.blind_depth);
+            let ties = TieBand::new(options.rule.sigma, whole.pitch, options.tie_band_per_mm);
+            let mut struck = 0;
+            for (a, &angle) in angles.iter().enumerate() {
+                let fp = GridFootprint::new(&options.knee, angle, &whole);
+                for (s, &(i, j)) in nodes.iter().enumerate() {
+                    let trace = &traces[a * nodes.len() + s];
+                    let g = grid_trace(&fine, &fp, k * i, k * j, &options.rule, None);
+                    struck += usize::from(!g.colliding.is_empty());
+                    let expected = compare(&g, trace, &ties, ExactRule::of(&options.rule), &cells)
+                        .inside_miss()
+                        .unwrap_or(0.0);
+                    let banded = inside_miss_refined(
+                        &bands,
+                        &grid,
+                        angle,
+                        (i, j),
+                        trace,
+                        &options,
+                        None,
+                        halvings,
+                    );
+                    assert_eq!(
+                        banded.to_bits(),
+                        expected.to_bits(),
+                        "{halvings} {angle} {i} {j}"
+                    );
+                }
             }
+            assert!(struck >= 4, "the finer grid strikes in {struck} pairs");
         }
-        assert!(struck >= 4, "the finer grid strikes in {struck} pairs");
     }
 
     /// A start whose inside miss (3 mm at a 1 mm pitch, beyond `sqrt 2`
-    /// pitches) falls to at most half at half the pitch is named
-    /// sampling, shown by refinement, in the per-start and the area
-    /// figures; one that does not halve stays unexplained, unless brief.
+    /// pitches) falls to at most half at half the pitch, or to at most a
+    /// quarter at a quarter, is named sampling, shown by refinement, in
+    /// the per-start and the area figures; one that falls by less stays
+    /// unexplained, unless brief.
     #[test]
-    fn an_inside_miss_that_halves_at_half_the_pitch_is_sampling() {
-        let verdict = |half: f64, brief: bool| {
+    fn an_inside_miss_that_falls_with_the_pitch_is_sampling() {
+        let verdict = |(half, quarter): (f64, Option<f64>), brief: bool| {
             let mut cmp = StartComparison {
                 miss: vec![3.0],
                 miss_decided: vec![3.0],
                 miss_rim: vec![false],
                 miss_brief: vec![brief],
                 miss_half_pitch: Some(half),
+                miss_quarter_pitch: quarter,
                 exact_strikes: 1,
                 ..StartComparison::default()
             };
@@ -1566,7 +1604,7 @@ mod tests {
             if !brief {
                 cmp.points.decided_inside = vec![[3.0, 0.0]];
             }
-            if cmp.halves() {
+            if cmp.falls_with_the_pitch() {
                 cmp.points.decided_refined = std::mem::take(&mut cmp.points.decided_inside);
             }
             let pair = PairResult {
@@ -1582,27 +1620,34 @@ mod tests {
                 .map(|f| (f.metric, f.mechanism))
                 .collect::<Vec<_>>()
         };
-        let sampling = verdict(1.5, false);
-        assert_eq!(
-            sampling,
-            [
-                ("miss_distance_decided".to_string(), Mechanism::Sampling),
-                (
-                    "area_miss_distance_decided".to_string(),
-                    Mechanism::Sampling
-                ),
-            ]
-        );
-        for half in [1.6, f64::INFINITY] {
-            let v = verdict(half, false);
-            assert!(
-                v.len() == 2 && v.iter().all(|(_, m)| *m == Mechanism::Unexplained),
-                "{half}: {v:?}"
+        for refined in [(1.5, None), (1.6, Some(0.75)), (1.5, Some(3.0))] {
+            assert_eq!(
+                verdict(refined, false),
+                [
+                    ("miss_distance_decided".to_string(), Mechanism::Sampling),
+                    (
+                        "area_miss_distance_decided".to_string(),
+                        Mechanism::Sampling
+                    ),
+                ],
+                "{refined:?}"
             );
         }
-        // A brief strike is sampling by the brief rule, halving or not: its
+        for refined in [
+            (1.6, None),
+            (1.6, Some(0.8)),
+            (f64::INFINITY, None),
+            (1.6, Some(f64::INFINITY)),
+        ] {
+            let v = verdict(refined, false);
+            assert!(
+                v.len() == 2 && v.iter().all(|(_, m)| *m == Mechanism::Unexplained),
+                "{refined:?}: {v:?}"
+            );
+        }
+        // A brief strike is sampling by the brief rule, falling or not: its
         // miss falls once the pitch is finer than the touch.
-        let brief = verdict(f64::INFINITY, true);
+        let brief = verdict((f64::INFINITY, None), true);
         assert!(
             brief.len() == 2 && brief.iter().all(|(_, m)| *m == Mechanism::Sampling),
             "{brief:?}"

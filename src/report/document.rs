@@ -455,7 +455,7 @@ fn verdict_first(k: usize, json: &Value, verdict: Verdict, blind_cells: usize) -
                     " mm at " (c("/worst_starts/0/angle_deg")) " degrees, "
                     code { (c("/worst_starts/0/metric")) } " = " (c("/worst_starts/0/value")) " mm"
                 }
-                ". Mechanisms: sampling (the grid's error at this pitch: a miss that halves at half the pitch, or a touch briefer than the pitch; a finer pitch resolves it), rim, oracle-failure, unexplained (README, \"When verify fails\")."
+                ". Mechanisms: sampling (the grid's error at this pitch: a miss that falls to half at half the pitch or to a quarter at a quarter, or a touch briefer than the pitch; a finer pitch resolves it), rim, oracle-failure, unexplained (README, \"When verify fails\")."
             }
             "\n"
         }

@@ -70,6 +70,7 @@ pub(super) fn put_pair(out: &mut Vec<u8>, pair: &PairResult) {
         c.first_contact_error_blind,
         c.first_contact_late_inside,
         c.miss_half_pitch,
+        c.miss_quarter_pitch,
     ] {
         put_opt(out, v);
     }
@@ -292,7 +293,7 @@ impl<'a> Reader<'a> {
             (self.opt()?, self.opt()?, self.opt()?);
         let first_contact_error_blind = self.opt()?;
         let first_contact_late_inside = self.opt()?;
-        let miss_half_pitch = self.opt()?;
+        let (miss_half_pitch, miss_quarter_pitch) = (self.opt()?, self.opt()?);
         let flags = self.u8()?;
         if flags >> 4 != 0 {
             return Err(format!("pair flags {flags}"));
@@ -330,6 +331,7 @@ impl<'a> Reader<'a> {
             miss_rim: self.bools()?,
             miss_brief: self.bools()?,
             miss_half_pitch,
+            miss_quarter_pitch,
             oracle_failure,
             exact_strikes: self.len()?,
             undecided: self.len()?,
@@ -368,6 +370,7 @@ mod tests {
             miss_rim: vec![true],
             miss_brief: vec![false],
             miss_half_pitch: Some(0.25),
+            miss_quarter_pitch: Some(f64::INFINITY),
             miss_blind: vec![0.5],
             false_alarm: vec![0.1 + 0.2, 7.0],
             false_alarm_decided: vec![0.3],

@@ -44,8 +44,9 @@ use crate::output::{OutputDir, WriteError};
 /// `shard.json` of a study's shard.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StudyRecord {
-    /// The format of the shard's files (`FORMAT`; 4: pairs carry their
-    /// miss at half the pitch and the points it sets apart).
+    /// The format of the shard's files (`FORMAT`; 5: pairs carry their
+    /// miss at half and at a quarter of the pitch and the points they set
+    /// apart).
     pub format: u32,
     /// Which shard of how many.
     pub shard: Shard,
@@ -72,9 +73,9 @@ pub struct StudyRecord {
 }
 
 /// The format [`write_study_shard`] writes and [`merge_study`] reads.
-pub(crate) const FORMAT: u32 = 4;
+pub(crate) const FORMAT: u32 = 5;
 
-const MAGIC: &[u8; 16] = b"kneeform study 4";
+const MAGIC: &[u8; 16] = b"kneeform study 5";
 
 /// The largest `shard.bin` read (bytes): far beyond a study's (a few
 /// hundred bytes per start and angle), short of exhausting memory.
