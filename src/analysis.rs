@@ -22,6 +22,7 @@ use crate::grid::{GridError, HeightGrid};
 use crate::input::{MeshError, PartFile};
 use crate::kneeform::{GridFootprint, KneeForm};
 use crate::memory::MemoryEstimate;
+use crate::partition::Shard;
 use crate::sanity::{self, Warning};
 use crate::setup::{GIB, Limit, Setup, SetupError, check_estimate};
 use crate::summary::{AngleSummary, FileSummary, Summary, Timings};
@@ -112,7 +113,11 @@ pub struct Analysis {
     /// (into the assembly's files) of the file whose surface set its
     /// height, the lowest index on a tie; `None` for one file.
     pub node_file: Option<Vec<u32>>,
-    /// The colliding mask per angle, in the order of `setup.angles`.
+    /// The share of `setup.angles` whose push and slide this analysis
+    /// computed: [`Shard::WHOLE`], or one shard's ([`crate::shard`]).
+    pub angles: Shard,
+    /// The colliding mask per angle, in the order of `setup.angles`
+    /// (empty at the angles outside `angles`).
     pub masks: Vec<AngleMask>,
     /// Per node, the number of angles at which it collides.
     pub composite: Vec<u16>,
@@ -152,19 +157,20 @@ impl Analysis {
         setup: &Setup,
         progress: &dyn Progress,
     ) -> Result<Analysis, AnalysisError> {
-        Analysis::of_source_at(source, setup, None, progress)
+        Analysis::of_source_at(source, setup, Shard::WHOLE, progress)
     }
 
     /// As [`Analysis::of_source`], with push and slide computed only at
-    /// the angles `only` (indices into `setup.angles`) when given: a shard
-    /// of the run ([`crate::shard`]). The other angles' masks are empty
-    /// (no node, no placed start, no blind spot met); all else (the grid,
-    /// the blind spots, the memory estimate, the warnings about the part
-    /// and the angles) is the whole run's.
+    /// the share `angles` of `setup.angles` ([`Shard::indices`];
+    /// [`Shard::WHOLE`]: all), a shard of the run ([`crate::shard`]). The
+    /// other angles' masks are empty (no node, no placed start, no blind
+    /// spot met); all else (the grid, the blind spots, the memory
+    /// estimate, the warnings about the part and the angles) is the whole
+    /// run's.
     pub fn of_source_at(
         source: &PartSource,
         setup: &Setup,
-        only: Option<&[usize]>,
+        angles: Shard,
         progress: &dyn Progress,
     ) -> Result<Analysis, AnalysisError> {
         setup.validate()?;
@@ -213,7 +219,7 @@ impl Analysis {
             crate::input::binary_stl_len(n)
         };
         let read = MemoryEstimate::reading(read_bytes, n);
-        let mut analysis = Analysis::run_checked(input, setup, only, progress, angle_warnings)?;
+        let mut analysis = Analysis::run_checked(input, setup, angles, progress, angle_warnings)?;
         analysis.timings.read_s = read_s;
         if read.bytes() > analysis.memory.bytes() {
             analysis.memory = read;
@@ -233,13 +239,13 @@ impl Analysis {
         for w in &angle_warnings {
             progress.warn(w);
         }
-        Analysis::run_checked(input, setup, None, progress, angle_warnings)
+        Analysis::run_checked(input, setup, Shard::WHOLE, progress, angle_warnings)
     }
 
     fn run_checked(
         mut input: PartFile,
         setup: &Setup,
-        only: Option<&[usize]>,
+        angles: Shard,
         progress: &dyn Progress,
         mut warnings: Vec<Warning>,
     ) -> Result<Analysis, AnalysisError> {
@@ -307,9 +313,8 @@ impl Analysis {
                 y: b.y,
             })
             .collect();
-        // A shard computes its own angles (`only`); the others are empty.
-        let all: Vec<usize> = (0..setup.angles.len()).collect();
-        let chosen = only.unwrap_or(&all);
+        // A shard computes its own angles; the others are empty.
+        let chosen = angles.indices(setup.angles.len());
         let step = || progress.step();
         let found = match setup.approach {
             Approach::Slide => {
@@ -320,14 +325,14 @@ impl Analysis {
                     start_rows: None,
                     probes,
                 };
-                match only {
-                    None => colliding_masks(&grid, &footprints, &options, &step),
-                    Some(only) => {
-                        let mine: Vec<GridFootprint> =
-                            only.iter().map(|&a| footprints[a].clone()).collect();
-                        colliding_masks(&grid, &mine, &options, &step)
-                    }
-                }
+                let mine: Vec<GridFootprint>;
+                let footprints = if angles.is_whole() {
+                    &footprints[..]
+                } else {
+                    mine = chosen.iter().map(|&a| footprints[a].clone()).collect();
+                    &mine[..]
+                };
+                colliding_masks(&grid, footprints, &options, &step)
             }
             Approach::Direct => {
                 progress.begin("direct approach", Some(chosen.len() as u64));
@@ -338,25 +343,19 @@ impl Analysis {
                 direct_masks(&grid, &fronts, setup.rule.e0, &probes, &step)
             }
         };
-        let masks = if only.is_none() {
-            found
-        } else {
-            let mut masks: Vec<AngleMask> = setup
-                .angles
-                .iter()
-                .map(|&angle_deg| AngleMask {
+        let mut found = found.into_iter();
+        let masks: Vec<AngleMask> = (setup.angles.iter().enumerate())
+            .map(|(a, &angle_deg)| match chosen.binary_search(&a) {
+                Ok(_) => found.next().expect("a mask per chosen angle"),
+                Err(_) => AngleMask {
                     angle_deg,
                     mask: vec![0; spec.len()],
                     placed: 0,
                     colliding: 0,
                     probes_met: vec![false; blind_count],
-                })
-                .collect();
-            for (&a, m) in chosen.iter().zip(found) {
-                masks[a] = m;
-            }
-            masks
-        };
+                },
+            })
+            .collect();
         progress.end();
         let push_slide_s = t.elapsed().as_secs_f64();
 
@@ -378,6 +377,7 @@ impl Analysis {
             grid,
             node_file,
             footprints,
+            angles,
             masks,
             composite,
             blind_spots: blind,

@@ -15,6 +15,14 @@ pub struct Shard {
 }
 
 impl Shard {
+    /// The whole run: shard 1 of 1, every item.
+    pub const WHOLE: Shard = Shard { index: 1, count: 1 };
+
+    /// Whether this shard is the whole run ([`Shard::WHOLE`]).
+    pub fn is_whole(&self) -> bool {
+        self.count == 1
+    }
+
     /// Parses `K/N` (1 <= K <= N <= [`crate::limits::MAX_ANGLES`]).
     pub fn parse(s: &str) -> Result<Shard, ShardSyntax> {
         let bad = || ShardSyntax(s.to_string());
@@ -27,17 +35,16 @@ impl Shard {
         Ok(Shard { index, count })
     }
 
-    /// The indices, among `angles` angles, of this shard's: `a` with
-    /// `a % count == index - 1`, in increasing order.
-    pub fn angle_indices(&self, angles: usize) -> Vec<usize> {
-        self.indices(angles)
-    }
-
     /// The indices, among `items` (a run's angles, a study's starts), of
     /// this shard's: `k` with `k % count == index - 1`, in increasing
     /// order.
     pub fn indices(&self, items: usize) -> Vec<usize> {
         (self.index - 1..items).step_by(self.count).collect()
+    }
+
+    /// Whether item `k` is this shard's: `k % count == index - 1`.
+    pub fn has(&self, k: usize) -> bool {
+        k % self.count == self.index - 1
     }
 
     /// Whether `indices` are this shard's among `items` ([`Shard::indices`]),

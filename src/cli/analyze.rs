@@ -93,8 +93,8 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         setup.pitch = chosen.pitch_mm;
         choice = Some(chosen);
     }
-    let only = shard.map(|s| s.angle_indices(setup.angles.len()));
-    let mut analysis = Analysis::of_source_at(&source, &setup, only.as_deref(), &bars)?;
+    let angles = shard.unwrap_or(Shard::WHOLE);
+    let mut analysis = Analysis::of_source_at(&source, &setup, angles, &bars)?;
     analysis.pitch_choice = choice;
     // The sample check (a shard checks its own angles: the merge puts the
     // checks together as the whole run's).
@@ -107,16 +107,16 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
     } else {
         let triangles = analysis.input.part.triangles.len();
         analysis.memory.add_sample_check(triangles);
-        harness::check_analysis(&analysis, only.as_deref(), &bars).map_err(super::harness_error)?
+        harness::check_analysis(&analysis, &bars).map_err(super::harness_error)?
     });
     analysis.timings.check_s = t.elapsed().as_secs_f64();
     if let Some(shard) = shard {
-        kneeform::shard::write_shard(&out, &analysis, shard)?;
+        kneeform::shard::write_shard(&out, &analysis)?;
         out.commit()
             .with_context(|| format!("cannot move the shard into {}", args.out.display()))?;
         eprintln!(
             "kneeform: shard {shard}: {} of {} angles written to {}; `kneeform merge` puts the {} shards together",
-            only.as_ref().map_or(0, Vec::len),
+            angles.indices(setup.angles.len()).len(),
             setup.angles.len(),
             args.out.display(),
             shard.count

@@ -39,12 +39,11 @@ fn check_angles(angles: &[f64]) -> Vec<usize> {
 
 /// Runs the sample check on `analysis` (the slide approach; the direct
 /// approach's record says it is not run: `verify --approach direct`
-/// checks it). With `only` (a shard's angle indices), the check's pairs
-/// at those angles alone: the shards' checks merge into the whole run's
-/// ([`SampleCheck::merged`]).
+/// checks it). A shard's analysis checks the pairs at its own angles
+/// alone (`analysis.angles`): the shards' checks merge into the whole
+/// run's ([`SampleCheck::merged`]).
 pub fn check_analysis(
     analysis: &Analysis,
-    only: Option<&[usize]>,
     progress: &dyn Progress,
 ) -> Result<SampleCheck, HarnessError> {
     let setup = &analysis.setup;
@@ -57,7 +56,7 @@ pub fn check_analysis(
     let picked = check_angles(&setup.angles);
     let footprints: Vec<_> = picked
         .iter()
-        .filter(|k| only.is_none_or(|only| only.contains(k)))
+        .filter(|&&k| analysis.angles.has(k))
         .filter_map(|&k| analysis.footprints.get(k).cloned())
         .collect();
     let angles: Vec<f64> = footprints.iter().map(|fp| fp.angle_deg).collect();
@@ -170,6 +169,7 @@ fn to_um(v: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::frame::Side;
+    use crate::partition::Shard;
     use crate::setup::Setup;
 
     fn bump(approach: Approach) -> Analysis {
@@ -188,7 +188,7 @@ mod tests {
     #[test]
     fn the_check_is_verify_on_a_sample_of_the_analysis_starts() {
         let analysis = bump(Approach::Slide);
-        let check = check_analysis(&analysis, None, &()).unwrap();
+        let check = check_analysis(&analysis, &()).unwrap();
         assert_eq!(check.status, CheckStatus::Checked);
         assert_eq!((check.starts, check.angles_deg.len()), (CHECK_STARTS, 3));
         assert_eq!(check.compared_pairs, CHECK_STARTS * 3, "{check:?}");
@@ -228,10 +228,16 @@ mod tests {
     #[test]
     fn the_shards_checks_merge_into_the_whole_runs() {
         let analysis = bump(Approach::Slide);
-        let whole = check_analysis(&analysis, None, &()).unwrap();
-        let parts: Vec<SampleCheck> = [[0usize], [1], [2]]
-            .iter()
-            .map(|only| check_analysis(&analysis, Some(only), &()).unwrap())
+        let whole = check_analysis(&analysis, &()).unwrap();
+        assert_eq!(analysis.setup.angles.len(), 3);
+        let parts: Vec<SampleCheck> = (1..=3)
+            .map(|index| {
+                let shard = Analysis {
+                    angles: Shard { index, count: 3 },
+                    ..analysis.clone()
+                };
+                check_analysis(&shard, &()).unwrap()
+            })
             .collect();
         assert!(parts.iter().all(|p| p.compared_pairs == CHECK_STARTS));
         assert_eq!(
@@ -242,7 +248,7 @@ mod tests {
 
     #[test]
     fn the_direct_approach_says_it_is_not_checked_here() {
-        let check = check_analysis(&bump(Approach::Direct), None, &()).unwrap();
+        let check = check_analysis(&bump(Approach::Direct), &()).unwrap();
         assert_eq!(check.status, CheckStatus::NotRun);
         assert!(
             check.line().contains("verify --approach direct"),

@@ -77,12 +77,9 @@ pub struct PitchPart {
     pub nodes: usize,
 }
 
-/// `shard`'s share of `all` (all of it without a shard); an error when a
-/// shard would have no start.
-pub(super) fn share(all: &[[f64; 2]], shard: Option<Shard>) -> Result<Vec<[f64; 2]>, HarnessError> {
-    let Some(shard) = shard else {
-        return Ok(all.to_vec());
-    };
+/// `shard`'s share of `all` ([`Shard::WHOLE`]: all of it); an error when
+/// a shard would have no start.
+pub(super) fn share(all: &[[f64; 2]], shard: Shard) -> Result<Vec<[f64; 2]>, HarnessError> {
     if shard.count > all.len() {
         return Err(HarnessError::TooManyShards {
             shards: shard.count,

@@ -178,7 +178,7 @@ fn run(
         }
     }
     let tracing = Tracing {
-        share: share(&method.laid().starts, Some(shard))?,
+        share: share(&method.laid().starts, shard)?,
         finest: pitches[pitches.len() - 1],
         refuse_beyond_s: options.budget_s(),
         within_s: None,

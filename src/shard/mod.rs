@@ -150,11 +150,12 @@ pub(crate) const FORMAT: u32 = 2;
 
 const MAGIC: &[u8; 16] = b"kneeform shard 2";
 
-/// Writes `analysis`, computed at `shard`'s angles only
-/// ([`Analysis::of_source_at`]), as that shard: `shard.json` and
-/// `shard.bin` in the staged directory `out`.
-pub fn write_shard(out: &OutputDir, analysis: &Analysis, shard: Shard) -> Result<(), WriteError> {
-    let indices = shard.angle_indices(analysis.masks.len());
+/// Writes `analysis`, computed at one shard's angles only
+/// (`analysis.angles`, [`Analysis::of_source_at`]), as that shard:
+/// `shard.json` and `shard.bin` in the staged directory `out`.
+pub fn write_shard(out: &OutputDir, analysis: &Analysis) -> Result<(), WriteError> {
+    let shard = analysis.angles;
+    let indices = shard.indices(analysis.masks.len());
     let mut bin = Vec::new();
     bin.extend_from_slice(MAGIC);
     let spec = analysis.grid.spec;
@@ -903,12 +904,9 @@ mod tests {
     #[test]
     fn shards_take_every_nth_angle() {
         let s = Shard::parse("2/3").unwrap();
-        assert_eq!(s.angle_indices(7), [1, 4]);
-        assert_eq!(Shard::parse("1/1").unwrap().angle_indices(3), [0, 1, 2]);
-        assert_eq!(
-            Shard::parse("3/3").unwrap().angle_indices(2),
-            Vec::<usize>::new()
-        );
+        assert_eq!(s.indices(7), [1, 4]);
+        assert_eq!(Shard::parse("1/1").unwrap().indices(3), [0, 1, 2]);
+        assert_eq!(Shard::parse("3/3").unwrap().indices(2), Vec::<usize>::new());
         for bad in ["0/3", "4/3", "1", "a/b", "1/0", "-1/2", ""] {
             assert!(Shard::parse(bad).is_err(), "{bad}");
         }
