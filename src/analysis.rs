@@ -24,7 +24,7 @@ use crate::kneeform::{GridFootprint, KneeForm};
 use crate::memory::MemoryEstimate;
 use crate::partition::Shard;
 use crate::sanity::{self, Warning};
-use crate::setup::{GIB, Limit, Setup, SetupError, check_estimate};
+use crate::setup::{GIB, Limit, Sampled, Setup, SetupError, check_estimate};
 use crate::summary::{AngleSummary, FileSummary, Summary, Timings};
 
 /// Estimates above this (bytes) are said before the run: 256 MiB.
@@ -271,8 +271,7 @@ impl Analysis {
             }
         }
         let t = Instant::now();
-        let spec = setup.grid_placed(&input.part.bbox())?;
-        let memory = setup.check_memory(&spec, input.part.triangles.len())?;
+        let (spec, memory) = setup.lay(&input.part)?;
         if memory.bytes() > NOTE_MEMORY_BYTES {
             progress.note(&format!(
                 "this run needs about {:.2} GiB of memory ({} x {} grid, {} angles; --max-memory {:.2} GiB)",
@@ -284,20 +283,14 @@ impl Analysis {
             ));
         }
         // An assembly's grid is the same heights, each node tagged with
-        // the file that set it.
-        let (grid, node_file) = match &input.assembly {
-            None => (HeightGrid::sample(&input.part.triangles, spec), None),
-            Some(a) => {
-                let (grid, files) =
-                    HeightGrid::sample_attributed(&input.part.triangles, &a.file_of, spec);
-                (grid, Some(files))
-            }
-        };
-        // The slide's footprints; the direct approach lays its own fronts.
-        let footprints = match setup.approach {
-            Approach::Slide => setup.footprints(&spec),
-            Approach::Direct => Vec::new(),
-        };
+        // the file that set it; the direct approach lays its own fronts.
+        let file_of = input.assembly.as_ref().map(|a| &a.file_of[..]);
+        let Sampled {
+            grid,
+            node_file,
+            footprints,
+            ..
+        } = setup.sample_on(spec, &input.part.triangles, file_of);
         let sample_s = t.elapsed().as_secs_f64();
 
         let t = Instant::now();

@@ -2,15 +2,18 @@
 //! angles, the strike rule, the approach), checked before any work
 //! ([`Setup::validate`]), and what it costs: the grid it lays on a part and
 //! the memory that grid needs, checked against the memory allowed before
-//! anything is allocated.
+//! anything is allocated. Then the one sampling stage every pipeline runs
+//! (the analysis, the studies' grids, the benchmark): [`Setup::lay`] and
+//! [`Setup::sample_on`] give the height grid and the slide's footprints,
+//! [`Sampled`].
 
 use crate::engine::Algorithm;
 use crate::frame::Approach;
-use crate::grid::{GridError, GridSpec};
+use crate::grid::{GridError, GridSpec, HeightGrid};
 use crate::kneeform::{Footprint, GridFootprint, KneeForm};
 use crate::limits::{self, short};
 use crate::memory::MemoryEstimate;
-use crate::mesh::{Bbox, Part};
+use crate::mesh::{Bbox, Part, Triangle};
 use crate::strike::StrikeRule;
 
 /// Where the grid lies.
@@ -235,9 +238,47 @@ impl Setup {
     /// bounded number of nodes and the analysis on it to fit the memory
     /// allowed ([`Setup::check_memory`]).
     pub fn grid_spec(&self, part: &Part) -> Result<GridSpec, GridError> {
+        Ok(self.lay(part)?.0)
+    }
+
+    /// The grid of [`Setup::grid_spec`] and the working memory it was
+    /// checked for: the first step of the sampling stage.
+    pub fn lay(&self, part: &Part) -> Result<(GridSpec, MemoryEstimate), GridError> {
         let spec = self.grid_placed(&part.bbox())?;
-        self.check_memory(&spec, part.triangles.len())?;
-        Ok(spec)
+        let memory = self.check_memory(&spec, part.triangles.len())?;
+        Ok((spec, memory))
+    }
+
+    /// `triangles` sampled on `spec` (SPEC's z-buffer from -y; with an
+    /// assembly's `file_of`, per triangle the index of its file, each
+    /// node tagged with the file that set its height), and the slide's
+    /// footprints laid on it: the second step of the sampling stage. The
+    /// direct approach lays no footprints here (its fronts move along x:
+    /// [`crate::direct::DirectFootprint`]).
+    pub fn sample_on(
+        &self,
+        spec: GridSpec,
+        triangles: &[Triangle],
+        file_of: Option<&[u32]>,
+    ) -> Sampled {
+        let t = std::time::Instant::now();
+        let (grid, node_file) = match file_of {
+            None => (HeightGrid::sample(triangles, spec), None),
+            Some(file_of) => {
+                let (grid, files) = HeightGrid::sample_attributed(triangles, file_of, spec);
+                (grid, Some(files))
+            }
+        };
+        let footprints = match self.approach {
+            Approach::Slide => self.footprints(&spec),
+            Approach::Direct => Vec::new(),
+        };
+        Sampled {
+            grid,
+            node_file,
+            footprints,
+            sample_s: t.elapsed().as_secs_f64(),
+        }
     }
 
     /// The grid alone, its node count checked, not its memory. For the
@@ -321,6 +362,21 @@ impl Setup {
             .map(|&a| GridFootprint::new(&self.knee, a, spec))
             .collect()
     }
+}
+
+/// A part sampled as a setup lays it ([`Setup::sample_on`]).
+#[derive(Debug, Clone)]
+pub struct Sampled {
+    /// The height grid (its nodes: `grid.spec`).
+    pub grid: HeightGrid,
+    /// For an assembly: per node, the index of the file whose surface set
+    /// its height (the lowest on a tie); `None` for one file.
+    pub node_file: Option<Vec<u32>>,
+    /// The slide's footprints on the grid, in the order of the setup's
+    /// angles; none for the direct approach.
+    pub footprints: Vec<GridFootprint>,
+    /// Seconds sampling the grid and laying the footprints.
+    pub sample_s: f64,
 }
 
 pub(crate) const GIB: f64 = 1024.0 * 1024.0 * 1024.0;

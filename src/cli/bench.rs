@@ -15,7 +15,7 @@ use kneeform::grid::GridSpec;
 use kneeform::scenario::{self, PAPER_TRIANGLES};
 use kneeform::strike::RateEstimate;
 use kneeform::{
-    Algorithm, EngineOptions, GridFootprint, HeightGrid, KneeForm, Setup, colliding_masks,
+    Algorithm, EngineOptions, GridFootprint, GridPlacement, KneeForm, Setup, colliding_masks,
 };
 
 use super::args::BenchArgs;
@@ -50,10 +50,17 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         |[lo, hi]: [f64; 2], n: usize| lo + (hi - lo - (n - 1) as f64 * PAPER_PITCH) / 2.0;
     let origin = [centred(console.extent.x, nx), centred(console.extent.z, nz)];
     let spec = GridSpec::explicit(origin[0], origin[1], nx, nz, PAPER_PITCH);
-    let footprints: Vec<GridFootprint> = angles
-        .iter()
-        .map(|&a| GridFootprint::new(&knee, a, &spec))
-        .collect();
+    let setup = Setup {
+        pitch: PAPER_PITCH,
+        knee,
+        angles,
+        grid: GridPlacement::Explicit {
+            origin,
+            size: PAPER_GRID,
+        },
+        ..Setup::default()
+    };
+    let footprints: Vec<GridFootprint> = setup.footprints(&spec);
     let fast = EngineOptions::default();
 
     let mut sample_s = Vec::new();
@@ -70,9 +77,9 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     let mut grid = None;
     let mut composite_nodes = 0;
     for run in 0..args.runs {
-        let t = Instant::now();
-        let g = HeightGrid::sample(&triangles, spec);
-        sample_s.push(t.elapsed().as_secs_f64());
+        let sampled = setup.sample_on(spec, &triangles, None);
+        let g = sampled.grid;
+        sample_s.push(sampled.sample_s);
         let t = Instant::now();
         blind_count =
             kneeform::blind::blind_spots(&triangles, &g, Setup::DEFAULT_BLIND_DEPTH).len();
@@ -147,7 +154,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
                 ]
             })
             .collect();
-        let options = kneeform::harness::oracle_options(&knee, PAPER_PITCH, spec.x(0));
+        let options = kneeform::harness::oracle_options(&setup.knee, PAPER_PITCH, spec.x(0));
         let t = Instant::now();
         kneeform_oracle::evaluate(&part, &starts, &[0.0], &options)?;
         Some(t.elapsed().as_secs_f64() / starts.len() as f64)

@@ -264,10 +264,10 @@ impl<'a> Ladder<'a> {
         setup.validate()?;
         let triangles = &input.part.triangles;
         let t = Instant::now();
-        let coarse = setup.grid_spec(&input.part)?;
-        let coarse_grid = HeightGrid::sample(triangles, coarse);
+        let (coarse, _) = setup.lay(&input.part)?;
+        let sampled = setup.sample_on(coarse, triangles, None);
         let sample_s = t.elapsed().as_secs_f64();
-        let all_starts = start_positions(&coarse_grid, &setup.footprints(&coarse), selection)?;
+        let all_starts = start_positions(&sampled.grid, &sampled.footprints, selection)?;
         Ok(Ladder {
             triangles,
             setup: setup.clone(),
@@ -276,7 +276,7 @@ impl<'a> Ladder<'a> {
                 starts: all_starts,
                 sample_s,
             },
-            coarse_grid: Some(coarse_grid),
+            coarse_grid: Some(sampled.grid),
             starts: Vec::new(),
             traces: Vec::new(),
             compare: CompareOptions::of(setup, tie_band_per_mm),

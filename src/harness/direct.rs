@@ -432,8 +432,8 @@ impl<'a> DirectMethod<'a> {
             approach: Approach::Direct,
             ..setup.clone()
         };
-        let spec = setup.grid_spec(&part)?;
-        let grid = HeightGrid::sample(&part.triangles, spec);
+        let (spec, _) = setup.lay(&part)?;
+        let grid = setup.sample_on(spec, &part.triangles, None).grid;
         let positions = match selection {
             StartSelection::At(given) => given.clone(),
             _ => {
