@@ -935,4 +935,24 @@ fn runs_of_starts_are_chained_and_bad_runs_are_refused() {
         );
         assert_eq!(err.trim().lines().count(), 1, "{bad}: {err}");
     }
+    // A speck between the nodes places no start: the default runs say
+    // so, not that shorter runs would fit.
+    let speck = dir.join("speck.stl");
+    std::fs::write(
+        &speck,
+        "solid s\nfacet normal 0 -1 0\nouter loop\nvertex 0.3 0 0.3\nvertex 0.5 0 0.3\nvertex 0.4 0 0.5\nendloop\nendfacet\nendsolid s\n",
+    )
+    .unwrap();
+    let out = kneeform(&[
+        "verify",
+        speck.to_str().unwrap(),
+        "--pitch",
+        "4",
+        "--out",
+        dir.join("speck").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no start is placed on this part"), "{err}");
+    assert!(!err.contains("shorter runs"), "{err}");
 }

@@ -208,9 +208,12 @@ pub(super) fn choose_nodes(
     nodes
 }
 
-/// The error for a `selection` that chose no start: none is placed on the
-/// part, or none lies in the strip, or no run fits.
-pub(super) fn none_chosen(selection: &StartSelection) -> HarnessError {
+/// The error for a `selection` that chose no start of the `placed` placed
+/// on the part: none is placed, or none lies in the strip, or no run fits.
+pub(super) fn none_chosen(selection: &StartSelection, placed: usize) -> HarnessError {
+    if placed == 0 {
+        return HarnessError::NoStarts;
+    }
     match *selection {
         StartSelection::Strip { z } => HarnessError::NoneChosen(format!(
             "no placed start lies in the strip {} <= z <= {} mm",

@@ -434,22 +434,24 @@ impl<'a> DirectMethod<'a> {
         };
         let (spec, _) = setup.lay(&part)?;
         let grid = setup.sample_on(spec, &part.triangles, None).grid;
-        let positions = match selection {
-            StartSelection::At(given) => given.clone(),
+        let (positions, placed) = match selection {
+            StartSelection::At(given) => (given.clone(), given.len()),
             _ => {
                 let placed = placed_nodes(&grid, &footprints(&setup, spec.pitch));
-                let nodes = (0..spec.len())
+                let nodes: Vec<(usize, usize)> = (0..spec.len())
                     .filter(|&n| placed[n])
                     .map(|n| (n % spec.nx, n / spec.nx))
                     .collect();
-                choose_nodes(&spec, nodes, selection)
+                let placed = nodes.len();
+                let chosen = choose_nodes(&spec, nodes, selection)
                     .iter()
                     .map(|&(i, j)| [spec.x(i), spec.z(j)])
-                    .collect()
+                    .collect();
+                (chosen, placed)
             }
         };
         if positions.is_empty() {
-            return Err(super::compare::none_chosen(selection));
+            return Err(super::compare::none_chosen(selection, placed));
         }
         Ok(DirectMethod {
             input,

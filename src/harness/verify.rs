@@ -151,7 +151,8 @@ pub(super) fn start_positions(
         .map(|&(i, j)| [spec.x(i), spec.z(j)])
         .collect();
     if starts.is_empty() {
-        return Err(super::compare::none_chosen(selection));
+        let placed = select_starts(grid, footprints, &StartSelection::All).len();
+        return Err(super::compare::none_chosen(selection, placed));
     }
     Ok(starts)
 }
