@@ -3,7 +3,9 @@
 //! ([`Setup::validate`]), and what it costs: the grid it lays on a part and
 //! the memory that grid needs, checked against the memory allowed before
 //! anything is allocated. Then the one sampling stage every pipeline runs
-//! (the analysis, the studies' grids, the benchmark): [`Setup::lay`] and
+//! (the analysis, the studies' grids at every pitch, the benchmark; the
+//! verification's half- and quarter-pitch bands of one start aside):
+//! [`Setup::lay`] and
 //! [`Setup::sample_on`] give the height grid and the slide's footprints,
 //! [`Sampled`].
 

@@ -12,7 +12,7 @@ use super::compare::{
     CompareOptions, Comparison, GridSide, PairResult, StartSelection, assemble, chain_of,
     pair_results,
 };
-use super::method::{Laid, Method, Pitch, Tracing, grid_at, spec_at};
+use super::method::{Laid, Method, Pitch, Tracing, sampled_at, spec_at};
 use super::metrics::{METRICS, TieBand};
 use super::pairs::{Pairs, PitchPart};
 use super::trace::Fault;
@@ -25,7 +25,7 @@ use crate::engine::{AngleMask, EngineOptions, colliding_masks};
 use crate::grid::{GridSpec, HeightGrid};
 use crate::input::PartFile;
 use crate::mesh::Triangle;
-use crate::setup::Setup;
+use crate::setup::{Sampled, Setup};
 use kneeform_oracle::StartTrace;
 
 /// One pitch of a convergence study.
@@ -191,7 +191,7 @@ pub(super) struct Ladder<'a> {
     laid: Laid,
     /// The coarsest grid, kept until its pitch is measured (a
     /// verification's one grid is sampled once).
-    coarse_grid: Option<HeightGrid>,
+    coarse_grid: Option<Sampled>,
     /// The starts traced (mm), nodes of every grid of the ladder: a
     /// shard's share of `all_starts`, or all of them.
     pub starts: Vec<[f64; 2]>,
@@ -276,7 +276,7 @@ impl<'a> Ladder<'a> {
                 starts: all_starts,
                 sample_s,
             },
-            coarse_grid: Some(sampled.grid),
+            coarse_grid: Some(sampled),
             starts: Vec::new(),
             traces: Vec::new(),
             compare: CompareOptions::of(setup, tie_band_per_mm),
@@ -324,8 +324,9 @@ impl<'a> Ladder<'a> {
         let p = at.p;
         let spec = self.spec_at(p);
         progress.begin(&at.stage(&spec, self.traces.len(), ""), None);
-        let grid = grid_at(&mut self.coarse_grid, self.triangles, spec);
-        let footprints = self.setup.footprints(&spec);
+        let Sampled {
+            grid, footprints, ..
+        } = sampled_at(&mut self.coarse_grid, &self.setup, self.triangles, spec);
         let (masks, seconds) = if at.converging {
             let t = Instant::now();
             let masks = colliding_masks(

@@ -43,7 +43,7 @@ use serde::{Deserialize, Serialize};
 use super::HarnessError;
 use super::compare::{StartSelection, choose_nodes, node_at};
 use super::converge::{Fit, fit_power_law};
-use super::method::{Laid, Method, Pitch, Tracing, grid_at, spec_at};
+use super::method::{Laid, Method, Pitch, Tracing, sampled_at, spec_at};
 use super::metrics::{nearest_rank, sorted_abs};
 pub(crate) use super::pairs::{DirectPair, DirectRow};
 use super::pairs::{NO_BAND, Pairs, PitchPart};
@@ -56,7 +56,7 @@ use crate::grid::HeightGrid;
 use crate::input::PartFile;
 use crate::kneeform::KneeForm;
 use crate::mesh::{Part, Triangle};
-use crate::setup::Setup;
+use crate::setup::{Sampled, Setup};
 
 /// The metrics of the direct approach, in the order of `converge.csv`.
 pub const DIRECT_METRICS: [&str; 2] = ["level_error", "contact_distance"];
@@ -412,7 +412,7 @@ pub(super) struct DirectMethod<'a> {
     /// The coarsest grid, every position of the study on it.
     laid: Laid,
     /// The coarsest grid, kept until its pitch is measured.
-    coarse_grid: Option<HeightGrid>,
+    coarse_grid: Option<Sampled>,
     /// The positions cast: a shard's share of `positions`, or all.
     share: Vec<[f64; 2]>,
     traces: Vec<DirectTrace>,
@@ -433,11 +433,12 @@ impl<'a> DirectMethod<'a> {
             ..setup.clone()
         };
         let (spec, _) = setup.lay(&part)?;
-        let grid = setup.sample_on(spec, &part.triangles, None).grid;
+        let sampled = setup.sample_on(spec, &part.triangles, None);
+        let grid = &sampled.grid;
         let (positions, placed) = match selection {
             StartSelection::At(given) => (given.clone(), given.len()),
             _ => {
-                let placed = placed_nodes(&grid, &footprints(&setup, spec.pitch));
+                let placed = placed_nodes(grid, &footprints(&setup, spec.pitch));
                 let nodes: Vec<(usize, usize)> = (0..spec.len())
                     .filter(|&n| placed[n])
                     .map(|n| (n % spec.nx, n / spec.nx))
@@ -463,7 +464,7 @@ impl<'a> DirectMethod<'a> {
                 // The direct approach's summaries report no sampling time.
                 sample_s: 0.0,
             },
-            coarse_grid: Some(grid),
+            coarse_grid: Some(sampled),
             share: Vec::new(),
             traces: Vec::new(),
         })
@@ -501,7 +502,13 @@ impl Method for DirectMethod<'_> {
         let spec = spec_at(&self.laid.coarse, p);
         let stage = at.stage(&spec, self.traces.len(), " (direct)");
         let (pairs, grid_s) = super::in_stage(progress, &stage, None, || {
-            let grid = grid_at(&mut self.coarse_grid, &self.part.triangles, spec);
+            let grid = sampled_at(
+                &mut self.coarse_grid,
+                &self.setup,
+                &self.part.triangles,
+                spec,
+            )
+            .grid;
             direct_pairs(
                 &grid,
                 &footprints(&self.setup, p),

@@ -5,8 +5,9 @@
 use super::HarnessError;
 use super::pairs::PitchPart;
 use crate::analysis::Progress;
-use crate::grid::{GridSpec, HeightGrid};
+use crate::grid::GridSpec;
 use crate::mesh::Triangle;
+use crate::setup::{Sampled, Setup};
 
 /// What [`Method::trace`] traces, and within what time.
 #[derive(Debug, Clone, Default)]
@@ -64,17 +65,19 @@ impl Pitch {
     }
 }
 
-/// The grid of `triangles` at `spec`: `kept` (the coarsest grid, sampled
-/// when the study was laid) when it is that grid, else sampled. `kept` is
-/// taken either way: the coarsest pitch is measured first.
-pub(super) fn grid_at(
-    kept: &mut Option<HeightGrid>,
+/// `triangles` sampled at `spec` as `setup` samples them
+/// ([`Setup::sample_on`]): `kept` (the coarsest grid, sampled when the
+/// study was laid) when it is that grid, else sampled. `kept` is taken
+/// either way: the coarsest pitch is measured first.
+pub(super) fn sampled_at(
+    kept: &mut Option<Sampled>,
+    setup: &Setup,
     triangles: &[Triangle],
     spec: GridSpec,
-) -> HeightGrid {
+) -> Sampled {
     match kept.take() {
-        Some(grid) if grid.spec == spec => grid,
-        _ => HeightGrid::sample(triangles, spec),
+        Some(sampled) if sampled.grid.spec == spec => sampled,
+        _ => setup.sample_on(spec, triangles, None),
     }
 }
 
