@@ -720,7 +720,12 @@ pub(crate) fn pair_results(
         }
     }
     let bands = FinerBands::new(triangles, options.blind_depth);
-    let one = |(a, s): (usize, usize), g: &GridTrace| {
+    // A pair's comparison, given its grid trace `g`; `finer_before` holds
+    // the traces of the start one node to the -x on the finer grids where
+    // it was refined (its pair came just before in the run), to join, and
+    // is left holding this start's.
+    let one = |(a, s): (usize, usize), g: &GridTrace, finer_before: &mut [Option<GridTrace>; 2]| {
+        let before = std::mem::take(finer_before);
         let (i, j) = nodes[s];
         let fp = &footprints[a];
         let trace = &traces[a * nodes.len() + s];
@@ -732,7 +737,7 @@ pub(crate) fn pair_results(
         let reach = super::causes::RISE_REACH * spec.pitch;
         let inside = cmp.inside_miss().filter(|d| d.is_finite() && *d > reach);
         if let Some(d) = inside.filter(|_| trace.status == StartStatus::Placed) {
-            let refined = |halvings| {
+            let refined = |halvings: u32| {
                 inside_miss_refined(
                     &bands,
                     grid,
@@ -741,13 +746,16 @@ pub(crate) fn pair_results(
                     trace,
                     options,
                     fault,
-                    halvings,
+                    (halvings, before[halvings as usize - 1].as_ref()),
                 )
             };
-            let half = refined(1);
+            let (half, fine) = refined(1);
             cmp.miss_half_pitch = Some(half);
+            finer_before[0] = Some(fine);
             if half < d && !cmp.falls_with_the_pitch() {
-                cmp.miss_quarter_pitch = Some(refined(2));
+                let (quarter, fine) = refined(2);
+                cmp.miss_quarter_pitch = Some(quarter);
+                finer_before[1] = Some(fine);
             }
             if cmp.falls_with_the_pitch() {
                 cmp.points.decided_refined = std::mem::take(&mut cmp.points.decided_inside);
@@ -778,17 +786,18 @@ pub(crate) fn pair_results(
         .par_iter()
         .map(|run| {
             let mut before: Option<GridTrace> = None;
+            let mut finer_before = [None, None];
             run.clone()
                 .map(|pair| {
                     let (a, s) = (pair / nodes.len(), pair % nodes.len());
                     let (i, j) = nodes[s];
                     let g = match &before {
                         Some(b) => {
-                            grid_trace_joining(grid, &footprints[a], (i, j), &options.rule, b)
+                            grid_trace_joining(grid, &footprints[a], (i, j), &options.rule, (b, 1))
                         }
                         None => grid_trace(grid, &footprints[a], i, j, &options.rule, fault),
                     };
-                    let result = one((a, s), &g);
+                    let result = one((a, s), &g, &mut finer_before);
                     before = Some(g);
                     result
                 })
@@ -807,10 +816,12 @@ const JOINED_RUN: usize = 64;
 /// `grid` (sampled from `triangles`) and `angle_deg`, with the grid
 /// sampled at its pitch halved `halvings` times (1 or 2), against the
 /// same exact `trace` (mm; `+inf` where the finer grid strikes nothing in
-/// the start, 0 where it misses nothing). The finer grid holds the nodes
-/// of `grid` (its origin's indices multiplied) and only the rows the
-/// footprint covers from the start: the slide of this start sees the same
-/// nodes as on the whole finer grid.
+/// the start, 0 where it misses nothing), with the finer grid's trace.
+/// The finer grid holds the nodes of `grid` (its origin's indices
+/// multiplied) and only the rows the footprint covers from the start: the
+/// slide of this start sees the same nodes as on the whole finer grid.
+/// Given `neighbour`, the finer trace of the start at `(i - 1, j)`, the
+/// trace joins it ([`grid_trace_joining`]: the same trace as alone).
 #[allow(clippy::too_many_arguments)]
 fn inside_miss_refined(
     bands: &FinerBands,
@@ -820,8 +831,8 @@ fn inside_miss_refined(
     trace: &StartTrace,
     options: &CompareOptions,
     fault: Option<Fault>,
-    halvings: u32,
-) -> f64 {
+    (halvings, neighbour): (u32, Option<&GridTrace>),
+) -> (f64, GridTrace) {
     let whole = finer(grid.spec, halvings);
     let k = 1usize << halvings;
     let fp = GridFootprint::new(&options.knee, angle_deg, &whole);
@@ -837,11 +848,16 @@ fn inside_miss_refined(
     };
     let sampled = bands.get((angle_deg.to_bits(), halvings, lo, hi), band);
     let (fine, cells) = sampled.get().expect("the band is made");
-    let g = grid_trace(fine, &fp, k * i, (j2 - lo) as usize, &options.rule, fault);
+    let row = (j2 - lo) as usize;
+    let g = match neighbour {
+        Some(b) => grid_trace_joining(fine, &fp, (k * i, row), &options.rule, (b, k)),
+        None => grid_trace(fine, &fp, k * i, row, &options.rule, fault),
+    };
     let ties = TieBand::new(options.rule.sigma, band.pitch, options.tie_band_per_mm);
-    compare(&g, trace, &ties, ExactRule::of(&options.rule), cells)
+    let miss = compare(&g, trace, &ties, ExactRule::of(&options.rule), cells)
         .inside_miss()
-        .unwrap_or(0.0)
+        .unwrap_or(0.0);
+    (miss, g)
 }
 
 /// The grid `spec` with its pitch halved `halvings` times: its nodes and
@@ -1560,7 +1576,7 @@ mod tests {
                     let expected = compare(&g, trace, &ties, ExactRule::of(&options.rule), &cells)
                         .inside_miss()
                         .unwrap_or(0.0);
-                    let banded = inside_miss_refined(
+                    let (banded, _) = inside_miss_refined(
                         &bands,
                         &grid,
                         angle,
@@ -1568,7 +1584,7 @@ mod tests {
                         trace,
                         &options,
                         None,
-                        halvings,
+                        (halvings, None),
                     );
                     assert_eq!(
                         banded.to_bits(),

@@ -96,32 +96,35 @@ pub(crate) fn grid_trace(
 }
 
 /// [`grid_trace`] of the start at node `(i0, j0)`, given `neighbour`, the
-/// trace of the start one pitch to its -x (node `(i0 - 1, j0)`) at the same
-/// footprint: the same trace, for a few hundred nodes where the start
-/// alone walks every node in front of it (10^5 on the console).
+/// trace of the start `shift` nodes to its -x (node `(i0 - shift, j0)`,
+/// `shift >= 1`) at the same footprint: the same trace, for a few hundred
+/// nodes where the start alone walks every node in front of it (10^5 on
+/// the console).
 ///
 /// Why it is the same. Call the start A and its neighbour B, `p` the
-/// pitch. A's footprint after `s` mm of travel covers B's after `s - p`,
-/// so for `s >= p` the nodes A has met are those it met by `p` (B's push
-/// footprint among them) and those B met by `s - p`, and A's level is
-/// `f_A(s) = min(f_A(p), f_B(s - p))`. Once B's level has come down to A's
-/// (at B's travel `J`), the two curves are the same, shifted by `p`; from
-/// `W` mm later on, so are the windows' earlier levels, and each node is
-/// met at the same level with the same earlier level: A strikes exactly
-/// the nodes B strikes from there, each `p` further along. So A slides on
-/// its own until it reaches `J + W` plus a pitch to spare (the levels
-/// A has reached bound `J` from above: a lower level only moves `J`
-/// later), and takes B's strikes and level curve from there, with each
-/// strike's travel computed as A's own slide computes it. A test compares
-/// every start of whole rows with its trace alone, to the bit.
+/// pitch, `d = shift * p`. A's footprint after `s` mm of travel covers
+/// B's after `s - d`, so for `s >= d` the nodes A has met are those it met
+/// by `d` (B's push footprint among them) and those B met by `s - d`, and
+/// A's level is `f_A(s) = min(f_A(d), f_B(s - d))`. Once B's level has
+/// come down to A's (at B's travel `J`), the two curves are the same,
+/// shifted by `d`; from `W` mm later on, so are the windows' earlier
+/// levels, and each node is met at the same level with the same earlier
+/// level: A strikes exactly the nodes B strikes from there, each `d`
+/// further along. So A slides on its own until it reaches `J + d + W`
+/// plus a pitch to spare (the levels A has reached bound `J` from above:
+/// a lower level only moves `J` later), and takes B's strikes and level
+/// curve from there, with each strike's travel computed as A's own slide
+/// computes it. A test compares every start of whole rows with its trace
+/// alone, to the bit, joined to the start one and four nodes before it.
 pub(crate) fn grid_trace_joining(
     grid: &HeightGrid,
     fp: &GridFootprint,
     (i0, j0): (usize, usize),
     rule: &StrikeRule,
-    neighbour: &GridTrace,
+    (neighbour, shift): (&GridTrace, usize),
 ) -> GridTrace {
-    slide(grid, fp, (i0, j0), rule, None, Some(neighbour))
+    assert!(shift >= 1, "a neighbour to the -x");
+    slide(grid, fp, (i0, j0), rule, None, Some((neighbour, shift)))
 }
 
 /// The layers of nodes in front that [`grid_trace_joining`] lays first
@@ -141,7 +144,7 @@ fn slide(
     (i0, j0): (usize, usize),
     rule: &StrikeRule,
     fault: Option<Fault>,
-    neighbour: Option<&GridTrace>,
+    neighbour: Option<(&GridTrace, usize)>,
 ) -> GridTrace {
     crate::engine::assert_same_pitch(grid, std::slice::from_ref(fp));
     let spec = grid.spec;
@@ -204,10 +207,12 @@ fn slide(
     // as the slide needs them: all nodes nearer than `layers * p` are laid
     // (a row's first node in front lies in `(0, p]`, up to rounding), and
     // the front's order up to there is the whole front's.
-    let neighbour = neighbour.filter(|b| b.yr.is_finite());
+    let neighbour = neighbour.filter(|b| b.0.yr.is_finite());
     let all_layers = in_order.iter().map(|r| r.1).max().unwrap_or(-1) + 1;
     let mut layers = match neighbour {
-        Some(_) => ((rule.window / p).ceil() as i64 + 2 + JOIN_SPARE_LAYERS).min(all_layers),
+        Some((_, shift)) => {
+            ((rule.window / p).ceil() as i64 + 1 + shift as i64 + JOIN_SPARE_LAYERS).min(all_layers)
+        }
         None => all_layers,
     };
     let laid_up_to = |layers: i64| {
@@ -234,7 +239,7 @@ fn slide(
             continue;
         }
         let s = front[k].0;
-        if let Some(b) = neighbour {
+        if let Some((b, shift)) = neighbour {
             while joined < b.levels.len() && b.levels[joined].1 > f {
                 joined += 1;
             }
@@ -243,8 +248,9 @@ fn slide(
             } else {
                 b.levels.get(joined).map_or(f64::INFINITY, |l| l.0)
             };
-            if s >= meets + rule.window + 2.0 * p {
-                join(&mut trace, b, s, f, &in_order, p);
+            // The shift and a pitch to spare.
+            if s >= meets + rule.window + (shift + 1) as f64 * p {
+                join(&mut trace, b, s, f, &in_order, (p, shift as f64 * p));
                 return trace;
             }
         }
@@ -293,15 +299,16 @@ fn slide(
 
 /// Completes `trace`, slid on its own up to the tie group at travel `s`
 /// (exclusive) and level `f`, with the strikes and the level curve of
-/// `neighbour` from there ([`grid_trace_joining`]). `rows` are the
-/// trace's rows in front, `(d0, first column in front, row)`.
+/// `neighbour`, `d` mm to its -x, from there ([`grid_trace_joining`]).
+/// `rows` are the trace's rows in front, `(d0, first column in front,
+/// row)`, the pitch `p` apart.
 fn join(
     trace: &mut GridTrace,
     neighbour: &GridTrace,
     s: f64,
     f: f64,
     rows: &[(f64, i64, usize)],
-    p: f64,
+    (p, d): (f64, f64),
 ) {
     // A node's distance as this start's own slide computes it.
     let distance = |(i, j): (usize, usize)| {
@@ -323,7 +330,7 @@ fn join(
             .levels
             .iter()
             .filter(|l| l.1 < f)
-            .map(|&(t, level)| (t + p, level)),
+            .map(|&(t, level)| (t + d, level)),
     );
 }
 
@@ -510,17 +517,26 @@ mod tests {
                 for angle in [-30.0, -7.0, 12.0, 30.0] {
                     let fp = GridFootprint::new(&knee, angle, &spec);
                     for j0 in (0..spec.nz).step_by(4) {
-                        let mut before: Option<GridTrace> = None;
+                        let mut before: Vec<GridTrace> = Vec::new();
                         for i0 in 0..spec.nx {
                             let alone = grid_trace(&grid, &fp, i0, j0, rule, None);
-                            if let Some(b) = &before {
-                                let chained = grid_trace_joining(&grid, &fp, (i0, j0), rule, b);
-                                let at = format!("pitch {pitch}, angle {angle}, start {i0} {j0}");
+                            // Joined to the start one node and four
+                            // nodes to the -x.
+                            for shift in [1, 4] {
+                                let Some(b) = before.len().checked_sub(shift).map(|n| &before[n])
+                                else {
+                                    continue;
+                                };
+                                let chained =
+                                    grid_trace_joining(&grid, &fp, (i0, j0), rule, (b, shift));
+                                let at = format!(
+                                    "pitch {pitch}, angle {angle}, start {i0} {j0}, shift {shift}"
+                                );
                                 assert_eq!(chained.yr, alone.yr, "{at}");
                                 assert_eq!(chained.colliding, alone.colliding, "{at}");
                                 assert_eq!(chained.push_rows, alone.push_rows, "{at}");
                                 // The level curve: the same levels, at
-                                // travels the neighbour's plus a pitch.
+                                // travels the neighbour's plus the shift.
                                 assert_eq!(chained.levels.len(), alone.levels.len(), "{at}");
                                 for (c, a) in chained.levels.iter().zip(&alone.levels) {
                                     assert_eq!(c.1, a.1, "{at}");
@@ -528,12 +544,12 @@ mod tests {
                                 }
                                 joined += usize::from(!alone.colliding.is_empty());
                             }
-                            before = Some(alone);
+                            before.push(alone);
                         }
                     }
                 }
             }
         }
-        assert!(joined > 1000, "{joined}");
+        assert!(joined > 2000, "{joined}");
     }
 }
