@@ -115,7 +115,8 @@ pub(crate) fn grid_trace(
 /// a lower level only moves `J` later), and takes B's strikes and level
 /// curve from there, with each strike's travel computed as A's own slide
 /// computes it. A test compares every start of whole rows with its trace
-/// alone, to the bit, joined to the start one and four nodes before it.
+/// alone, to the bit, joined to the start one, two and four nodes before
+/// it.
 pub(crate) fn grid_trace_joining(
     grid: &HeightGrid,
     fp: &GridFootprint,
@@ -520,9 +521,10 @@ mod tests {
                         let mut before: Vec<GridTrace> = Vec::new();
                         for i0 in 0..spec.nx {
                             let alone = grid_trace(&grid, &fp, i0, j0, rule, None);
-                            // Joined to the start one node and four
-                            // nodes to the -x.
-                            for shift in [1, 4] {
+                            // Joined to the start one, two and four
+                            // nodes to the -x (a pitch's, and the
+                            // refinements' at half and a quarter).
+                            for shift in [1, 2, 4] {
                                 let Some(b) = before.len().checked_sub(shift).map(|n| &before[n])
                                 else {
                                     continue;
@@ -550,6 +552,6 @@ mod tests {
                 }
             }
         }
-        assert!(joined > 2000, "{joined}");
+        assert!(joined > 3000, "{joined}");
     }
 }
