@@ -922,6 +922,11 @@ fn runs_of_starts_are_chained_and_bad_runs_are_refused() {
         ("4", "runs:0:4", "at least one start"),
         ("4", "runs:3:65", "1 to 64 starts"),
         ("4", "runs:3", "expected runs:N:L"),
+        (
+            "4",
+            "all:3",
+            "expected runs:N:L, strip:Z0:Z1, a number of starts or `all`",
+        ),
         // No row of the bump at 16 mm holds 64 placed starts.
         ("16", "runs:3:64", "no 64 adjacent placed starts"),
         ("4", "strip:5000:6000", "no placed start lies in the strip"),

@@ -424,10 +424,12 @@ impl StartArgs {
                 seed: self.seed,
             });
         }
-        let count: usize = self
-            .starts
-            .parse()
-            .with_context(|| format!("--starts {:?}: expected `all` or a number", self.starts))?;
+        let count: usize = self.starts.parse().with_context(|| {
+            format!(
+                "--starts {:?}: expected runs:N:L, strip:Z0:Z1, a number of starts or `all`",
+                self.starts
+            )
+        })?;
         Ok(StartSelection::Sample {
             count,
             seed: self.seed,
