@@ -338,15 +338,18 @@ impl Analysis {
         };
         let mut found = found.into_iter();
         let masks: Vec<AngleMask> = (setup.angles.iter().enumerate())
-            .map(|(a, &angle_deg)| match chosen.binary_search(&a) {
-                Ok(_) => found.next().expect("a mask per chosen angle"),
-                Err(_) => AngleMask {
-                    angle_deg,
-                    mask: vec![0; spec.len()],
-                    placed: 0,
-                    colliding: 0,
-                    probes_met: vec![false; blind_count],
-                },
+            .map(|(a, &angle_deg)| {
+                if angles.has(a) {
+                    found.next().expect("a mask per chosen angle")
+                } else {
+                    AngleMask {
+                        angle_deg,
+                        mask: vec![0; spec.len()],
+                        placed: 0,
+                        colliding: 0,
+                        probes_met: vec![false; blind_count],
+                    }
+                }
             })
             .collect();
         progress.end();

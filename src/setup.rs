@@ -5,9 +5,8 @@
 //! anything is allocated. Then the one sampling stage every pipeline runs
 //! (the analysis, the studies' grids at every pitch, the benchmark; the
 //! verification's half- and quarter-pitch bands of one start aside):
-//! [`Setup::lay`] and
-//! [`Setup::sample_on`] give the height grid and the slide's footprints,
-//! [`Sampled`].
+//! [`Setup::lay`] and [`Setup::sample_on`] give the height grid and the
+//! slide's footprints, [`Sampled`].
 
 use crate::engine::Algorithm;
 use crate::frame::Approach;

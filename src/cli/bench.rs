@@ -13,10 +13,9 @@ use std::time::Instant;
 use anyhow::{Context, ensure};
 use kneeform::grid::GridSpec;
 use kneeform::scenario::{self, PAPER_TRIANGLES};
+use kneeform::setup::Sampled;
 use kneeform::strike::RateEstimate;
-use kneeform::{
-    Algorithm, EngineOptions, GridFootprint, GridPlacement, KneeForm, Setup, colliding_masks,
-};
+use kneeform::{Algorithm, EngineOptions, GridFootprint, Setup, colliding_masks};
 
 use super::args::BenchArgs;
 
@@ -38,7 +37,6 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         args.paper_rows >= 1 && args.paper_angles >= 1,
         "--paper-rows and --paper-angles must be at least 1"
     );
-    let knee = KneeForm::default();
     let angles = super::args::parse_angles(&args.angles.angles)?;
     let t = Instant::now();
     let console = scenario::builtin("console").context("the console is a built-in scenario")?;
@@ -50,17 +48,13 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         |[lo, hi]: [f64; 2], n: usize| lo + (hi - lo - (n - 1) as f64 * PAPER_PITCH) / 2.0;
     let origin = [centred(console.extent.x, nx), centred(console.extent.z, nz)];
     let spec = GridSpec::explicit(origin[0], origin[1], nx, nz, PAPER_PITCH);
+    // The default knee-form at the angles asked for; the grid is `spec`,
+    // handed to the sampling stage.
     let setup = Setup {
         pitch: PAPER_PITCH,
-        knee,
         angles,
-        grid: GridPlacement::Explicit {
-            origin,
-            size: PAPER_GRID,
-        },
         ..Setup::default()
     };
-    let footprints: Vec<GridFootprint> = setup.footprints(&spec);
     let fast = EngineOptions::default();
 
     let mut sample_s = Vec::new();
@@ -75,11 +69,18 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     };
     let mut x_slope_s = Vec::new();
     let mut grid = None;
+    let mut footprints = Vec::new();
     let mut composite_nodes = 0;
     for run in 0..args.runs {
-        let sampled = setup.sample_on(spec, &triangles, None);
-        let g = sampled.grid;
-        sample_s.push(sampled.sample_s);
+        // The sampling stage: the heights and the footprints.
+        let Sampled {
+            grid: g,
+            footprints: laid,
+            sample_s: s,
+            ..
+        } = setup.sample_on(spec, &triangles, None);
+        footprints = laid;
+        sample_s.push(s);
         let t = Instant::now();
         blind_count =
             kneeform::blind::blind_spots(&triangles, &g, Setup::DEFAULT_BLIND_DEPTH).len();

@@ -438,9 +438,9 @@ impl<'a> DirectMethod<'a> {
         let (positions, placed) = match selection {
             StartSelection::At(given) => (given.clone(), given.len()),
             _ => {
-                let placed = placed_nodes(grid, &footprints(&setup, spec.pitch));
+                let on_part = placed_nodes(grid, &footprints(&setup, spec.pitch));
                 let nodes: Vec<(usize, usize)> = (0..spec.len())
-                    .filter(|&n| placed[n])
+                    .filter(|&n| on_part[n])
                     .map(|n| (n % spec.nx, n / spec.nx))
                     .collect();
                 let placed = nodes.len();

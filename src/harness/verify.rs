@@ -19,8 +19,7 @@ use crate::grid::{GridSpec, HeightGrid};
 use crate::input::PartFile;
 use crate::kneeform::{GridFootprint, KneeForm};
 use crate::mesh::Triangle;
-use crate::setup::GIB;
-use crate::setup::Setup;
+use crate::setup::{GIB, Setup};
 
 /// How to verify, beside the analysis [`Setup`].
 #[derive(Debug, Clone, PartialEq)]
