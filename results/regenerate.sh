@@ -108,11 +108,16 @@ import json, os, sys
 out = sys.argv[1]
 
 def named(d, metric, value):
-    """The mechanism verify.json names for `metric` at `value`, or ''."""
+    """The mechanism verify.json names for `metric` at `value`, or ''
+    (an infinite value is null in verify.json)."""
     for f in d["failures"]:
-        if f["metric"] == metric and abs(f["value"] - value) < 1e-9:
+        same = f["value"] == value if None in (f["value"], value) else abs(f["value"] - value) < 1e-9
+        if f["metric"] == metric and same:
             return f" ({f['mechanism']})"
     return ""
+
+def mm(v):
+    return "inf" if v is None else f"{v:.3f}"
 
 rows = ["| angle (deg) | verdict | decided area miss (mm) | decided area false alarm (mm) "
         "| decided miss per start (max, p95; mm) | oracle (s) | comparison (s) |",
@@ -125,9 +130,9 @@ for angle in range(-30, 31):
     pm = m["miss_distance_decided"]
     rows.append(
         f"| {angle} | {'PASS' if d['pass'] else 'FAIL'} "
-        f"| {am:.3f}{named(d, 'area_miss_distance_decided', am)} "
-        f"| {af:.3f}{named(d, 'area_false_alarm_distance_decided', af)} "
-        f"| {pm['max']:.3f}{named(d, 'miss_distance_decided', pm['max'])}, {pm['p95']:.3f} "
+        f"| {mm(am)}{named(d, 'area_miss_distance_decided', am)} "
+        f"| {mm(af)}{named(d, 'area_false_alarm_distance_decided', af)} "
+        f"| {mm(pm['max'])}{named(d, 'miss_distance_decided', pm['max'])}, {mm(pm['p95'])} "
         f"| {t['oracle_s']:.1f} | {t['grid_s']:.1f} |")
 readme = os.path.join(out, "README.md")
 lines = open(readme).read().split("\n")
