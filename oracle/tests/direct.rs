@@ -3,7 +3,7 @@
 //! along -x, on a smooth part facing +x at two coarse pitches: both
 //! metrics within a bound that halves with the pitch.
 
-use kneeform::harness::{ConvergeOptions, StartSelection, Study, StudyOptions, study};
+use kneeform::harness::{ConvergeOptions, DirectConvergence, StartSelection, StudyOptions, study};
 use kneeform::{Approach, Part, PartFile, Setup};
 
 mod util;
@@ -45,11 +45,10 @@ fn grid_and_exact_direct_contacts_agree_within_a_bound_that_shrinks_with_the_pit
         tolerance: None,
         budget_s: None,
     };
-    let Study::ConvergeDirect(study) =
-        study(&input, &setup, StudyOptions::Converge(&options), &()).unwrap()
-    else {
-        panic!("the direct approach's convergence study");
-    };
+    let study = study(&input, &setup, StudyOptions::Converge(&options), &())
+        .unwrap()
+        .downcast::<DirectConvergence>()
+        .expect("the direct approach's convergence study");
     assert_eq!(study.summary.approach, "direct");
     assert_eq!(study.results.len(), 2);
     let mut worst = Vec::new();

@@ -103,20 +103,8 @@ pub fn run_study(
     let result = harness::study(&input, &setup, options, &bars).map_err(harness_error)?;
     // A convergence study says how long its one oracle run took (a merge
     // sums its shards').
-    match &result {
-        harness::Study::Converge(c) => eprintln!(
-            "exact oracle: {} starts x {} angles in {:.1} s",
-            c.summary.starts,
-            setup.angles.len(),
-            c.oracle_s
-        ),
-        harness::Study::ConvergeDirect(c) => eprintln!(
-            "exact oracle (direct): {} positions x {} angles in {:.1} s",
-            c.summary.starts,
-            setup.angles.len(),
-            c.summary.oracle_s
-        ),
-        _ => {}
+    if let Some(line) = result.oracle_line(setup.angles.len()) {
+        eprintln!("{line}");
     }
     kneeform::output::write_study(out, &result)?;
     Ok(study::print_study(&result, out))

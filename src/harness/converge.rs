@@ -360,7 +360,7 @@ impl<'a> Ladder<'a> {
         progress.end();
         let part = PitchPart {
             pitch: p,
-            pairs: Pairs::Slide(Vec::new()),
+            pairs: Pairs::of(Vec::<PairResult>::new()),
             band: TieBand::new(self.compare.rule.sigma, p, self.compare.tie_band_per_mm),
             grid_s,
             seconds,
@@ -413,7 +413,7 @@ impl Method for Ladder<'_> {
     fn pitch(&mut self, at: Pitch, progress: &dyn Progress) -> Result<PitchPart, HarnessError> {
         let (pairs, pitch, _, _) = self.measure_raw(at, progress)?;
         Ok(PitchPart {
-            pairs: Pairs::Slide(pairs),
+            pairs: Pairs::of(pairs),
             ..pitch
         })
     }

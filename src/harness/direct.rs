@@ -41,12 +41,19 @@ use kneeform_oracle::{DirectOptions, DirectStatus, DirectTrace, KneeFormDims};
 use serde::{Deserialize, Serialize};
 
 use super::HarnessError;
+use super::approach::{
+    Said, ShareKnown, Study, StudyApproach, StudyFile, StudyOptions, StudyResult,
+};
+use super::codec::{Reader, put_opt, put_u64};
 use super::compare::{StartSelection, choose_nodes, node_at};
 use super::converge::{Fit, fit_power_law};
 use super::method::{Laid, Method, Pitch, Tracing, sampled_at, spec_at};
 use super::metrics::{nearest_rank, sorted_abs};
-pub(crate) use super::pairs::{DirectPair, DirectRow};
-use super::pairs::{NO_BAND, Pairs, PitchPart};
+use super::pairs::{NO_BAND, Pair, Pairs, PitchPart, read_each};
+use super::sharded::{
+    KnownSummary, StudyKind, StudyPart, StudySummary, merged_pitches, only, oracle_s, read_summary,
+};
+use super::trace::Fault;
 use super::{ConvergeOptions, VerifyOptions};
 use crate::analysis::Progress;
 use crate::direct::{DirectFootprint, contact_levels};
@@ -55,8 +62,10 @@ use crate::frame::to_direct;
 use crate::grid::HeightGrid;
 use crate::input::PartFile;
 use crate::kneeform::KneeForm;
+use crate::limits::short;
 use crate::mesh::{Part, Triangle};
 use crate::setup::{Sampled, Setup};
+use std::path::Path;
 
 /// The metrics of the direct approach, in the order of `converge.csv`.
 pub const DIRECT_METRICS: [&str; 2] = ["level_error", "contact_distance"];
@@ -519,7 +528,7 @@ impl Method for DirectMethod<'_> {
         })?;
         Ok(PitchPart {
             pitch: p,
-            pairs: Pairs::Direct(pairs),
+            pairs: Pairs::of(pairs),
             band: NO_BAND,
             grid_s,
             seconds: 0.0,
@@ -746,6 +755,413 @@ impl DirectConvergeSummary {
     }
 }
 
+/// One position at one angle: both sides' first contacts and the errors.
+/// Positions and points in mm, in the placed part's frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DirectRow {
+    /// The position's y (the centre of the knee-form's width).
+    pub y: f64,
+    /// The position's z (the reference point's height).
+    pub z: f64,
+    /// Angle (degrees).
+    pub angle_deg: f64,
+    /// `both`, `grid_only`, `exact_only`, `neither` or `oracle_failed`.
+    pub status: String,
+    /// The grid's `X* = -Y*` (the reference point's x at first contact).
+    pub grid_level: Option<f64>,
+    /// The exact `X*`.
+    pub exact_level: Option<f64>,
+    /// `|Y*_grid - Y*_exact|`.
+    pub level_error: Option<f64>,
+    /// The exact contact point's y and z.
+    pub exact_y: Option<f64>,
+    /// See `exact_y`.
+    pub exact_z: Option<f64>,
+    /// From the exact contact to the nearest grid-contacted node, in y-z.
+    pub contact_distance: Option<f64>,
+    /// Grid-contacted nodes (ties within `e0`).
+    pub grid_contacted: usize,
+    /// Exact contact points (ties within `e0` of travel).
+    pub exact_ties: usize,
+}
+
+/// One position at one angle as a shard keeps it: its row, and whether
+/// the engine's level there is not the transcription's (which the row
+/// does not say). A comparison is [`assemble_direct`]d from these alone.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DirectPair {
+    /// The row.
+    pub row: DirectRow,
+    /// The engine's level differs from the transcription's, to the bit.
+    pub engine_mismatch: bool,
+}
+
+/// A direct pair in `shard.bin`: its row's status, levels, contact and
+/// counts, and whether the engine's level differed; the position and
+/// angle are the shard's ([`read_direct_pair`] is given them).
+impl Pair for DirectPair {
+    fn put(&self, out: &mut Vec<u8>) {
+        let pair = self;
+        let r = &pair.row;
+        let status = DIRECT_STATUSES
+            .iter()
+            .position(|s| *s == r.status)
+            .unwrap_or(DIRECT_STATUSES.len());
+        out.push(status as u8);
+        for v in [
+            r.grid_level,
+            r.exact_level,
+            r.level_error,
+            r.exact_y,
+            r.exact_z,
+            r.contact_distance,
+        ] {
+            put_opt(out, v);
+        }
+        put_u64(out, r.grid_contacted as u64);
+        put_u64(out, r.exact_ties as u64);
+        out.push(u8::from(pair.engine_mismatch));
+    }
+}
+
+/// A direct pair as [`DirectPair`]'s [`Pair::put`] wrote it, of the
+/// position `[y, z]` at `angle_deg`.
+fn read_direct_pair(
+    r: &mut Reader,
+    [y, z]: [f64; 2],
+    angle_deg: f64,
+) -> Result<DirectPair, String> {
+    let status = r.u8()?;
+    let status = DIRECT_STATUSES
+        .get(usize::from(status))
+        .ok_or(format!("a direct status {status}"))?;
+    let mut row = DirectRow {
+        y,
+        z,
+        angle_deg,
+        status: (*status).into(),
+        grid_level: r.opt()?,
+        exact_level: r.opt()?,
+        level_error: r.opt()?,
+        exact_y: r.opt()?,
+        exact_z: r.opt()?,
+        contact_distance: r.opt()?,
+        grid_contacted: 0,
+        exact_ties: 0,
+    };
+    row.grid_contacted = r.len()?;
+    row.exact_ties = r.len()?;
+    let engine_mismatch = match r.u8()? {
+        0 => false,
+        1 => true,
+        b => return Err(format!("an engine mismatch flag {b}")),
+    };
+    Ok(DirectPair {
+        row,
+        engine_mismatch,
+    })
+}
+
+/// The direct approach's studies: what the one study path
+/// ([`super::study`]) asks of it.
+pub(crate) struct Direct;
+
+impl StudyApproach for Direct {
+    fn kind_word(&self, kind: StudyKind) -> &'static str {
+        match kind {
+            StudyKind::Verify => "verify-direct",
+            StudyKind::Converge => "converge-direct",
+        }
+    }
+
+    fn shard_words(&self, kind: StudyKind) -> &'static str {
+        match kind {
+            StudyKind::Verify => {
+                "a direct-approach verification (verify --approach direct --shard)"
+            }
+            StudyKind::Converge => {
+                "a direct-approach convergence study (converge --approach direct --shard)"
+            }
+        }
+    }
+
+    fn lay<'a>(
+        &self,
+        input: &'a PartFile,
+        coarse: &Setup,
+        options: StudyOptions,
+        _fault: Option<Fault>,
+    ) -> Result<Box<dyn Method + 'a>, HarnessError> {
+        Ok(Box::new(DirectMethod::lay(
+            input,
+            coarse,
+            options.selection(),
+        )?))
+    }
+
+    fn summary_as_known(&self, share: ShareKnown) -> StudySummary {
+        let ShareKnown {
+            input,
+            setup,
+            options,
+            starts,
+            parts,
+            oracle_s,
+            ..
+        } = share;
+        match options {
+            StudyOptions::Verify(o) => {
+                let mut s = DirectVerifySummary::new(input, setup, o);
+                s.grid_s = parts.first().map_or(0.0, |p| p.grid_s);
+                s.oracle_s = oracle_s;
+                StudySummary::new(Approach::Direct, StudyKind::Verify, s)
+            }
+            StudyOptions::Converge(o) => {
+                let s = DirectConvergeSummary::new(input, setup, o, starts, oracle_s);
+                StudySummary::new(Approach::Direct, StudyKind::Converge, s)
+            }
+        }
+    }
+
+    fn summary_from_json(
+        &self,
+        kind: StudyKind,
+        json: serde_json::Value,
+    ) -> Result<Box<dyn KnownSummary>, String> {
+        match kind {
+            StudyKind::Verify => read_summary::<DirectVerifySummary>(json),
+            StudyKind::Converge => read_summary::<DirectConvergeSummary>(json),
+        }
+    }
+
+    fn merged_fields(&self, kind: StudyKind) -> serde_json::Value {
+        match kind {
+            StudyKind::Verify => serde_json::json!({
+                "pass": false,
+                "metrics": {},
+                "counts": DirectCounts::default(),
+            }),
+            StudyKind::Converge => serde_json::json!({
+                "fits": {},
+                "fits_median": {},
+                "recommended_pitch_mm": null,
+            }),
+        }
+    }
+
+    fn clock_fields(&self, kind: StudyKind) -> &'static [&'static str] {
+        match kind {
+            StudyKind::Verify => &["grid_s", "oracle_s"],
+            StudyKind::Converge => &["oracle_s"],
+        }
+    }
+
+    fn read_pairs(
+        &self,
+        r: &mut Reader,
+        count: usize,
+        at: &dyn Fn(usize) -> ([f64; 2], f64),
+    ) -> Result<Pairs, String> {
+        read_each(count, |k| {
+            let (position, angle) = at(k);
+            read_direct_pair(r, position, angle)
+        })
+    }
+
+    fn merge(&self, summary: StudySummary, parts: &mut [StudyPart]) -> Option<Study> {
+        let oracle_s = oracle_s(parts);
+        let results = merged_pitches(parts, |clocks, pairs| DirectPitchResult {
+            pitch: clocks.pitch,
+            comparison: assemble_direct(pairs, clocks.grid_s),
+            nodes: clocks.nodes,
+        })?;
+        Some(match summary.kind {
+            StudyKind::Verify => {
+                let mut summary = summary.take::<DirectVerifySummary>()?;
+                let result = only(results)?;
+                summary.set_comparison(&result.comparison, oracle_s);
+                Study::of(DirectVerification {
+                    comparison: result.comparison,
+                    summary,
+                })
+            }
+            StudyKind::Converge => {
+                let mut summary = summary.take::<DirectConvergeSummary>()?;
+                summary.oracle_s = oracle_s;
+                summary.set_results(&results);
+                Study::of(DirectConvergence { results, summary })
+            }
+        })
+    }
+}
+
+impl KnownSummary for DirectVerifySummary {
+    fn angles_and_pitches(&self) -> (&[f64], Vec<f64>) {
+        (&self.angles_deg, vec![self.pitch_mm])
+    }
+}
+
+impl KnownSummary for DirectConvergeSummary {
+    fn angles_and_pitches(&self) -> (&[f64], Vec<f64>) {
+        (&self.angles_deg, self.pitches_mm.clone())
+    }
+}
+
+/// A direct verification's files: `verify.csv` (one row per position and
+/// angle) and `verify.json` (`"approach": "direct"`).
+impl StudyResult for DirectVerification {
+    fn files(&self) -> Vec<StudyFile<'_>> {
+        StudyFile::verification(&self.comparison.rows, &self.summary)
+    }
+
+    fn said(&self, out: &Path) -> Said {
+        verification_said(self, out)
+    }
+}
+
+/// A direct convergence study's files: `converge.csv` (both metrics at
+/// every pitch), `verify_<pitch>mm.csv` (each pitch's rows) and
+/// `converge.json` (`"approach": "direct"`).
+impl StudyResult for DirectConvergence {
+    fn files(&self) -> Vec<StudyFile<'_>> {
+        let tolerance = self.summary.tolerance_mm;
+        let results = &self.results;
+        let table = move |csv: &mut csv::Writer<&mut dyn std::io::Write>| {
+            csv.write_record([
+                "approach",
+                "pitch_mm",
+                "metric",
+                "max",
+                "p95",
+                "median",
+                "mean",
+                "n",
+                "both",
+                "grid_only",
+                "exact_only",
+                "oracle_failed",
+                "engine_mismatch",
+                "pass",
+            ])?;
+            for r in results {
+                let c = &r.comparison.counts;
+                let pass = tolerance.map_or(String::new(), |t| r.comparison.passes(t).to_string());
+                for (metric, s) in &r.comparison.stats {
+                    csv.write_record([
+                        "direct".to_string(),
+                        r.pitch.to_string(),
+                        metric.clone(),
+                        s.max.to_string(),
+                        s.p95.to_string(),
+                        s.median.to_string(),
+                        s.mean.to_string(),
+                        s.n.to_string(),
+                        c.both.to_string(),
+                        c.grid_only.to_string(),
+                        c.exact_only.to_string(),
+                        c.oracle_failed.to_string(),
+                        c.engine_mismatch.to_string(),
+                        pass.clone(),
+                    ])?;
+                }
+            }
+            Ok(())
+        };
+        let pitches = results.iter().map(|r| (r.pitch, &r.comparison.rows[..]));
+        StudyFile::convergence(table, pitches, &self.summary)
+    }
+
+    fn said(&self, out: &Path) -> Said {
+        convergence_said(self, out)
+    }
+
+    fn oracle_line(&self, angles: usize) -> Option<String> {
+        Some(format!(
+            "exact oracle (direct): {} positions x {} angles in {:.1} s",
+            self.summary.starts, angles, self.summary.oracle_s
+        ))
+    }
+}
+
+/// What a direct verification says: its statistics, counts and verdict
+/// (its results are in `out`); it passes as its summary does.
+fn verification_said(result: &DirectVerification, out: &Path) -> Said {
+    let s = &result.summary;
+    let mut lines = Vec::new();
+    for name in DIRECT_METRICS {
+        let stats = &s.metrics[name];
+        lines.push(format!(
+            "{name:>16}: max {:.4}  p95 {:.4}  median {:.4} mm  (n = {})",
+            stats.max, stats.p95, stats.median, stats.n
+        ));
+    }
+    let c = &s.counts;
+    lines.push(format!(
+        "{:>16}: {} position-angle pairs, {} touched on both sides, {} on the grid only, {} exactly only, {} oracle failures, {} engine levels unlike the harness's",
+        "positions",
+        c.compared,
+        c.both,
+        c.grid_only,
+        c.exact_only,
+        c.oracle_failed,
+        c.engine_mismatch
+    ));
+    let verdict = if s.pass { "PASS" } else { "FAIL" };
+    lines.push(format!(
+        "kneeform: {verdict} (direct approach) at tolerance {} mm; results in {}",
+        crate::limits::short(s.tolerance_mm),
+        out.display()
+    ));
+    Said {
+        lines,
+        pass: s.pass,
+    }
+}
+
+/// What a direct convergence study says: its errors per pitch, fitted
+/// orders and the pitch it recommends (its results are in `out`).
+fn convergence_said(study: &DirectConvergence, out: &Path) -> Said {
+    let mut lines = Vec::new();
+    for r in &study.results {
+        let c = &r.comparison;
+        let stats: Vec<String> = c
+            .stats
+            .iter()
+            .map(|(m, s)| format!("{m} max {:.4} median {:.4}", s.max, s.median))
+            .collect();
+        lines.push(format!(
+            "p = {:>6} mm: {} | {} both, {} grid only, {} exact only, {} failed, {} engine mismatches",
+            r.pitch,
+            stats.join(", "),
+            c.counts.both,
+            c.counts.grid_only,
+            c.counts.exact_only,
+            c.counts.oracle_failed,
+            c.counts.engine_mismatch
+        ));
+    }
+    for (m, f) in &study.summary.fits {
+        lines.push(format!("{m:>16}: max error ~ {:.3} p^{:.2}", f.c, f.alpha));
+    }
+    match (
+        study.summary.tolerance_mm,
+        study.summary.recommended_pitch_mm,
+    ) {
+        (Some(t), Some(p)) => lines.push(format!(
+            "kneeform: the coarsest pitch within {} mm is {} mm",
+            short(t),
+            short(p)
+        )),
+        (Some(t), None) => lines.push(format!(
+            "kneeform: no pitch tried is within {} mm",
+            short(t)
+        )),
+        _ => {}
+    }
+    lines.push(format!("kneeform: results in {}", out.display()));
+    Said { lines, pass: true }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -804,5 +1220,57 @@ mod tests {
             (4.0, 4.0, 2.0, 2.5, 4)
         );
         assert_eq!(DirectStats::of(&[]), DirectStats::default());
+    }
+}
+
+#[cfg(test)]
+mod pair_tests {
+    use super::*;
+    use crate::harness::codec::Reader;
+
+    #[test]
+    fn a_direct_pair_reads_back_bit_for_bit_and_a_cut_one_is_an_error() {
+        let p = DirectPair {
+            row: DirectRow {
+                y: 12.0,
+                z: -4.0,
+                angle_deg: 30.0,
+                status: "both".into(),
+                grid_level: Some(-0.0),
+                exact_level: Some(0.1 + 0.2),
+                level_error: Some(f64::MIN_POSITIVE),
+                exact_y: Some(11.5),
+                exact_z: None,
+                contact_distance: Some(f64::INFINITY),
+                grid_contacted: 7,
+                exact_ties: 2,
+            },
+            engine_mismatch: true,
+        };
+        let mut bin = Vec::new();
+        p.put(&mut bin);
+        let mut r = Reader::new(&bin);
+        let back = read_direct_pair(&mut r, [12.0, -4.0], 30.0).unwrap();
+        assert_eq!(r.at, bin.len());
+        assert_eq!(back, p);
+        // PartialEq on f64 would take -0.0 for 0.0: compare the bits too.
+        assert_eq!(
+            back.row.grid_level.map(f64::to_bits),
+            Some((-0.0f64).to_bits())
+        );
+        for end in 0..bin.len() {
+            let mut r = Reader::new(&bin[..end]);
+            assert!(
+                read_direct_pair(&mut r, [0.0, 0.0], 0.0).is_err(),
+                "cut at {end}"
+            );
+        }
+        // An unknown status, an unknown flag.
+        let mut bad = bin.clone();
+        bad[0] = DIRECT_STATUSES.len() as u8;
+        assert!(read_direct_pair(&mut Reader::new(&bad), [0.0, 0.0], 0.0).is_err());
+        let mut bad = bin.clone();
+        *bad.last_mut().unwrap() = 2;
+        assert!(read_direct_pair(&mut Reader::new(&bad), [0.0, 0.0], 0.0).is_err());
     }
 }

@@ -11,7 +11,7 @@ use crate::setup::{Sampled, Setup};
 
 /// What [`Method::trace`] traces, and within what time.
 #[derive(Debug, Clone, Default)]
-pub(super) struct Tracing {
+pub(crate) struct Tracing {
     /// The starts (some of [`Method::all_starts`], in their order).
     pub share: Vec<[f64; 2]>,
     /// The finest pitch the traces must resolve (mm).
@@ -30,7 +30,7 @@ pub(super) struct Tracing {
 
 /// The memory a study's traces and comparisons may take.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct MemoryLimit {
+pub(crate) struct MemoryLimit {
     /// Bytes allowed (`--max-memory`; the machine's memory is checked
     /// too).
     pub bytes: f64,
@@ -40,7 +40,7 @@ pub(super) struct MemoryLimit {
 
 /// One pitch of a study, as [`Method::pitch`] compares it.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Pitch {
+pub(crate) struct Pitch {
     /// The pitch (mm, dividing the coarsest).
     pub p: f64,
     /// Whether it is one of a convergence study's pitches: a stage named
@@ -83,7 +83,7 @@ pub(super) fn sampled_at(
 
 /// The coarsest grid of a study and its starts, as a [`Method`] lays them.
 #[derive(Debug, Clone)]
-pub(super) struct Laid {
+pub(crate) struct Laid {
     /// The coarsest grid (the study's starts are its nodes).
     pub coarse: GridSpec,
     /// Every start of the study (mm), in its order.
@@ -97,7 +97,7 @@ pub(super) struct Laid {
 /// side and its pairs. The study's steps, in order: the coarsest grid
 /// and the starts laid ([`Method::laid`]), [`Method::trace`] on a share
 /// of them, then [`Method::pitch`] at each pitch, coarsest first.
-pub(super) trait Method {
+pub(crate) trait Method {
     /// The coarsest grid and the study's starts on it, as laid.
     fn laid(&self) -> &Laid;
     /// Takes the exact side of `what.share` at the study's angles,

@@ -20,8 +20,11 @@
 //! * `nearest`: a 2-d tree for the area distance's nearest points;
 //! * `pairs`: what a study compares per start and angle, and per pitch,
 //!   for either approach, and a shard's share of the starts;
-//! * `method`: what a study does its own way per approach (the `Method`
-//!   trait, which `converge::Ladder` and `direct::DirectMethod` implement);
+//! * `approach`: what a study does its own way per approach (the
+//!   `StudyApproach` trait: its steps, a `method::Method`, its summaries,
+//!   its pairs in a shard's file, its merge, its files and words), which
+//!   `slide` (push-and-slide) and `direct` implement;
+//! * `codec`: the bits of a shard's `shard.bin`;
 //! * `study`: the one path every study takes, verify or converge, either
 //!   approach, whole or one shard's share ([`study()`], [`study_shard`]),
 //!   and the merge of shares;
@@ -35,9 +38,11 @@
 //! travel (it keeps each node's reach). It is a direct transcription of
 //! SPEC, tested equal to the engine's masks on every start.
 
+pub(crate) mod approach;
 pub(crate) mod auto;
 pub(crate) mod causes;
 pub(crate) mod check;
+pub(crate) mod codec;
 pub(crate) mod compare;
 pub(crate) mod converge;
 pub(crate) mod direct;
@@ -46,6 +51,7 @@ pub(crate) mod metrics;
 pub(crate) mod nearest;
 pub(crate) mod pairs;
 pub(crate) mod sharded;
+pub(crate) mod slide;
 pub(crate) mod study;
 pub(crate) mod trace;
 pub(crate) mod verify;
@@ -53,6 +59,7 @@ pub(crate) mod verify;
 #[cfg(test)]
 mod fault_tests;
 
+pub use approach::{Said, Study, StudyOptions};
 pub use auto::{AutoPitch, choose_pitch};
 pub use causes::Mechanism;
 pub use check::check_analysis;
@@ -60,8 +67,28 @@ pub use compare::{Comparison, StartSelection};
 pub use converge::{ConvergeOptions, Convergence, ROUNDING_MM, fit_power_law};
 pub use direct::{DIRECT_METRICS, DirectConvergence, DirectVerification};
 pub use metrics::{DECIDED_METRICS, METRICS, TieBand};
-pub use sharded::StudyPart;
-pub use study::{Study, StudyOptions, converge, study, study_shard, verify};
+pub use sharded::{StudyKind, StudyPart};
+pub use study::{converge, study, study_shard, verify};
+
+/// Each approach's studies ([`approach::StudyApproach`]): the one place
+/// that names them. A new approach is its variant of
+/// [`crate::Approach`], its own module, and its line here.
+pub(crate) fn studies_of(approach: crate::Approach) -> &'static dyn approach::StudyApproach {
+    match approach {
+        crate::Approach::Slide => &slide::Slide,
+        crate::Approach::Direct => &direct::Direct,
+    }
+}
+
+/// The approach and study whose shards `shard.json` names `word`.
+pub(crate) fn study_named(word: &str) -> Option<(crate::Approach, StudyKind)> {
+    crate::Approach::ALL.into_iter().find_map(|a| {
+        [StudyKind::Verify, StudyKind::Converge]
+            .into_iter()
+            .find(|&k| studies_of(a).kind_word(k) == word)
+            .map(|k| (a, k))
+    })
+}
 pub use verify::{Verification, VerifyOptions, oracle_options, sampling_tolerance};
 
 use serde::{Deserialize, Serialize};

@@ -1,31 +1,66 @@
 //! What a study compares, per start (or position) and angle and per
-//! pitch, for either approach: the leaf the study modules (`verify`,
-//! `converge`, `direct`) and the shards (`sharded`) share, so that none of
-//! them depends on another for these.
+//! pitch, whatever its approach: the leaf the approaches (`slide`,
+//! `direct`) and the shares (`sharded`) share, so that none of them
+//! depends on another for these.
 
-use serde::{Deserialize, Serialize};
+use std::any::Any;
 
 use super::HarnessError;
-use super::compare::PairResult;
 use super::metrics::TieBand;
 use crate::partition::Shard;
 
-/// The pairs of one pitch of a share, angle-major over the share's starts.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Pairs {
-    /// Push-and-slide's start-angle pairs.
-    Slide(Vec<PairResult>),
-    /// The direct approach's position-angle pairs.
-    Direct(Vec<DirectPair>),
+/// One pair of a study (a start or a position at one angle) as a shard
+/// keeps it: all its comparison is assembled from. Each approach has its
+/// own ([`super::compare::PairResult`] for push-and-slide,
+/// [`super::direct::DirectPair`] for the direct approach), and encodes it
+/// in a shard's `shard.bin` itself.
+pub(crate) trait Pair: std::fmt::Debug + Clone + PartialEq + Send + Sync + 'static {
+    /// Appends the pair's bits to `bin`; its approach's `read_pairs` reads
+    /// them back (`super::approach::StudyApproach`).
+    fn put(&self, bin: &mut Vec<u8>);
 }
 
+/// The pairs of one pitch of a share as [`Pairs`] holds them, whatever
+/// their approach.
+trait PairSet: Any + std::fmt::Debug + Send + Sync {
+    fn len(&self) -> usize;
+    fn put(&self, bin: &mut Vec<u8>);
+    fn boxed_clone(&self) -> Box<dyn PairSet>;
+    fn same(&self, other: &dyn PairSet) -> bool;
+}
+
+impl<T: Pair> PairSet for Vec<T> {
+    fn len(&self) -> usize {
+        Vec::len(self)
+    }
+
+    fn put(&self, bin: &mut Vec<u8>) {
+        self.iter().for_each(|pair| pair.put(bin));
+    }
+
+    fn boxed_clone(&self) -> Box<dyn PairSet> {
+        Box::new(self.clone())
+    }
+
+    fn same(&self, other: &dyn PairSet) -> bool {
+        (other as &dyn Any).downcast_ref::<Vec<T>>() == Some(self)
+    }
+}
+
+/// The pairs of one pitch of a share, angle-major over the share's
+/// starts, of whichever approach compared them.
+#[derive(Debug)]
+pub struct Pairs(Box<dyn PairSet>);
+
 impl Pairs {
+    /// `pairs`, as a share holds them.
+    pub(crate) fn of<T: Pair>(pairs: Vec<T>) -> Pairs {
+        Pairs(Box::new(pairs))
+    }
+
     /// How many pairs.
     pub fn len(&self) -> usize {
-        match self {
-            Pairs::Slide(p) => p.len(),
-            Pairs::Direct(p) => p.len(),
-        }
+        self.0.len()
     }
 
     /// Whether there is none.
@@ -33,20 +68,42 @@ impl Pairs {
         self.len() == 0
     }
 
-    /// Push-and-slide's pairs (`None` for the direct approach's).
-    pub(super) fn slide_mut(&mut self) -> Option<&mut Vec<PairResult>> {
-        match self {
-            Pairs::Slide(p) => Some(p),
-            Pairs::Direct(_) => None,
-        }
+    /// Appends every pair's bits to `bin`, in order.
+    pub(crate) fn put(&self, bin: &mut Vec<u8>) {
+        self.0.put(bin);
     }
 
-    /// The direct approach's pairs (`None` for push-and-slide's).
-    pub(super) fn direct_mut(&mut self) -> Option<&mut Vec<DirectPair>> {
-        match self {
-            Pairs::Direct(p) => Some(p),
-            Pairs::Slide(_) => None,
-        }
+    /// The pairs moved out, when they are `T`s (`None` for another
+    /// approach's, which are left).
+    pub(crate) fn take<T: Pair>(&mut self) -> Option<Vec<T>> {
+        (self.0.as_mut() as &mut dyn Any)
+            .downcast_mut::<Vec<T>>()
+            .map(std::mem::take)
+    }
+}
+
+/// `count` pairs read one by one (pair `k` by `read(k)`), as [`Pairs`]: an
+/// approach's [`super::approach::StudyApproach::read_pairs`].
+pub(crate) fn read_each<T: Pair>(
+    count: usize,
+    mut read: impl FnMut(usize) -> Result<T, String>,
+) -> Result<Pairs, String> {
+    let mut pairs = Vec::with_capacity(count);
+    for k in 0..count {
+        pairs.push(read(k)?);
+    }
+    Ok(Pairs::of(pairs))
+}
+
+impl Clone for Pairs {
+    fn clone(&self) -> Pairs {
+        Pairs(self.0.boxed_clone())
+    }
+}
+
+impl PartialEq for Pairs {
+    fn eq(&self, other: &Pairs) -> bool {
+        self.0.same(other.0.as_ref())
     }
 }
 
@@ -91,45 +148,4 @@ pub(super) fn share(all: &[[f64; 2]], shard: Shard) -> Result<Vec<[f64; 2]>, Har
         .into_iter()
         .map(|s| all[s])
         .collect())
-}
-
-/// One position at one angle: both sides' first contacts and the errors.
-/// Positions and points in mm, in the placed part's frame.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct DirectRow {
-    /// The position's y (the centre of the knee-form's width).
-    pub y: f64,
-    /// The position's z (the reference point's height).
-    pub z: f64,
-    /// Angle (degrees).
-    pub angle_deg: f64,
-    /// `both`, `grid_only`, `exact_only`, `neither` or `oracle_failed`.
-    pub status: String,
-    /// The grid's `X* = -Y*` (the reference point's x at first contact).
-    pub grid_level: Option<f64>,
-    /// The exact `X*`.
-    pub exact_level: Option<f64>,
-    /// `|Y*_grid - Y*_exact|`.
-    pub level_error: Option<f64>,
-    /// The exact contact point's y and z.
-    pub exact_y: Option<f64>,
-    /// See `exact_y`.
-    pub exact_z: Option<f64>,
-    /// From the exact contact to the nearest grid-contacted node, in y-z.
-    pub contact_distance: Option<f64>,
-    /// Grid-contacted nodes (ties within `e0`).
-    pub grid_contacted: usize,
-    /// Exact contact points (ties within `e0` of travel).
-    pub exact_ties: usize,
-}
-
-/// One position at one angle as a shard keeps it: its row, and whether
-/// the engine's level there is not the transcription's (which the row
-/// does not say). A comparison is [`assemble_direct`]d from these alone.
-#[derive(Debug, Clone, PartialEq)]
-pub struct DirectPair {
-    /// The row.
-    pub row: DirectRow,
-    /// The engine's level differs from the transcription's, to the bit.
-    pub engine_mismatch: bool,
 }

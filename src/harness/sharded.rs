@@ -5,9 +5,10 @@
 //! ([`super::study::study_shard`]); [`super::study::merge`] puts the N
 //! shares back together into the study the unsharded command computes.
 //!
-//! A share ([`StudyPart`]) keeps every start-angle pair it compared as a
-//! [`super::compare::PairResult`] (the direct approach's position-angle
-//! pairs as a [`super::pairs::DirectPair`]): a comparison's statistics,
+//! A share ([`StudyPart`]) keeps every start-angle pair it compared as its
+//! approach's [`super::pairs::Pair`] (push-and-slide's
+//! [`super::compare::PairResult`], the direct approach's position-angle
+//! [`super::direct::DirectPair`]): a comparison's statistics,
 //! counts, area distances and worst starts are computed from those alone,
 //! so a merge that puts the pairs back in the unsharded order computes them
 //! exactly as the unsharded run does. The file format of a share is
@@ -18,32 +19,120 @@
 //! the unsharded run is itself the merge of its one share, shard 1/1;
 //! only clock readings differ.
 
+use std::any::Any;
+
 use super::compare::StartSelection;
-use super::converge::ConvergeSummary;
-use super::direct::{DirectConvergeSummary, DirectVerifySummary};
 use super::metrics::TieBand;
-use super::pairs::{Pairs, PitchPart};
-use super::verify::VerifySummary;
+use super::pairs::{Pair, PitchPart};
+use crate::frame::Approach;
 use crate::grid::GridSpec;
 use crate::partition::Shard;
+
+/// Which study: `verify` (one pitch) or `converge` (a ladder).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StudyKind {
+    /// `verify`.
+    Verify,
+    /// `converge`.
+    Converge,
+}
+
+/// A study's summary (`verify.json`, `converge.json`) as its approach
+/// types it: what the one study path, the shards and the merge hold
+/// without naming it.
+pub(crate) trait KnownSummary: Any + std::fmt::Debug + Send + Sync + SummaryRecord {
+    /// The study's angles (degrees) and pitches, coarsest first (mm), as
+    /// the summary records them.
+    fn angles_and_pitches(&self) -> (&[f64], Vec<f64>);
+}
+
+/// What every [`KnownSummary`] is as a record: written, read and copied
+/// as its type says (one implementation for all).
+pub(crate) trait SummaryRecord {
+    /// The summary as its file holds it.
+    fn to_json(&self) -> serde_json::Value;
+    /// A copy.
+    fn boxed_clone(&self) -> Box<dyn KnownSummary>;
+}
+
+impl<T: KnownSummary + serde::Serialize + Clone> SummaryRecord for T {
+    fn to_json(&self) -> serde_json::Value {
+        serde_json::to_value(self).unwrap_or_default()
+    }
+
+    fn boxed_clone(&self) -> Box<dyn KnownSummary> {
+        Box::new(self.clone())
+    }
+}
+
+/// The summary `T` read from its JSON (a shard's).
+pub(crate) fn read_summary<T: KnownSummary + serde::de::DeserializeOwned>(
+    json: serde_json::Value,
+) -> Result<Box<dyn KnownSummary>, String> {
+    let summary: T = serde_json::from_value(json).map_err(|e| e.to_string())?;
+    Ok(Box::new(summary))
+}
 
 /// A shard's summary: `verify.json` or `converge.json` as the shard knows
 /// it: the part's identity, every setting and the shard's own timings,
 /// with the statistics of no start (the merge computes them from every
-/// shard's pairs; `shard.json` leaves them out).
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(tag = "kind", content = "summary", rename_all = "lowercase")]
-pub enum StudySummary {
-    /// A verification's.
-    Verify(Box<VerifySummary>),
-    /// A convergence study's.
-    Converge(ConvergeSummary),
-    /// A direct verification's (`verify --approach direct`).
-    #[serde(rename = "verify-direct")]
-    VerifyDirect(DirectVerifySummary),
-    /// A direct convergence study's (`converge --approach direct`).
-    #[serde(rename = "converge-direct")]
-    ConvergeDirect(DirectConvergeSummary),
+/// shard's pairs; `shard.json` leaves them out). `shard.json` holds it as
+/// `{"kind": ..., "summary": ...}`, the kind its approach's word for the
+/// study (`verify`, `converge`, `verify-direct`, `converge-direct`).
+#[derive(Debug)]
+pub struct StudySummary {
+    /// Whose study.
+    pub(crate) approach: Approach,
+    /// Which study.
+    pub(crate) kind: StudyKind,
+    /// The summary, as the approach types it.
+    pub(crate) known: Box<dyn KnownSummary>,
+}
+
+impl StudySummary {
+    /// `known`, the summary of `approach`'s study `kind`.
+    pub(crate) fn new(approach: Approach, kind: StudyKind, known: impl KnownSummary) -> Self {
+        StudySummary {
+            approach,
+            kind,
+            known: Box::new(known),
+        }
+    }
+
+    /// The summary, when it is a `T` (`None` for another's).
+    pub(crate) fn take<T: KnownSummary>(self) -> Option<T> {
+        (self.known as Box<dyn Any>)
+            .downcast::<T>()
+            .ok()
+            .map(|t| *t)
+    }
+}
+
+impl Clone for StudySummary {
+    fn clone(&self) -> StudySummary {
+        StudySummary {
+            known: self.known.boxed_clone(),
+            ..*self
+        }
+    }
+}
+
+impl PartialEq for StudySummary {
+    fn eq(&self, other: &StudySummary) -> bool {
+        (self.approach, self.kind) == (other.approach, other.kind)
+            && self.known.to_json() == other.known.to_json()
+    }
+}
+
+impl serde::Serialize for StudySummary {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut record = s.serialize_struct("StudySummary", 2)?;
+        let word = super::studies_of(self.approach).kind_word(self.kind);
+        record.serialize_field("kind", word)?;
+        record.serialize_field("summary", &self.known.to_json())?;
+        record.end()
+    }
 }
 
 /// The options of a sharded study as given, beyond its summary: what
@@ -108,18 +197,14 @@ pub(super) fn study_settings(
 /// The pairs of pitch `k` of `parts` (every shard of one study exactly
 /// once, in shard order: `parts[K - 1]` is shard K's), moved out of them
 /// in the unsharded order: angle-major, then the study's start order.
-/// `pick` gives a share's pairs of the study's kind (`None` for another
-/// kind, which makes the merge `None`; so does a share short of pairs).
-pub(super) fn unsharded_pairs<T>(
-    parts: &mut [StudyPart],
-    k: usize,
-    pick: impl Fn(&mut Pairs) -> Option<&mut Vec<T>>,
-) -> Option<Vec<T>> {
+/// `None` when a share's pairs are not `T`s (another approach's) or it is
+/// short of pairs.
+pub(crate) fn unsharded_pairs<T: Pair>(parts: &mut [StudyPart], k: usize) -> Option<Vec<T>> {
     let (n, total) = (parts.len(), parts.first()?.starts.len());
     let angles = parts[0].angles_deg.len();
     let mut shares = parts
         .iter_mut()
-        .map(|p| Some(std::mem::take(pick(&mut p.pitches.get_mut(k)?.pairs)?).into_iter()))
+        .map(|p| Some(p.pitches.get_mut(k)?.pairs.take::<T>()?.into_iter()))
         .collect::<Option<Vec<_>>>()?;
     let whole = |p: &StudyPart, share: &std::vec::IntoIter<T>| {
         share.len() == p.shard.indices(total).len() * angles
@@ -142,7 +227,7 @@ pub(super) fn unsharded_pairs<T>(
 /// pitch, tie band and node count, the grid seconds summed over the
 /// shards, the engine's seconds (which every shard measures alike) their
 /// longest.
-pub(super) struct MergedClocks {
+pub(crate) struct MergedClocks {
     pub pitch: f64,
     pub band: TieBand,
     pub nodes: usize,
@@ -151,7 +236,7 @@ pub(super) struct MergedClocks {
 }
 
 /// [`MergedClocks`] of pitch `k` of the shares `parts`.
-pub(super) fn merged_clocks(parts: &[StudyPart], k: usize) -> MergedClocks {
+pub(crate) fn merged_clocks(parts: &[StudyPart], k: usize) -> MergedClocks {
     let first = &parts[0].pitches[k];
     MergedClocks {
         pitch: first.pitch,
@@ -166,6 +251,26 @@ pub(super) fn merged_clocks(parts: &[StudyPart], k: usize) -> MergedClocks {
 }
 
 /// The oracle's seconds summed over the shards.
-pub(super) fn oracle_s(parts: &[StudyPart]) -> f64 {
+pub(crate) fn oracle_s(parts: &[StudyPart]) -> f64 {
     parts.iter().map(|p| p.oracle_s).sum()
+}
+
+/// Every pitch of the shares `parts`, its pairs (`T`s: `None` for another
+/// approach's, which makes the merge `None`) moved back in the unsharded
+/// order and made a pitch's result by `result`.
+pub(crate) fn merged_pitches<T: Pair, R>(
+    parts: &mut [StudyPart],
+    result: impl Fn(MergedClocks, Vec<T>) -> R,
+) -> Option<Vec<R>> {
+    (0..parts.first()?.pitches.len())
+        .map(|k| {
+            let clocks = merged_clocks(parts, k);
+            Some(result(clocks, unsharded_pairs(parts, k)?))
+        })
+        .collect()
+}
+
+/// The one pitch of a verification (`None` for more or none).
+pub(crate) fn only<T>(mut results: Vec<T>) -> Option<T> {
+    results.pop().filter(|_| results.is_empty())
 }

@@ -4,108 +4,31 @@
 //!
 //! Every study runs as [`study_shard`]: it lays the coarsest grid and
 //! chooses the study's starts on it, takes the exact side of the share's
-//! starts, and compares every pitch's grid with it ([`Method`]); the
+//! starts, and compares every pitch's grid with it; the
 //! result is a [`StudyPart`]. The whole study ([`study`]) is the merge
 //! ([`merge`]) of its one share, shard 1/1, so the unsharded command and a
 //! merge of N shards compute every statistic in one place.
 //!
-//! What differs per approach is its [`Method`] (declared in the leaf
-//! `method`, so that this module alone calls down into the approaches):
-//! [`super::converge::Ladder`] for push-and-slide,
-//! [`super::direct::DirectMethod`] for the direct approach. What differs
-//! per study is its options ([`StudyOptions`]) and its summary; the four
-//! summaries (`verify.json` and `converge.json` of each approach) are made
-//! and set in [`summary_as_known`] and [`merge`].
+//! What differs per approach is its
+//! [`super::approach::StudyApproach`] ([`super::studies_of`] names
+//! them): the [`super::method::Method`] it lays (its grids, its exact
+//! side, its pairs), its summaries, its pairs in a shard's file and its
+//! merge. What differs per study is its options ([`StudyOptions`]); this
+//! module names no approach.
 
 use super::HarnessError;
-use super::converge::{ConvergeOptions, ConvergeSummary, Convergence, PitchResult};
-use super::direct::{
-    DirectConvergeSummary, DirectConvergence, DirectMethod, DirectPitchResult, DirectVerification,
-    DirectVerifySummary, assemble_direct,
-};
-use super::method::{Laid, MemoryLimit, Method, Pitch, Tracing, spec_at};
-use super::pairs::{Pairs, PitchPart, share};
-use super::sharded::{
-    MergedClocks, StudyPart, StudySummary, merged_clocks, oracle_s, study_settings, unsharded_pairs,
-};
+use super::approach::{ShareKnown, Study, StudyOptions};
+use super::converge::{ConvergeOptions, Convergence};
+use super::method::{Laid, MemoryLimit, Pitch, Tracing, spec_at};
+use super::pairs::share;
+use super::sharded::{StudyKind, StudyPart, study_settings};
 use super::trace::Fault;
-use super::verify::{Verification, VerifyOptions, VerifySummary};
+use super::verify::{Verification, VerifyOptions};
 use crate::analysis::Progress;
 use crate::frame::Approach;
-use crate::grid::GridSpec;
 use crate::input::PartFile;
 use crate::partition::Shard;
 use crate::setup::Setup;
-
-/// Which study, with its options.
-#[derive(Debug, Clone, Copy)]
-pub enum StudyOptions<'a> {
-    /// `verify`: one pitch, the setup's.
-    Verify(&'a VerifyOptions),
-    /// `converge`: a ladder of pitches.
-    Converge(&'a ConvergeOptions),
-}
-
-impl StudyOptions<'_> {
-    /// Checks the options.
-    pub fn validate(&self) -> Result<(), HarnessError> {
-        match self {
-            StudyOptions::Verify(o) => o.validate(),
-            StudyOptions::Converge(o) => o.validate(),
-        }
-    }
-
-    /// The pitches, coarsest first (mm): verify's one (the setup's),
-    /// converge's ladder.
-    fn pitches(&self, setup: &Setup) -> Vec<f64> {
-        match self {
-            StudyOptions::Verify(_) => vec![setup.pitch],
-            StudyOptions::Converge(o) => o.pitches.clone(),
-        }
-    }
-
-    /// The longest the oracle may take (s): beyond it, refused.
-    pub fn budget_s(&self) -> Option<f64> {
-        match self {
-            StudyOptions::Verify(o) => o.budget_s,
-            StudyOptions::Converge(o) => o.budget_s,
-        }
-    }
-
-    fn selection(&self) -> &super::StartSelection {
-        match self {
-            StudyOptions::Verify(o) => &o.selection,
-            StudyOptions::Converge(o) => &o.selection,
-        }
-    }
-
-    fn tie_band_per_mm(&self) -> f64 {
-        match self {
-            StudyOptions::Verify(o) => o.tie_band_per_mm,
-            StudyOptions::Converge(o) => o.tie_band_per_mm,
-        }
-    }
-
-    fn tolerance(&self) -> Option<f64> {
-        match self {
-            StudyOptions::Verify(o) => Some(o.tolerance),
-            StudyOptions::Converge(o) => o.tolerance,
-        }
-    }
-}
-
-/// A study's result: what its files hold, for either study and approach.
-#[derive(Debug, Clone)]
-pub enum Study {
-    /// `verify`'s.
-    Verify(Box<Verification>),
-    /// `converge`'s.
-    Converge(Box<Convergence>),
-    /// `verify --approach direct`'s.
-    VerifyDirect(Box<DirectVerification>),
-    /// `converge --approach direct`'s.
-    ConvergeDirect(Box<DirectConvergence>),
-}
 
 /// The study `options` of `shard`'s share of the starts (the starts `s`,
 /// 0-based in the study's order, with `s % N == K - 1`) on `setup`'s
@@ -159,19 +82,10 @@ fn run(
         ..setup.clone()
     };
     coarse_setup.validate()?;
-    let selection = options.selection();
-    let mut method: Box<dyn Method + '_> = match setup.approach {
-        Approach::Slide => Box::new(super::converge::Ladder::lay(
-            input,
-            &coarse_setup,
-            selection,
-            options.tie_band_per_mm(),
-            fault,
-        )?),
-        Approach::Direct => Box::new(DirectMethod::lay(input, &coarse_setup, selection)?),
-    };
+    let approach = super::studies_of(setup.approach);
+    let mut method = approach.lay(input, &coarse_setup, options, fault)?;
     let coarse = method.laid().coarse;
-    let converging = matches!(options, StudyOptions::Converge(_));
+    let converging = options.kind() == StudyKind::Converge;
     if converging {
         for &p in &pitches {
             setup.check_memory(&spec_at(&coarse, p), input.part.triangles.len())?;
@@ -197,16 +111,16 @@ fn run(
         sample_s,
         ..
     } = method.laid().clone();
-    let summary = summary_as_known(
+    let summary = approach.summary_as_known(ShareKnown {
         input,
         setup,
         options,
-        &coarse,
-        all_starts.len(),
-        &parts,
+        coarse: &coarse,
+        starts: all_starts.len(),
+        parts: &parts,
         sample_s,
         oracle_s,
-    );
+    });
     Ok(StudyPart {
         shard,
         spec: coarse,
@@ -214,7 +128,7 @@ fn run(
         angles_deg: setup.angles.clone(),
         pitches: parts,
         settings: study_settings(
-            selection,
+            options.selection(),
             options.tie_band_per_mm(),
             options.tolerance(),
             pitches,
@@ -225,130 +139,14 @@ fn run(
     })
 }
 
-/// The study's summary as a share knows it: the part's identity, every
-/// setting and the share's own seconds, with the statistics of no start
-/// ([`merge`] sets them from every share's pairs; a share's own could be
-/// infinite, which JSON cannot say).
-#[allow(clippy::too_many_arguments)]
-fn summary_as_known(
-    input: &PartFile,
-    setup: &Setup,
-    options: StudyOptions,
-    coarse: &GridSpec,
-    starts: usize,
-    parts: &[PitchPart],
-    sample_s: f64,
-    oracle_s: f64,
-) -> StudySummary {
-    let grid_s = parts.first().map_or(0.0, |p| p.grid_s);
-    match (options, setup.approach) {
-        (StudyOptions::Verify(o), Approach::Slide) => {
-            let band = parts[0].band;
-            let none = super::compare::assemble(Vec::new(), &setup.angles, band, 0.0);
-            let mut s = VerifySummary::new(input, setup, o, coarse, &none, sample_s, oracle_s);
-            s.timings.grid_s = grid_s;
-            StudySummary::Verify(Box::new(s))
-        }
-        (StudyOptions::Converge(o), Approach::Slide) => {
-            StudySummary::Converge(ConvergeSummary::new(input, setup, o, starts, &[]))
-        }
-        (StudyOptions::Verify(o), Approach::Direct) => {
-            let mut s = DirectVerifySummary::new(input, setup, o);
-            s.grid_s = grid_s;
-            s.oracle_s = oracle_s;
-            StudySummary::VerifyDirect(s)
-        }
-        (StudyOptions::Converge(o), Approach::Direct) => StudySummary::ConvergeDirect(
-            DirectConvergeSummary::new(input, setup, o, starts, oracle_s),
-        ),
-    }
-}
-
 /// The study of the shares `parts`: every shard of one study exactly
 /// once, in shard order (as [`crate::shard::study`] checks), each holding
 /// every pair of its starts. Its pairs are put back in the unsharded order
 /// and assembled, and its summary set, as for the whole study; `None` when
 /// the shares are not of one study.
 pub(crate) fn merge(mut parts: Vec<StudyPart>) -> Option<Study> {
-    let first = parts.first()?;
-    let summary = first.summary.clone();
-    let (angles, spec) = (first.angles_deg.clone(), first.spec);
-    let oracle_s = oracle_s(&parts);
-    let sample_s = parts.iter().map(|p| p.sample_s).fold(0.0, f64::max);
-    let slide = |parts: &mut [StudyPart]| {
-        merged_pitches(parts, Pairs::slide_mut, |clocks, pairs| PitchResult {
-            pitch: clocks.pitch,
-            comparison: super::compare::assemble(pairs, &angles, clocks.band, clocks.grid_s),
-            seconds: clocks.seconds,
-            nodes: clocks.nodes,
-        })
-    };
-    let direct = |parts: &mut [StudyPart]| {
-        merged_pitches(parts, Pairs::direct_mut, |clocks, pairs| {
-            DirectPitchResult {
-                pitch: clocks.pitch,
-                comparison: assemble_direct(pairs, clocks.grid_s),
-                nodes: clocks.nodes,
-            }
-        })
-    };
-    Some(match summary {
-        StudySummary::Verify(mut summary) => {
-            let result = only(slide(&mut parts)?)?;
-            summary.set_comparison(&result.comparison, &spec);
-            summary.timings.sample_s = sample_s;
-            summary.timings.oracle_s = oracle_s;
-            Study::Verify(Box::new(Verification {
-                comparison: result.comparison,
-                summary: *summary,
-            }))
-        }
-        StudySummary::Converge(mut summary) => {
-            let results = slide(&mut parts)?;
-            summary.set_results(&results);
-            Study::Converge(Box::new(Convergence {
-                fits: super::converge::fits(&results),
-                results,
-                summary,
-                oracle_s,
-            }))
-        }
-        StudySummary::VerifyDirect(mut summary) => {
-            let result = only(direct(&mut parts)?)?;
-            summary.set_comparison(&result.comparison, oracle_s);
-            Study::VerifyDirect(Box::new(DirectVerification {
-                comparison: result.comparison,
-                summary,
-            }))
-        }
-        StudySummary::ConvergeDirect(mut summary) => {
-            let results = direct(&mut parts)?;
-            summary.oracle_s = oracle_s;
-            summary.set_results(&results);
-            Study::ConvergeDirect(Box::new(DirectConvergence { results, summary }))
-        }
-    })
-}
-
-/// Every pitch of the shares `parts`, its pairs (those `pick` takes:
-/// `None` for the other approach's, which makes the merge `None`) moved
-/// back in the unsharded order and made a pitch's result by `result`.
-fn merged_pitches<T, R>(
-    parts: &mut [StudyPart],
-    pick: fn(&mut Pairs) -> Option<&mut Vec<T>>,
-    result: impl Fn(MergedClocks, Vec<T>) -> R,
-) -> Option<Vec<R>> {
-    (0..parts.first()?.pitches.len())
-        .map(|k| {
-            let clocks = merged_clocks(parts, k);
-            Some(result(clocks, unsharded_pairs(parts, k, pick)?))
-        })
-        .collect()
-}
-
-/// The one pitch of a verification (`None` for more or none).
-fn only<T>(mut results: Vec<T>) -> Option<T> {
-    results.pop().filter(|_| results.is_empty())
+    let summary = parts.first()?.summary.clone();
+    super::studies_of(summary.approach).merge(summary, &mut parts)
 }
 
 /// `verify`'s study of push-and-slide: refused for the direct approach,
@@ -370,13 +168,13 @@ pub(crate) fn verify_with(
     progress: &dyn Progress,
     fault: Option<Fault>,
 ) -> Result<Verification, HarnessError> {
-    if setup.approach == Approach::Direct {
+    if setup.approach != Approach::Slide {
         return Err(HarnessError::DirectApproach);
     }
-    match whole(input, setup, StudyOptions::Verify(options), fault, progress)? {
-        Study::Verify(v) => Ok(*v),
-        _ => unreachable!("a slide verification is a Study::Verify"),
-    }
+    let study = whole(input, setup, StudyOptions::Verify(options), fault, progress)?;
+    Ok(study
+        .downcast::<Verification>()
+        .expect("a slide verification is a Verification"))
 }
 
 /// `converge`'s study: every pitch of `options` compared on the same
@@ -390,11 +188,11 @@ pub fn converge(
     options: &ConvergeOptions,
     progress: &dyn Progress,
 ) -> Result<Convergence, HarnessError> {
-    if setup.approach == Approach::Direct {
+    if setup.approach != Approach::Slide {
         return Err(HarnessError::DirectApproach);
     }
-    match study(input, setup, StudyOptions::Converge(options), progress)? {
-        Study::Converge(c) => Ok(*c),
-        _ => unreachable!("a slide convergence study is a Study::Converge"),
-    }
+    let study = study(input, setup, StudyOptions::Converge(options), progress)?;
+    Ok(study
+        .downcast::<Convergence>()
+        .expect("a slide convergence study is a Convergence"))
 }

@@ -37,7 +37,7 @@ mod surface;
 pub use self::csv::micrometres;
 pub(crate) use self::csv::{write_colliding_points, write_composite};
 #[cfg(feature = "harness")]
-pub(crate) use self::plot::write_plots;
+pub(crate) use self::plot::write_plot;
 pub(crate) use self::ply::write_colliding_area_ply;
 pub(crate) use self::png::count_colour;
 #[cfg(feature = "harness")]

@@ -1,5 +1,6 @@
-//! The convergence study's plots: the largest decided error against the
-//! pitch, and the engine's time against the pitch, both log-log.
+//! A study's plots against the pitch, log-log, as its approach describes
+//! them (`LogLogPlot`): the convergence study's largest decided error and
+//! the engine's time.
 //!
 //! Both are laid out from their text, measured: the value labels of the y
 //! axis get the room the widest of them needs, the image is as wide as
@@ -16,8 +17,7 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::WriteError;
-use crate::harness::DECIDED_METRICS;
-use crate::harness::converge::{Fit, PitchResult};
+use crate::harness::approach::LogLogPlot;
 
 /// The font of every text here (registered by [`super::register_font`]).
 const FONT: &str = "sans-serif";
@@ -41,29 +41,10 @@ const LEGEND_GAP: u32 = 28;
 /// A legend entry's swatch: a stroke with a dot, then the words.
 const SWATCH: u32 = 30;
 
-/// Draws the log-log error plot (one series per decided metric, fitted
-/// order in the legend: the guarantee a user reads) and the time plot into
-/// `dir`.
-pub fn write_plots(
-    dir: &Path,
-    results: &[PitchResult],
-    fits: &[(String, Option<Fit>)],
-) -> Result<(), WriteError> {
+/// Draws `plot` into `dir` (its file's name is the plot's), its series
+/// coloured in order.
+pub(crate) fn write_plot(dir: &Path, plot: &LogLogPlot) -> Result<(), WriteError> {
     super::register_font()?;
-    let pitches: Vec<f64> = results.iter().map(|r| r.pitch).collect();
-    let positive: Vec<f64> = results
-        .iter()
-        .flat_map(|r| r.comparison.stats.iter().map(|s| s.1.max))
-        .filter(|v| *v > 0.0 && v.is_finite())
-        .collect();
-    let (emin, emax) = (
-        positive
-            .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min)
-            .min(1e-3),
-        positive.iter().copied().fold(0.0, f64::max).max(1e-2),
-    );
     let colours = [
         RGBColor(31, 119, 180),
         RGBColor(214, 39, 40),
@@ -72,57 +53,25 @@ pub fn write_plots(
         RGBColor(255, 127, 14),
         RGBColor(140, 86, 75),
     ];
-    let plotted = fits
+    let series = plot
+        .series
         .iter()
         .enumerate()
-        .filter(|(_, (m, _))| DECIDED_METRICS.contains(&m.as_str()));
-    let series = plotted
-        .enumerate()
-        .map(|(series, (k, (metric, fit)))| Series {
-            label: Some(match fit {
-                Some(f) => format!("{metric}: alpha = {}", two_places(f.alpha)),
-                None => format!("{metric}: no fit"),
-            }),
-            colour: colours[series % colours.len()],
-            points: results
-                .iter()
-                .map(|r| (r.pitch, r.comparison.stats[k].1.max))
-                .filter(|(_, e)| *e > 0.0 && e.is_finite())
-                .collect(),
+        .map(|(k, line)| Series {
+            label: line.label.clone(),
+            colour: colours[k % colours.len()],
+            points: line.points.clone(),
         })
         .collect();
     draw_log_log(
-        &dir.join("error_vs_pitch.png"),
+        &dir.join(plot.file),
         &LogLog {
-            caption: "Grid vs exact, decided strikes: largest error against pitch (log-log)",
-            x_desc: "pitch (mm)",
-            y_desc: "max error (mm)",
-            pitches: &pitches,
-            values: emin / 2.0..emax * 2.0,
+            caption: plot.caption,
+            x_desc: plot.x_desc,
+            y_desc: plot.y_desc,
+            pitches: &plot.pitches,
+            values: plot.values.clone(),
             series,
-        },
-    )?;
-    let times: Vec<(f64, f64)> = results
-        .iter()
-        .map(|r| (r.pitch, r.seconds.max(1e-4)))
-        .collect();
-    let (tmin, tmax) = (
-        times.iter().map(|t| t.1).fold(f64::INFINITY, f64::min),
-        times.iter().map(|t| t.1).fold(0.0, f64::max),
-    );
-    draw_log_log(
-        &dir.join("time_vs_pitch.png"),
-        &LogLog {
-            caption: "Engine time against pitch (log-log)",
-            x_desc: "pitch (mm)",
-            y_desc: "push + slide, study angles (s)",
-            pitches: &pitches,
-            values: tmin / 2.0..tmax * 2.0,
-            series: vec![Series {
-                label: None,
-                colour: colours[0],
-                points: times,
-            }],
         },
     )?;
     Ok(())
@@ -385,16 +334,6 @@ fn log_label(v: f64) -> String {
     }
 }
 
-/// `v` to two decimal places, never `-0.00` (a fitted order of -0.001).
-fn two_places(v: f64) -> String {
-    let text = format!("{v:.2}");
-    if text == "-0.00" {
-        "0.00".to_string()
-    } else {
-        text
-    }
-}
-
 fn draw_error<E: std::fmt::Display>(e: E) -> WriteError {
     WriteError::Plot(e.to_string())
 }
@@ -417,8 +356,6 @@ mod tests {
         assert_eq!(log_label(2.5e-8), "2.5e-8");
         assert_eq!(log_label(1e-8), "1e-8");
         assert_eq!(log_label(1e5), "1e5");
-        assert_eq!(two_places(-0.001), "0.00");
-        assert_eq!(two_places(1.305), format!("{:.2}", 1.305));
         assert_eq!(log_ticks(0.005..0.2), [0.005, 0.01, 0.02, 0.05, 0.1, 0.2]);
         assert_eq!(log_ticks(0.003..0.4), [0.005, 0.01, 0.02, 0.05, 0.1, 0.2]);
         assert_eq!(log_ticks(3e-9..40.0).len(), 5);

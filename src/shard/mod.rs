@@ -47,8 +47,6 @@ use crate::partition::{Shard, ShardSyntax};
 use crate::summary::{AngleSummary, Summary};
 
 #[cfg(feature = "harness")]
-mod codec;
-#[cfg(feature = "harness")]
 pub mod study;
 
 /// The SHA-256 (hex) of a `shard.json`'s content with its

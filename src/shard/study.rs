@@ -30,15 +30,15 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::codec::{Reader, put_direct_pair, put_f64, put_f64s, put_pair, put_points, put_u64};
 use super::{
     Shard, ShardDir, ShardError, first_difference, hex_sha256, io_error, read_record, read_set,
 };
 use crate::grid::GridSpec;
+use crate::harness::codec::{Reader, put_f64, put_f64s, put_points, put_u64};
 use crate::harness::metrics::TieBand;
-use crate::harness::pairs::{Pairs, PitchPart};
+use crate::harness::pairs::PitchPart;
 use crate::harness::sharded::{StudySettings, StudySummary};
-use crate::harness::{Study, StudyPart};
+use crate::harness::{Study, StudyPart, studies_of, study_named};
 use crate::output::{OutputDir, WriteError};
 
 /// `shard.json` of a study's shard.
@@ -57,6 +57,7 @@ pub struct StudyRecord {
     /// The options every shard of the study shares.
     pub settings: StudySettings,
     /// The study's summary as the shard knows it, and its kind.
+    #[serde(deserialize_with = "summary_of_its_kind")]
     pub study: StudySummary,
     /// Seconds sampling the grid.
     pub sample_s: f64,
@@ -102,12 +103,7 @@ pub fn write_study_shard(out: &OutputDir, part: &StudyPart) -> Result<(), WriteE
         }
         put_u64(&mut bin, p.nodes as u64);
         put_u64(&mut bin, p.pairs.len() as u64);
-        match &p.pairs {
-            Pairs::Slide(pairs) => pairs.iter().for_each(|pair| put_pair(&mut bin, pair)),
-            Pairs::Direct(pairs) => pairs
-                .iter()
-                .for_each(|pair| put_direct_pair(&mut bin, pair)),
-        }
+        p.pairs.put(&mut bin);
     }
     let record = StudyRecord {
         format: FORMAT,
@@ -133,29 +129,16 @@ pub fn write_study_shard(out: &OutputDir, part: &StudyPart) -> Result<(), WriteE
 pub enum ShardKind {
     /// An analysis's (`analyze --shard`).
     Analysis,
-    /// A verification's (`verify --shard`).
-    Verify,
-    /// A convergence study's (`converge --shard`).
-    Converge,
-    /// A direct verification's (`verify --approach direct --shard`).
-    VerifyDirect,
-    /// A direct convergence study's (`converge --approach direct
-    /// --shard`).
-    ConvergeDirect,
+    /// A study's (`verify --shard`, `converge --shard`, either approach),
+    /// in words.
+    Study(&'static str),
 }
 
 impl std::fmt::Display for ShardKind {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
             ShardKind::Analysis => "an analysis (analyze --shard)",
-            ShardKind::Verify => "a verification (verify --shard)",
-            ShardKind::Converge => "a convergence study (converge --shard)",
-            ShardKind::VerifyDirect => {
-                "a direct-approach verification (verify --approach direct --shard)"
-            }
-            ShardKind::ConvergeDirect => {
-                "a direct-approach convergence study (converge --approach direct --shard)"
-            }
+            ShardKind::Study(words) => words,
         })
     }
 }
@@ -174,16 +157,14 @@ pub fn shard_kind(dir: &Path) -> Result<ShardKind, ShardError> {
             path: path.clone(),
             reason: format!("not a kneeform shard.json: {e}"),
         })?;
-    let kind = value.get("study").map(|s| s.get("kind"));
-    match kind {
-        None => Ok(ShardKind::Analysis),
-        Some(Some(k)) if k == "verify" => Ok(ShardKind::Verify),
-        Some(Some(k)) if k == "converge" => Ok(ShardKind::Converge),
-        Some(Some(k)) if k == "verify-direct" => Ok(ShardKind::VerifyDirect),
-        Some(Some(k)) if k == "converge-direct" => Ok(ShardKind::ConvergeDirect),
-        Some(k) => Err(ShardError::Corrupt {
+    let Some(kind) = value.get("study").map(|s| s.get("kind")) else {
+        return Ok(ShardKind::Analysis);
+    };
+    match kind.and_then(|k| study_named(k.as_str()?)) {
+        Some((approach, kind)) => Ok(ShardKind::Study(studies_of(approach).shard_words(kind))),
+        None => Err(ShardError::Corrupt {
             path,
-            reason: format!("a study of unknown kind {k:?}"),
+            reason: format!("a study of unknown kind {kind:?}"),
         }),
     }
 }
@@ -234,29 +215,14 @@ pub fn merge_study(dirs: &[PathBuf]) -> Result<Study, ShardError> {
 }
 
 /// The fields of a study's summary that a merge computes from every
-/// shard's pairs (statistics, fits, the verdict): a shard's `shard.json`
-/// leaves them out, since a shard's own would describe a part of the
-/// starts only (and could be infinite, which JSON cannot hold).
-fn merged_keys(study: &StudySummary) -> &'static [&'static str] {
-    match study {
-        StudySummary::Verify(_) => &[
-            "pass",
-            "area_distance_decided_mm",
-            "area_distance_mm",
-            "area_distance",
-            "metrics",
-            "area_iou",
-            "counts",
-            "worst_starts",
-        ],
-        StudySummary::Converge(_) => &[
-            "fits",
-            "recommended_pitch_mm",
-            "predicted_full_time_s",
-            "seconds",
-        ],
-        StudySummary::VerifyDirect(_) => &["pass", "metrics", "counts"],
-        StudySummary::ConvergeDirect(_) => &["fits", "fits_median", "recommended_pitch_mm"],
+/// shard's pairs (statistics, fits, the verdict), with their values for a
+/// study of no start: a shard's `shard.json` leaves them out, since a
+/// shard's own would describe a part of the starts only (and could be
+/// infinite, which JSON cannot hold).
+fn merged_fields(study: &StudySummary) -> serde_json::Map<String, serde_json::Value> {
+    match studies_of(study.approach).merged_fields(study.kind) {
+        serde_json::Value::Object(fields) => fields,
+        _ => serde_json::Map::new(),
     }
 }
 
@@ -267,71 +233,60 @@ fn to_json(record: &StudyRecord) -> serde_json::Value {
         .pointer_mut("/study/summary")
         .and_then(|s| s.as_object_mut())
     {
-        for key in merged_keys(&record.study) {
-            summary.remove(*key);
+        for key in merged_fields(&record.study).keys() {
+            summary.remove(key);
         }
     }
     v
 }
 
-/// `shard.json`'s record, its [`merged_keys`] set to those of a study of
-/// no start (the merge sets them from every shard's pairs).
+/// `shard.json`'s record, its [`merged_fields`] set to those of a study
+/// of no start (the merge sets them from every shard's pairs).
 fn from_json(text: &[u8]) -> Result<StudyRecord, String> {
-    let mut v = super::unsealed_json(text)?;
-    let kind = v.pointer("/study/kind").and_then(|k| k.as_str());
-    let neutral = match kind {
-        Some("verify") => serde_json::json!({
-            "pass": false,
-            "area_distance_decided_mm": null,
-            "area_distance_mm": null,
-            "area_distance": [],
-            "metrics": {},
-            "area_iou": 0.0,
-            "counts": crate::harness::compare::Counts::default(),
-            "worst_starts": [],
-        }),
-        Some("converge") => serde_json::json!({
-            "fits": {},
-            "recommended_pitch_mm": null,
-            "predicted_full_time_s": null,
-            "seconds": [],
-        }),
-        Some("verify-direct") => serde_json::json!({
-            "pass": false,
-            "metrics": {},
-            "counts": crate::harness::direct::DirectCounts::default(),
-        }),
-        Some("converge-direct") => serde_json::json!({
-            "fits": {},
-            "fits_median": {},
-            "recommended_pitch_mm": null,
-        }),
-        _ => serde_json::json!({}),
-    };
-    if let (Some(summary), Some(neutral)) = (
-        v.pointer_mut("/study/summary")
-            .and_then(|s| s.as_object_mut()),
-        neutral.as_object(),
-    ) {
+    let v = super::unsealed_json(text)?;
+    serde_json::from_value(v).map_err(|e| e.to_string())
+}
+
+/// `shard.json`'s `study`: `{"kind": ..., "summary": ...}`, read as the
+/// approach whose study the kind names reads it, its merged fields set to
+/// those of a study of no start.
+fn summary_of_its_kind<'de, D: serde::Deserializer<'de>>(d: D) -> Result<StudySummary, D::Error> {
+    use serde::de::Error;
+    let mut study = serde_json::Value::deserialize(d)?;
+    let word = study.get("kind").and_then(|k| k.as_str()).unwrap_or("");
+    let (approach, kind) = study_named(word)
+        .ok_or_else(|| D::Error::custom(format!("a study of unknown kind {word:?}")))?;
+    let mut summary = study
+        .get_mut("summary")
+        .map(serde_json::Value::take)
+        .ok_or_else(|| D::Error::missing_field("summary"))?;
+    let studies = studies_of(approach);
+    if let (Some(fields), serde_json::Value::Object(neutral)) =
+        (summary.as_object_mut(), studies.merged_fields(kind))
+    {
         for (key, value) in neutral {
-            summary.entry(key.clone()).or_insert(value.clone());
+            fields.entry(key).or_insert(value);
         }
     }
-    serde_json::from_value(v).map_err(|e| e.to_string())
+    let known = studies
+        .summary_from_json(kind, summary)
+        .map_err(D::Error::custom)?;
+    Ok(StudySummary {
+        approach,
+        kind,
+        known,
+    })
 }
 
 /// What the shards of one study share: the record with its own counts,
 /// statistics, clocks and checksum of its data left out.
 fn identity(record: &StudyRecord) -> serde_json::Value {
     let mut v = serde_json::to_value(record).unwrap_or_default();
-    let mut derived = merged_keys(&record.study).to_vec();
+    let study = &record.study;
+    let mut derived: Vec<String> = merged_fields(study).keys().cloned().collect();
     // The shard's own clock readings.
-    derived.extend_from_slice(match record.study {
-        StudySummary::Verify(_) => &["timings"][..],
-        StudySummary::Converge(_) => &[],
-        StudySummary::VerifyDirect(_) => &["grid_s", "oracle_s"],
-        StudySummary::ConvergeDirect(_) => &["oracle_s"],
-    });
+    let clocks = studies_of(study.approach).clock_fields(study.kind);
+    derived.extend(clocks.iter().map(|k| k.to_string()));
     let mut out = serde_json::Map::new();
     if let Some(map) = v.as_object_mut() {
         for key in [
@@ -348,7 +303,7 @@ fn identity(record: &StudyRecord) -> serde_json::Value {
         let mut summary = study.get("summary").cloned().unwrap_or_default();
         if let Some(s) = summary.as_object_mut() {
             for key in &derived {
-                s.remove(*key);
+                s.remove(key);
             }
             // Keyed by the summary's own names, so that a mismatch names
             // the option that differs.
@@ -433,16 +388,8 @@ fn decode(bin: &[u8], record: &StudyRecord) -> Result<StudyPart, String> {
     if hex_sha256(&bin[..r.at]) != record.common_sha256 {
         return Err("its common part's SHA-256 is not the one shard.json records".into());
     }
-    let (summary_angles, summary_pitches) = match &record.study {
-        StudySummary::Verify(s) => (&s.angles_deg, vec![s.pitch_mm]),
-        StudySummary::Converge(s) => (&s.angles_deg, s.pitches_mm.clone()),
-        StudySummary::VerifyDirect(s) => (&s.angles_deg, vec![s.pitch_mm]),
-        StudySummary::ConvergeDirect(s) => (&s.angles_deg, s.pitches_mm.clone()),
-    };
-    let direct = matches!(
-        record.study,
-        StudySummary::VerifyDirect(_) | StudySummary::ConvergeDirect(_)
-    );
+    let (summary_angles, summary_pitches) = record.study.known.angles_and_pitches();
+    let studies = studies_of(record.study.approach);
     let same = |a: &[f64], b: &[f64]| {
         a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
     };
@@ -478,22 +425,12 @@ fn decode(bin: &[u8], record: &StudyRecord) -> Result<StudyPart, String> {
                 "pitch {p} mm holds {count} start-angle pairs where shard.json says {expected} mm and {expected_pairs}"
             ));
         }
-        let angle = |k: usize| angles_deg[k / share.max(1)];
-        let pairs = if direct {
-            // The position of pair k: the share's start k % share.
-            let mut pairs = Vec::with_capacity(count);
-            for k in 0..count {
-                let s = record.start_indices[k % share];
-                pairs.push(r.direct_pair(starts[s], angle(k))?);
-            }
-            Pairs::Direct(pairs)
-        } else {
-            let mut pairs = Vec::with_capacity(count);
-            for k in 0..count {
-                pairs.push(r.pair(angle(k))?);
-            }
-            Pairs::Slide(pairs)
+        // Pair k: the share's start k % share at angle k / share.
+        let at = |k: usize| {
+            let s = record.start_indices[k % share.max(1)];
+            (starts[s], angles_deg[k / share.max(1)])
         };
+        let pairs = studies.read_pairs(&mut r, count, &at)?;
         pitches.push(PitchPart {
             pitch: p,
             pairs,
