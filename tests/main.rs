@@ -2,6 +2,7 @@
 //! capability.
 
 mod analytic;
+mod architecture;
 mod cli;
 mod direct;
 mod engine;

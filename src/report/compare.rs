@@ -15,7 +15,7 @@ use std::collections::HashMap;
 
 use crate::frame::Approach;
 
-use super::ReportError;
+use super::error::ReportError;
 use super::render::{Rgb, RgbImage, View, paint, rasterize};
 use super::run::{GridAxes, NodeCounts, Run};
 use super::views::{Figure, LARGE_WIDTH, OBLIQUE_Y_TOL_PITCHES, run_camera, run_oblique_camera};

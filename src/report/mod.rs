@@ -7,7 +7,8 @@
 //! * [`grid_spec`], [`STRIKE_RULE_KEYS`], [`MAIN_BORDER`]: what a reader
 //!   of the run's files and of the page needs to check them.
 //!
-//! Inside: `render` (the CPU renderer: orthographic, z-buffered, Lambert
+//! Inside: `error` ([`ReportError`], the leaf every part of the report
+//! returns), `render` (the CPU renderer: orthographic, z-buffered, Lambert
 //! shading, and its pixel ↔ part mapping), `views` (the report's views of
 //! the part and how they are painted), `run` and `verify` (reading the run
 //! and verification files back), `document` (the page, a `maud` template)
@@ -21,6 +22,7 @@ use std::path::{Path, PathBuf};
 
 mod compare;
 mod document;
+mod error;
 mod html;
 mod render;
 mod run;
@@ -29,6 +31,7 @@ mod view3d;
 mod views;
 
 pub use self::document::MAIN_BORDER;
+pub use self::error::ReportError;
 pub use self::run::grid_spec;
 pub use self::verify::STRIKE_RULE_KEYS;
 
@@ -39,95 +42,6 @@ use self::views::{render_views, small_multiple_angles};
 
 /// The images of the run directory embedded in the report, when present.
 const RUN_FIGURES: [&str; 2] = ["composite.png", "depth.png"];
-
-/// Why a report could not be written.
-#[derive(Debug, thiserror::Error)]
-pub enum ReportError {
-    /// A file could not be read or written.
-    #[error("{}: {source}", path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The cause.
-        source: std::io::Error,
-    },
-    /// A JSON file does not parse (or lacks a field the report needs).
-    #[error("{} is not a readable run file: {source}", path.display())]
-    Json {
-        /// The file.
-        path: PathBuf,
-        /// What serde said.
-        source: serde_json::Error,
-    },
-    /// A buffer the run's files call for cannot be allocated.
-    #[error("{what}: {source}")]
-    Memory {
-        /// What needed it.
-        what: String,
-        /// The refused allocation.
-        source: crate::limits::OutOfMemory,
-    },
-    /// A run file contradicts the run's summary.
-    #[error("{}: {reason}", path.display())]
-    Inconsistent {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong.
-        reason: String,
-    },
-    /// The part file is not the one the run analysed.
-    #[error(
-        "{} has changed since the run: its SHA-256 is {found}, the run analysed {expected}; pass the analysed file with --part",
-        path.display()
-    )]
-    PartChanged {
-        /// The file found.
-        path: PathBuf,
-        /// The run's SHA-256.
-        expected: String,
-        /// The file's.
-        found: String,
-    },
-    /// The part file is nowhere to be found.
-    #[error(
-        "cannot find the analysed part {input_file:?} (tried {}); pass it with --part",
-        tried.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
-    )]
-    PartMissing {
-        /// The file as the run named it.
-        input_file: String,
-        /// Where it was looked for.
-        tried: Vec<PathBuf>,
-    },
-    /// The part file does not read.
-    #[error("cannot read the part {}: {reason}", path.display())]
-    Part {
-        /// The file.
-        path: PathBuf,
-        /// What the reader said.
-        reason: String,
-    },
-    /// A verification directory holds neither `verify.json` nor
-    /// `converge.json`.
-    #[error("{} holds neither verify.json nor converge.json", dir.display())]
-    NotAVerification {
-        /// The directory.
-        dir: PathBuf,
-    },
-    /// A verification directory is not of the run reported on.
-    #[error("{} is not a verification of this run ({file}): {reason}", dir.display())]
-    Mismatch {
-        /// The directory.
-        dir: PathBuf,
-        /// The file that says so.
-        file: String,
-        /// What differs.
-        reason: String,
-    },
-    /// An image could not be encoded.
-    #[error("cannot encode a PNG: {0}")]
-    Png(#[from] png::EncodingError),
-}
 
 /// What to report on.
 #[derive(Debug, Clone)]

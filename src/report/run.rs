@@ -15,7 +15,7 @@ use crate::input::{read_part_bytes, sha256_hex};
 use crate::mesh::Part;
 use crate::summary::{Summary, SummaryError};
 
-use super::ReportError;
+use super::error::ReportError;
 
 /// The counts of one run's grid nodes (composite or one angle's mask) with
 /// the heights the run reported, for painting the part.

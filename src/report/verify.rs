@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-use super::ReportError;
+use super::error::ReportError;
 use crate::limits::{MAX_RUN_JSON_BYTES, MAX_RUN_TABLE_BYTES};
 
 /// The figures a verification directory may hold, in the order shown.
