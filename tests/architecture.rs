@@ -115,10 +115,10 @@ fn use_paths(tree: &str) -> Vec<String> {
 /// `super::`, `self::`; `None` for another crate's).
 fn absolute(me: &[String], path: &str) -> Option<Vec<String>> {
     let segments: Vec<&str> = path.split("::").filter(|s| !s.is_empty()).collect();
-    let (mut base, rest) = match segments.first()? {
-        &"crate" => (Vec::new(), &segments[1..]),
-        &"self" => (me.to_vec(), &segments[1..]),
-        &"super" => {
+    let (mut base, rest) = match *segments.first()? {
+        "crate" => (Vec::new(), &segments[1..]),
+        "self" => (me.to_vec(), &segments[1..]),
+        "super" => {
             let up = segments.iter().take_while(|s| **s == "super").count();
             (me[..me.len().checked_sub(up)?].to_vec(), &segments[up..])
         }
