@@ -13,15 +13,16 @@ use std::io;
 use std::ops::Range;
 use std::path::Path;
 
-use super::HarnessError;
 use super::codec::Reader;
 use super::compare::StartSelection;
 use super::converge::ConvergeOptions;
+use super::error::HarnessError;
 use super::method::Method;
 use super::pairs::{Pairs, PitchPart};
 use super::sharded::{KnownSummary, StudyKind, StudyPart, StudySummary};
 use super::trace::Fault;
 use super::verify::VerifyOptions;
+use crate::frame::Approach;
 use crate::grid::GridSpec;
 use crate::input::PartFile;
 use crate::setup::Setup;
@@ -45,7 +46,7 @@ impl StudyOptions<'_> {
     }
 
     /// Which study.
-    pub fn kind(&self) -> StudyKind {
+    pub(crate) fn kind(&self) -> StudyKind {
         match self {
             StudyOptions::Verify(_) => StudyKind::Verify,
             StudyOptions::Converge(_) => StudyKind::Converge,
@@ -119,6 +120,13 @@ pub(crate) trait StudyApproach: Sync {
     /// `shard.json`'s word for this approach's study `kind` (`verify`,
     /// `converge-direct`, ...), unique over the approaches.
     fn kind_word(&self, kind: StudyKind) -> &'static str;
+    /// The approach, its study `kind` and the study's word
+    /// ([`StudyApproach::kind_word`]): what names a summary of it.
+    fn named(&self, kind: StudyKind) -> (Approach, StudyKind, &'static str) {
+        (self.approach(), kind, self.kind_word(kind))
+    }
+    /// The approach whose studies these are.
+    fn approach(&self) -> Approach;
     /// A shard of this approach's study `kind`, in words.
     fn shard_words(&self, kind: StudyKind) -> &'static str;
     /// The study `options` laid on `input` with `coarse` (the setup at

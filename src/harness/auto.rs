@@ -32,9 +32,10 @@ use std::time::Instant;
 
 use super::compare::StartSelection;
 use super::converge::Ladder;
+use super::error::HarnessError;
 use super::method::{Method, Tracing};
+use super::metrics::TieBand;
 use super::nearest::PointSet;
-use super::{HarnessError, TieBand};
 use crate::analysis::Progress;
 use crate::engine::AngleMask;
 use crate::grid::{GridSpec, HeightGrid};

@@ -10,9 +10,9 @@
 //! `verify`'s. Its cost is the oracle's on [`CHECK_STARTS`] starts at three
 //! angles (0.37 s on the bundled console, against 3.0 s for its analysis).
 
-use super::HarnessError;
 use super::causes::Cells;
 use super::compare::{CompareOptions, GridSide, StartSelection, choose_nodes, compare_grid_with};
+use super::error::HarnessError;
 use super::metrics::TieBand;
 use crate::analysis::{Analysis, Progress};
 use crate::frame::Approach;
@@ -83,9 +83,9 @@ pub fn check_analysis(
         ));
     }
     let triangles = &analysis.input.part.triangles;
-    let oracle = super::oracle_options(&setup.knee, setup.pitch, spec.x(0));
+    let oracle = super::verify::oracle_options(&setup.knee, setup.pitch, spec.x(0));
     let pairs = starts.len() * angles.len();
-    let tolerance = super::sampling_tolerance(setup.pitch);
+    let tolerance = super::verify::sampling_tolerance(setup.pitch);
     let note = format!(
         "the exact oracle on {} seeded starts at {} angles, compared with the grid as `kneeform verify` does: a sample, not the evidence",
         starts.len(),
@@ -108,7 +108,7 @@ pub fn check_analysis(
         starts.len(),
         angles.len()
     );
-    let traces = super::in_stage(progress, &what, Some(pairs as u64), || {
+    let traces = super::stage::in_stage(progress, &what, Some(pairs as u64), || {
         let part = kneeform_oracle::Part::from_triangles(triangles)?;
         kneeform_oracle::evaluate_reporting(&part, &starts, &angles, &oracle, &|| progress.step())
     })?;

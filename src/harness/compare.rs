@@ -10,8 +10,8 @@ use kneeform_oracle::{StartStatus, StartTrace};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::HarnessError;
 use super::causes::{Cells, Failure, Mechanism, Side};
+use super::error::HarnessError;
 use super::metrics::{
     ExactRule, METRICS, StartComparison, StartPoints, Stats, TieBand, compare, metric_index,
 };

@@ -7,11 +7,11 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::HarnessError;
 use super::compare::{
     CompareOptions, Comparison, GridSide, PairResult, StartSelection, assemble, chain_of,
     pair_results,
 };
+use super::error::HarnessError;
 use super::method::{Laid, Method, Pitch, Tracing, sampled_at, spec_at};
 use super::metrics::{METRICS, TieBand};
 use super::pairs::{Pairs, PitchPart};
@@ -118,7 +118,7 @@ pub struct ConvergeSummary {
     /// Which part, read how, by which kneeform: the same record, in the
     /// same order, in every study's JSON.
     #[serde(flatten)]
-    pub run: super::RunIdentity,
+    pub run: super::identity::RunIdentity,
     /// Knee-form L, R, W (mm).
     #[serde(default)]
     pub knee_form_mm: [f64; 3],
@@ -504,7 +504,7 @@ impl ConvergeSummary {
         results: &[PitchResult],
     ) -> ConvergeSummary {
         let mut summary = ConvergeSummary {
-            run: super::RunIdentity::of(input),
+            run: super::identity::RunIdentity::of(input),
             knee_form_mm: [
                 setup.knee.triangle_side,
                 setup.knee.radius,

@@ -40,13 +40,14 @@ use std::time::Instant;
 use kneeform_oracle::{DirectOptions, DirectStatus, DirectTrace, KneeFormDims};
 use serde::{Deserialize, Serialize};
 
-use super::HarnessError;
 use super::approach::{
     Said, ShareKnown, Study, StudyApproach, StudyFile, StudyOptions, StudyResult,
 };
 use super::codec::{Reader, put_opt, put_u64};
 use super::compare::{StartSelection, choose_nodes, node_at};
+use super::converge::ConvergeOptions;
 use super::converge::{Fit, fit_power_law};
+use super::error::HarnessError;
 use super::method::{Laid, Method, Pitch, Tracing, sampled_at, spec_at};
 use super::metrics::{nearest_rank, sorted_abs};
 use super::pairs::{NO_BAND, Pair, Pairs, PitchPart, read_each};
@@ -54,7 +55,7 @@ use super::sharded::{
     KnownSummary, StudyKind, StudyPart, StudySummary, merged_pitches, only, oracle_s, read_summary,
 };
 use super::trace::Fault;
-use super::{ConvergeOptions, VerifyOptions};
+use super::verify::VerifyOptions;
 use crate::analysis::Progress;
 use crate::direct::{DirectFootprint, contact_levels};
 use crate::frame::Approach;
@@ -496,7 +497,7 @@ impl Method for DirectMethod<'_> {
             angles.len()
         );
         let t = Instant::now();
-        let traces = super::in_stage(progress, &stage, None, || {
+        let traces = super::stage::in_stage(progress, &stage, None, || {
             let part = kneeform_oracle::Part::from_triangles(&self.input.part.triangles)?;
             let options = direct_oracle_options(&self.setup.knee, self.setup.rule.e0);
             kneeform_oracle::evaluate_direct(&part, &share, angles, &options)
@@ -510,7 +511,7 @@ impl Method for DirectMethod<'_> {
         let p = at.p;
         let spec = spec_at(&self.laid.coarse, p);
         let stage = at.stage(&spec, self.traces.len(), " (direct)");
-        let (pairs, grid_s) = super::in_stage(progress, &stage, None, || {
+        let (pairs, grid_s) = super::stage::in_stage(progress, &stage, None, || {
             let grid = sampled_at(
                 &mut self.coarse_grid,
                 &self.setup,
@@ -553,7 +554,7 @@ pub struct DirectVerifySummary {
     /// Which part, read how, by which kneeform: the same record, in the
     /// same order, in every study's JSON.
     #[serde(flatten)]
-    pub run: super::RunIdentity,
+    pub run: super::identity::RunIdentity,
     /// Grid pitch (mm).
     pub pitch_mm: f64,
     /// The tolerance both metrics' max is held to (mm).
@@ -605,7 +606,7 @@ impl DirectVerifySummary {
         let (starts, seed) = super::verify::selection_words(&options.selection);
         DirectVerifySummary {
             approach: "direct".into(),
-            run: super::RunIdentity::of(input),
+            run: super::identity::RunIdentity::of(input),
             pitch_mm: setup.pitch,
             tolerance_mm: options.tolerance,
             pass: false,
@@ -657,7 +658,7 @@ pub struct DirectConvergeSummary {
     /// Which part, read how, by which kneeform: the same record, in the
     /// same order, in every study's JSON.
     #[serde(flatten)]
-    pub run: super::RunIdentity,
+    pub run: super::identity::RunIdentity,
     /// Knee-form L, R, W (mm).
     pub knee_form_mm: [f64; 3],
     /// The pitches, coarsest first (mm).
@@ -707,7 +708,7 @@ impl DirectConvergeSummary {
         let (_, seed) = super::verify::selection_words(&options.selection);
         DirectConvergeSummary {
             approach: "direct".into(),
-            run: super::RunIdentity::of(input),
+            run: super::identity::RunIdentity::of(input),
             knee_form_mm: [
                 setup.knee.triangle_side,
                 setup.knee.radius,
@@ -867,6 +868,10 @@ fn read_direct_pair(
 pub(crate) struct Direct;
 
 impl StudyApproach for Direct {
+    fn approach(&self) -> Approach {
+        Approach::Direct
+    }
+
     fn kind_word(&self, kind: StudyKind) -> &'static str {
         match kind {
             StudyKind::Verify => "verify-direct",
@@ -914,11 +919,11 @@ impl StudyApproach for Direct {
                 let mut s = DirectVerifySummary::new(input, setup, o);
                 s.grid_s = parts.first().map_or(0.0, |p| p.grid_s);
                 s.oracle_s = oracle_s;
-                StudySummary::new(Approach::Direct, StudyKind::Verify, s)
+                StudySummary::new(self.named(StudyKind::Verify), s)
             }
             StudyOptions::Converge(o) => {
                 let s = DirectConvergeSummary::new(input, setup, o, starts, oracle_s);
-                StudySummary::new(Approach::Direct, StudyKind::Converge, s)
+                StudySummary::new(self.named(StudyKind::Converge), s)
             }
         }
     }

@@ -2,7 +2,7 @@
 //! leaf that the approaches' modules (`converge`, `direct`) implement and
 //! the one study path (`study`) calls, so that neither imports the other.
 
-use super::HarnessError;
+use super::error::HarnessError;
 use super::pairs::PitchPart;
 use crate::analysis::Progress;
 use crate::grid::GridSpec;
@@ -60,7 +60,7 @@ impl Pitch {
                 self.p, spec.nx, spec.nz
             )
         } else {
-            super::comparing(pairs)
+            super::stage::comparing(pairs)
         }
     }
 }

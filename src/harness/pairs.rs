@@ -5,7 +5,7 @@
 
 use std::any::Any;
 
-use super::HarnessError;
+use super::error::HarnessError;
 use super::metrics::TieBand;
 use crate::partition::Shard;
 

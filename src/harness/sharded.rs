@@ -30,7 +30,7 @@ use crate::partition::Shard;
 
 /// Which study: `verify` (one pitch) or `converge` (a ladder).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StudyKind {
+pub(crate) enum StudyKind {
     /// `verify`.
     Verify,
     /// `converge`.
@@ -85,16 +85,23 @@ pub struct StudySummary {
     pub(crate) approach: Approach,
     /// Which study.
     pub(crate) kind: StudyKind,
+    /// The approach's word for the study in `shard.json`'s `kind`.
+    pub(crate) word: &'static str,
     /// The summary, as the approach types it.
     pub(crate) known: Box<dyn KnownSummary>,
 }
 
 impl StudySummary {
-    /// `known`, the summary of `approach`'s study `kind`.
-    pub(crate) fn new(approach: Approach, kind: StudyKind, known: impl KnownSummary) -> Self {
+    /// `known`, the summary of `approach`'s study `kind`, which
+    /// `shard.json` names `word`.
+    pub(crate) fn new(
+        (approach, kind, word): (Approach, StudyKind, &'static str),
+        known: impl KnownSummary,
+    ) -> Self {
         StudySummary {
             approach,
             kind,
+            word,
             known: Box::new(known),
         }
     }
@@ -128,8 +135,7 @@ impl serde::Serialize for StudySummary {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeStruct;
         let mut record = s.serialize_struct("StudySummary", 2)?;
-        let word = super::studies_of(self.approach).kind_word(self.kind);
-        record.serialize_field("kind", word)?;
+        record.serialize_field("kind", self.word)?;
         record.serialize_field("summary", &self.known.to_json())?;
         record.end()
     }

@@ -9,7 +9,6 @@ use std::path::Path;
 
 use kneeform_oracle::FailureReason;
 
-use super::HarnessError;
 use super::approach::{
     LogLogPlot, PlotLine, Said, ShareKnown, Study, StudyApproach, StudyFile, StudyOptions,
     StudyResult,
@@ -17,6 +16,7 @@ use super::approach::{
 use super::codec::{Reader, put_f64s, put_nodes, put_opt, put_points, put_u64};
 use super::compare::{PairResult, STATUSES, assemble, row_of};
 use super::converge::{ConvergeSummary, Convergence, Ladder, PitchResult, fits};
+use super::error::HarnessError;
 use super::method::Method;
 use super::metrics::{DECIDED_METRICS, StartComparison, StartPoints};
 use super::pairs::{Pair, Pairs, read_each};
@@ -34,6 +34,10 @@ use crate::setup::Setup;
 pub(crate) struct Slide;
 
 impl StudyApproach for Slide {
+    fn approach(&self) -> Approach {
+        Approach::Slide
+    }
+
     fn kind_word(&self, kind: StudyKind) -> &'static str {
         match kind {
             StudyKind::Verify => "verify",
@@ -82,11 +86,11 @@ impl StudyApproach for Slide {
                 let none = assemble(Vec::new(), &setup.angles, band, 0.0);
                 let mut s = VerifySummary::new(input, setup, o, coarse, &none, sample_s, oracle_s);
                 s.timings.grid_s = parts.first().map_or(0.0, |p| p.grid_s);
-                StudySummary::new(Approach::Slide, StudyKind::Verify, s)
+                StudySummary::new(self.named(StudyKind::Verify), s)
             }
             StudyOptions::Converge(o) => {
                 let s = ConvergeSummary::new(input, setup, o, starts, &[]);
-                StudySummary::new(Approach::Slide, StudyKind::Converge, s)
+                StudySummary::new(self.named(StudyKind::Converge), s)
             }
         }
     }
@@ -521,7 +525,7 @@ fn resolving_pitch(pitch: f64, tolerance: f64, metric: &str, value: f64) -> Stri
 fn verification_said(result: &Verification, out: &Path) -> Said {
     let s = &result.summary;
     let mut lines = Vec::new();
-    for name in crate::harness::METRICS {
+    for name in super::metrics::METRICS {
         let stats = &s.metrics[name];
         lines.push(format!(
             "{name:>29}: max {:.4}  p95 {:.4}  mean {:.4} mm  (n = {})",
@@ -609,7 +613,7 @@ fn verification_said(result: &Verification, out: &Path) -> Said {
             });
             // The hint follows the figure's mechanism: a rim or a brief
             // strike is the grid's sampling, not a feature's width.
-            use crate::harness::Mechanism;
+            use super::causes::Mechanism;
             let mechanism = s
                 .failures
                 .iter()
@@ -686,7 +690,7 @@ fn convergence_said(study: &Convergence, out: &Path) -> Said {
         }
         let exact = results
             .iter()
-            .all(|r| r.comparison.stat(m).max <= crate::harness::ROUNDING_MM);
+            .all(|r| r.comparison.stat(m).max <= super::converge::ROUNDING_MM);
         match f {
             Some(f) => lines.push(format!("{m:>22}: error ~ {:.3} p^{:.2}", f.c, f.alpha)),
             None if exact => lines.push(format!(

@@ -16,9 +16,9 @@
 //! merge. What differs per study is its options ([`StudyOptions`]); this
 //! module names no approach.
 
-use super::HarnessError;
 use super::approach::{ShareKnown, Study, StudyOptions};
 use super::converge::{ConvergeOptions, Convergence};
+use super::error::HarnessError;
 use super::method::{Laid, MemoryLimit, Pitch, Tracing, spec_at};
 use super::pairs::share;
 use super::sharded::{StudyKind, StudyPart, study_settings};

@@ -8,10 +8,10 @@ use std::time::Instant;
 use kneeform_oracle::{KneeFormDims, OracleOptions, StartTrace};
 use serde::{Deserialize, Serialize};
 
-use super::HarnessError;
 use super::compare::{
     AreaDistance, CHAIN_BLOCK, Comparison, Counts, StartSelection, select_starts,
 };
+use super::error::HarnessError;
 use super::method::MemoryLimit;
 use super::metrics::{Stats, TieBand};
 use crate::analysis::Progress;
@@ -188,7 +188,7 @@ pub(super) fn run_oracle(
         starts.len(),
         angles.len()
     );
-    super::in_stage(progress, &what, Some(pairs as u64), || {
+    super::stage::in_stage(progress, &what, Some(pairs as u64), || {
         let t = Instant::now();
         let part = kneeform_oracle::Part::from_triangles(triangles)?;
         let trace = |pairs: &[(usize, usize)]| {
@@ -293,7 +293,7 @@ impl VerifySummary {
     ) -> VerifySummary {
         let (starts, seed) = selection_words(&options.selection);
         let mut summary = VerifySummary {
-            run: super::RunIdentity::of(input),
+            run: super::identity::RunIdentity::of(input),
             pitch_mm: setup.pitch,
             tolerance_mm: options.tolerance,
             pass: false,
@@ -411,7 +411,7 @@ pub struct VerifySummary {
     /// Which part, read how, by which kneeform: the same record, in the
     /// same order, in every study's JSON.
     #[serde(flatten)]
-    pub run: super::RunIdentity,
+    pub run: super::identity::RunIdentity,
     /// Grid pitch (mm).
     pub pitch_mm: f64,
     /// The tolerance every metric's max is held to (mm).
@@ -480,16 +480,6 @@ pub struct VerifySummary {
     /// traced on its own.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub oracle_chain: Option<kneeform_oracle::Chain>,
-}
-
-/// `scale` of files written before it was recorded.
-pub(crate) fn unit_scale() -> f64 {
-    1.0
-}
-
-/// `side` of files written before it was recorded.
-pub(crate) fn left_side() -> crate::Side {
-    crate::Side::Left
 }
 
 /// One of the worst start-angle pairs.

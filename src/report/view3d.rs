@@ -29,7 +29,7 @@ use serde_json::json;
 use crate::frame::Approach;
 use crate::mesh::Part;
 
-use super::ReportError;
+use super::error::ReportError;
 use super::html::base64;
 use super::run::{AngleBits, Run};
 use super::views::{OBLIQUE_Y_TOL_PITCHES, composite_colour, ramp_len, run_oblique_camera};

@@ -67,7 +67,7 @@ mod tests {
         let mut on_disk: Vec<(String, String)> = std::fs::read_dir(dir)
             .unwrap()
             .map(|e| e.unwrap().path())
-            .filter(|p| super::super::is_scenario_file(p))
+            .filter(|p| super::super::file::is_scenario_file(p))
             .map(|p| {
                 let stem = p.file_stem().unwrap().to_string_lossy().into_owned();
                 (stem, std::fs::read_to_string(&p).unwrap())
@@ -80,7 +80,7 @@ mod tests {
             .collect();
         assert_eq!(embedded, on_disk);
         for name in builtin_names() {
-            let from_disk = super::super::load(&Path::new(dir).join(format!("{name}.toml")));
+            let from_disk = super::super::file::load(&Path::new(dir).join(format!("{name}.toml")));
             assert_eq!(builtin(name), Some(from_disk.unwrap()), "{name}");
         }
         assert_eq!(builtin("no-such-part"), None);

@@ -24,13 +24,9 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use super::lattice::{axis, refined_step, tessellate, triangle_count};
+use super::lattice::{MAX_TRIANGLES, axis, refined_step, tessellate, triangle_count};
 use super::primitive::Feature;
 use crate::mesh::Triangle;
-
-/// The most triangles a scenario is tessellated into (72 bytes each in
-/// memory, 50 in the STL): 20 million, 54 times the paper's console.
-pub const MAX_TRIANGLES: usize = 20_000_000;
 
 /// A scenario file, loaded and checked: the surface `y(x, z)` (mm,
 /// analysis frame) is the sum of its features over its extent.

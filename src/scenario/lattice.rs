@@ -8,6 +8,10 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use crate::mesh::Triangle;
 
+/// The most triangles a scenario is tessellated into (72 bytes each in
+/// memory, 50 in the STL): 20 million, 54 times the paper's console.
+pub const MAX_TRIANGLES: usize = 20_000_000;
+
 /// Lines closer than this (mm) are the same line: `10.3 - 0.3` is
 /// `10.000000000000002`, and a cell 2e-15 mm wide would only add a sliver.
 /// 1 um, because binary STL stores f32: at 1400 mm its spacing is 1.2e-4 mm,

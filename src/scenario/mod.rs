@@ -39,10 +39,10 @@ mod library_tests;
 
 pub use builtin::{PAPER_TRIANGLES, builtin, builtin_names};
 pub use file::ScenarioError;
-pub use file::{Extent, MAX_TRIANGLES, ScenarioFile, is_scenario_file, load, parse};
+pub use file::{Extent, ScenarioFile, is_scenario_file, load, parse};
 #[cfg(test)]
 pub(crate) use lattice::axis;
-pub use lattice::tessellate;
+pub use lattice::{MAX_TRIANGLES, tessellate};
 
 #[cfg(test)]
 mod tests {

@@ -475,7 +475,7 @@ impl Feature {
 
 /// The most crease lines a wave reports: one per two triangles of
 /// [`super::MAX_TRIANGLES`] (a lattice line makes at least two).
-const MAX_CREASES: i64 = (super::MAX_TRIANGLES / 2) as i64;
+const MAX_CREASES: i64 = (super::lattice::MAX_TRIANGLES / 2) as i64;
 
 impl Wave {
     /// The amplitude at x: grows by `growth` per mm towards -x, never below

@@ -274,6 +274,7 @@ fn summary_of_its_kind<'de, D: serde::Deserializer<'de>>(d: D) -> Result<StudySu
     Ok(StudySummary {
         approach,
         kind,
+        word: studies.kind_word(kind),
         known,
     })
 }
