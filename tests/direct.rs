@@ -317,4 +317,18 @@ fn verify_compares_the_direct_approach_with_its_exact_oracle() {
     assert_eq!(summary["counts"]["engine_mismatch"], 0, "{json}");
     assert_eq!(summary["counts"]["oracle_failed"], 0, "{json}");
     assert!(dir.join("v/verify.csv").exists());
+    // No sample predicts the direct approach's casts: a budget is said
+    // not to apply, and only when one is given.
+    let warning = "--budget-s is not applied with --approach direct";
+    assert!(!err.contains(warning), "{err}");
+    let mut budget = args.to_vec();
+    *budget.last_mut().unwrap() = "with-budget";
+    budget.extend(["--budget-s", "1000"]);
+    let out = kneeform_cli(&dir, &budget);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(matches!(out.status.code(), Some(0 | 1)), "{err}");
+    assert!(
+        err.contains(&format!("kneeform: warning: {warning}")),
+        "{err}"
+    );
 }

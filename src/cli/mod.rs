@@ -79,7 +79,6 @@ pub fn study_shard(study: &StudyArgs) -> anyhow::Result<Option<Shard>> {
 /// (its own options checked first), then its shard when `--shard` is
 /// given (written to `out`), else the whole study, of the setup's
 /// approach, written to `out` and printed as `kneeform merge` prints it.
-/// `--budget-s` does not apply to the direct approach, which says so.
 pub fn run_study(
     study: &StudyArgs,
     out: &Path,
@@ -87,13 +86,6 @@ pub fn run_study(
 ) -> anyhow::Result<ExitCode> {
     let shard = study_shard(study)?;
     let (input, setup) = study_inputs(study, options.validate())?;
-    let direct = setup.approach == kneeform::Approach::Direct;
-    if direct && options.budget_s().is_some() {
-        // The direct study casts once per position: no sample predicts it.
-        eprintln!(
-            "kneeform: warning: --budget-s is not applied with --approach direct (one cast per knee position; --shard fans it out)"
-        );
-    }
     let bars = progress::Bars::default();
     if let Some(shard) = shard {
         let part =

@@ -489,6 +489,12 @@ impl Method for DirectMethod<'_> {
     /// One exact cast per position and angle: no bisection to resolve a
     /// pitch, and no budget (nothing predicts it: `--shard` fans it out).
     fn trace(&mut self, what: Tracing, progress: &dyn Progress) -> Result<f64, HarnessError> {
+        if what.refuse_beyond_s.is_some() {
+            // One cast per position: no sample predicts the casts' time.
+            progress.note(
+                "warning: --budget-s is not applied with --approach direct (one cast per knee position; --shard fans it out)",
+            );
+        }
         let share = what.share;
         let angles = &self.setup.angles;
         let stage = format!(
