@@ -41,61 +41,27 @@ const LEGEND_GAP: u32 = 28;
 /// A legend entry's swatch: a stroke with a dot, then the words.
 const SWATCH: u32 = 30;
 
+/// The series' colours, in order (the k-th series the k-th, cycling).
+const COLOURS: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(140, 86, 75),
+];
+
+/// The colour of series `k`.
+fn colour(k: usize) -> RGBColor {
+    COLOURS[k % COLOURS.len()]
+}
+
 /// Draws `plot` into `dir` (its file's name is the plot's), its series
 /// coloured in order.
 pub(crate) fn write_plot(dir: &Path, plot: &LogLogPlot) -> Result<(), WriteError> {
     super::register_font()?;
-    let colours = [
-        RGBColor(31, 119, 180),
-        RGBColor(214, 39, 40),
-        RGBColor(44, 160, 44),
-        RGBColor(148, 103, 189),
-        RGBColor(255, 127, 14),
-        RGBColor(140, 86, 75),
-    ];
-    let series = plot
-        .series
-        .iter()
-        .enumerate()
-        .map(|(k, line)| Series {
-            label: line.label.clone(),
-            colour: colours[k % colours.len()],
-            points: line.points.clone(),
-        })
-        .collect();
-    draw_log_log(
-        &dir.join(plot.file),
-        &LogLog {
-            caption: plot.caption,
-            x_desc: plot.x_desc,
-            y_desc: plot.y_desc,
-            pitches: &plot.pitches,
-            values: plot.values.clone(),
-            series,
-        },
-    )?;
+    draw_log_log(&dir.join(plot.file), plot)?;
     Ok(())
-}
-
-/// One line of a plot, its points marked.
-struct Series {
-    /// Its words in the legend; `None` keeps it out (a plot of one line).
-    label: Option<String>,
-    colour: RGBColor,
-    /// (pitch, value), both positive.
-    points: Vec<(f64, f64)>,
-}
-
-/// A log-log plot against the pitch.
-struct LogLog<'a> {
-    caption: &'a str,
-    x_desc: &'a str,
-    y_desc: &'a str,
-    /// The study's pitches (mm): the x axis's ticks.
-    pitches: &'a [f64],
-    /// The y axis's range (positive).
-    values: Range<f64>,
-    series: Vec<Series>,
 }
 
 /// Where [`draw_log_log`] put its text (pixels).
@@ -124,7 +90,7 @@ fn text_size(text: &str, pt: u32) -> Result<(u32, u32), WriteError> {
 }
 
 /// Draws `plot` into `path`.
-fn draw_log_log(path: &Path, plot: &LogLog) -> Result<PlotLayout, WriteError> {
+fn draw_log_log(path: &Path, plot: &LogLogPlot) -> Result<PlotLayout, WriteError> {
     let mut pitches: Vec<f64> = plot
         .pitches
         .iter()
@@ -203,7 +169,7 @@ type DrawResult =
 /// The drawing of [`draw_log_log`], at the places `layout` gives.
 fn draw(
     path: &Path,
-    plot: &LogLog,
+    plot: &LogLogPlot,
     layout: &PlotLayout,
     pitches: &[f64],
     x_range: Range<f64>,
@@ -250,22 +216,23 @@ fn draw(
         .y_label_formatter(&label)
         .label_style((FONT, LABEL_PT))
         .draw()?;
-    for s in &plot.series {
+    for (k, s) in plot.series.iter().enumerate() {
         chart.draw_series(LineSeries::new(
             s.points.iter().copied(),
-            s.colour.stroke_width(2),
+            colour(k).stroke_width(2),
         ))?;
         chart.draw_series(
             s.points
                 .iter()
-                .map(|&p| Circle::new(p, 4, s.colour.filled())),
+                .map(|&p| Circle::new(p, 4, colour(k).filled())),
         )?;
     }
     let style = (FONT, LABEL_PT).into_text_style(&root);
     let labelled = plot
         .series
         .iter()
-        .filter_map(|s| s.label.as_ref().map(|l| (s.colour, l)));
+        .enumerate()
+        .filter_map(|(k, s)| s.label.as_ref().map(|l| (colour(k), l)));
     for ((colour, words), &[x, y, _]) in labelled.zip(&layout.legend) {
         let (x, y) = (x as i32, y as i32);
         root.draw(&PathElement::new(
@@ -341,6 +308,7 @@ fn draw_error<E: std::fmt::Display>(e: E) -> WriteError {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::harness::approach::PlotLine;
     use crate::output::{decode_png, temp_dir};
 
     #[test]
@@ -365,7 +333,6 @@ mod tests {
     #[test]
     fn convergence_plots_keep_every_label_inside_the_canvas() {
         let dir = temp_dir("plot-inside");
-        let colours = [RGBColor(31, 119, 180), RGBColor(214, 39, 40)];
         // An error exact to rounding at every pitch beside errors of mm, a
         // time at the 1e-4 s floor: the labels the plots had trouble with
         // (`9.999999999e-5`, two `0.1` one over the other).
@@ -381,10 +348,9 @@ mod tests {
         ];
         for (n, (values, ys)) in cases.into_iter().enumerate() {
             let series = (0..2)
-                .map(|s| Series {
+                .map(|s| PlotLine {
                     label: (n % 2 == 0)
                         .then(|| format!("first_contact_error_decided, number {s}: alpha = 1.31")),
-                    colour: colours[s],
                     points: pitches
                         .iter()
                         .zip(&ys)
@@ -396,11 +362,12 @@ mod tests {
             crate::output::register_font().unwrap();
             let layout = draw_log_log(
                 &path,
-                &LogLog {
+                &LogLogPlot {
+                    file: "plot.png",
                     caption: "Engine time against pitch (log-log)",
                     x_desc: "pitch (mm)",
                     y_desc: "push + slide, study angles (s)",
-                    pitches: &pitches,
+                    pitches: pitches.to_vec(),
                     values,
                     series,
                 },
