@@ -82,10 +82,11 @@ impl StudyApproach for Slide {
         } = share;
         match options {
             StudyOptions::Verify(o) => {
-                let band = parts[0].band;
-                let none = assemble(Vec::new(), &setup.angles, band, 0.0);
+                // A verification compares one pitch.
+                let pitch = &parts[0];
+                let none = assemble(Vec::new(), &setup.angles, pitch.band, 0.0);
                 let mut s = VerifySummary::new(input, setup, o, coarse, &none, sample_s, oracle_s);
-                s.timings.grid_s = parts.first().map_or(0.0, |p| p.grid_s);
+                s.timings.grid_s = pitch.grid_s;
                 StudySummary::new(self.named(StudyKind::Verify), s)
             }
             StudyOptions::Converge(o) => {

@@ -33,11 +33,12 @@ use serde::{Deserialize, Serialize};
 use super::{
     Shard, ShardDir, ShardError, first_difference, hex_sha256, io_error, read_record, read_set,
 };
+use crate::frame::Approach;
 use crate::grid::GridSpec;
 use crate::harness::codec::{Reader, put_f64, put_f64s, put_points, put_u64};
 use crate::harness::metrics::TieBand;
 use crate::harness::pairs::PitchPart;
-use crate::harness::sharded::{StudySettings, StudySummary};
+use crate::harness::sharded::{StudyKind, StudySettings, StudySummary};
 use crate::harness::{Study, StudyPart, studies_of, study_named};
 use crate::output::{OutputDir, WriteError};
 
@@ -219,21 +220,24 @@ pub fn merge_study(dirs: &[PathBuf]) -> Result<Study, ShardError> {
 /// study of no start: a shard's `shard.json` leaves them out, since a
 /// shard's own would describe a part of the starts only (and could be
 /// infinite, which JSON cannot hold).
-fn merged_fields(study: &StudySummary) -> serde_json::Map<String, serde_json::Value> {
-    match studies_of(study.approach).merged_fields(study.kind) {
+fn merged_fields(
+    approach: Approach,
+    kind: StudyKind,
+) -> serde_json::Map<String, serde_json::Value> {
+    match studies_of(approach).merged_fields(kind) {
         serde_json::Value::Object(fields) => fields,
         _ => serde_json::Map::new(),
     }
 }
 
-/// `record` as `shard.json` holds it: without [`merged_keys`].
+/// `record` as `shard.json` holds it: without [`merged_fields`].
 fn to_json(record: &StudyRecord) -> serde_json::Value {
     let mut v = serde_json::to_value(record).unwrap_or_default();
     if let Some(summary) = v
         .pointer_mut("/study/summary")
         .and_then(|s| s.as_object_mut())
     {
-        for key in merged_fields(&record.study).keys() {
+        for key in merged_fields(record.study.approach, record.study.kind).keys() {
             summary.remove(key);
         }
     }
@@ -260,14 +264,12 @@ fn summary_of_its_kind<'de, D: serde::Deserializer<'de>>(d: D) -> Result<StudySu
         .get_mut("summary")
         .map(serde_json::Value::take)
         .ok_or_else(|| D::Error::missing_field("summary"))?;
-    let studies = studies_of(approach);
-    if let (Some(fields), serde_json::Value::Object(neutral)) =
-        (summary.as_object_mut(), studies.merged_fields(kind))
-    {
-        for (key, value) in neutral {
+    if let Some(fields) = summary.as_object_mut() {
+        for (key, value) in merged_fields(approach, kind) {
             fields.entry(key).or_insert(value);
         }
     }
+    let studies = studies_of(approach);
     let known = studies
         .summary_from_json(kind, summary)
         .map_err(D::Error::custom)?;
@@ -284,7 +286,10 @@ fn summary_of_its_kind<'de, D: serde::Deserializer<'de>>(d: D) -> Result<StudySu
 fn identity(record: &StudyRecord) -> serde_json::Value {
     let mut v = serde_json::to_value(record).unwrap_or_default();
     let study = &record.study;
-    let mut derived: Vec<String> = merged_fields(study).keys().cloned().collect();
+    let mut derived: Vec<String> = merged_fields(study.approach, study.kind)
+        .keys()
+        .cloned()
+        .collect();
     // The shard's own clock readings.
     let clocks = studies_of(study.approach).clock_fields(study.kind);
     derived.extend(clocks.iter().map(|k| k.to_string()));
