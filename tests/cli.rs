@@ -31,8 +31,8 @@ pub(crate) fn kneeform_in(dir: &Path, args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
-fn shared_meshes() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes")
+fn real_meshes() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/meshes")
 }
 
 const OUTPUTS: [&str; 6] = [
@@ -66,11 +66,11 @@ pub(crate) fn assert_clean_failure(out: &Output, dir: &Path, what: &str) {
 }
 
 #[test]
-fn every_shared_mesh_analyses_or_fails_cleanly() {
+fn every_real_mesh_analyses_or_fails_cleanly() {
     let mut analysed = 0;
     let mut refused = 0;
-    let mut files: Vec<PathBuf> = std::fs::read_dir(shared_meshes())
-        .expect("../shared/meshes beside the repository")
+    let mut files: Vec<PathBuf> = std::fs::read_dir(real_meshes())
+        .expect("tests/data/meshes in the repository")
         .flatten()
         .map(|e| e.path())
         .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("stl")))
@@ -78,7 +78,7 @@ fn every_shared_mesh_analyses_or_fails_cleanly() {
     files.sort();
     assert!(
         files.len() >= 10,
-        "expected the shared meshes, found {files:?}"
+        "expected the third-party meshes, found {files:?}"
     );
     for file in &files {
         let scratch = scratch_dir("mesh");
@@ -130,7 +130,7 @@ fn bad_input_gets_one_line_and_exit_2() {
     let garbage = scratch.join("garbage.stl");
     std::fs::write(&garbage, vec![7u8; 300]).unwrap();
     let truncated = scratch.join("truncated.stl");
-    let mut bytes = std::fs::read(shared_meshes().join("featuretype.STL")).unwrap();
+    let mut bytes = std::fs::read(real_meshes().join("featuretype.STL")).unwrap();
     bytes.truncate(bytes.len() / 2);
     std::fs::write(&truncated, bytes).unwrap();
     let nan = scratch.join("nan.stl");

@@ -1,6 +1,6 @@
 //! A new user's first hour (issue 13): the README's first command through
 //! `analyze --report` and `report` at the default pitch and grid, every
-//! shared mesh and scenario reported at its default pitch, and each
+//! third-party mesh (tests/data/meshes) and scenario reported at its default pitch, and each
 //! natural mistake met with its warning or error, the documented exit
 //! code, and nothing half written.
 
@@ -242,13 +242,13 @@ fn the_readme_first_command_analyses_and_reports_the_bundled_console() {
 }
 
 #[test]
-fn every_shared_mesh_and_scenario_analyses_and_reports_at_its_default_pitch() {
+fn every_real_mesh_and_scenario_analyses_and_reports_at_its_default_pitch() {
     // Default pitch and grid; the angles are cut to -30, 0, 30, which give
     // the same default grid as all 61 (the footprint's extent over
     // -30..30 is reached at the ends).
     let mut parts: Vec<PathBuf> = std::fs::read_dir(repo().join("scenarios"))
         .unwrap()
-        .chain(std::fs::read_dir(repo().join("../shared/meshes")).unwrap())
+        .chain(std::fs::read_dir(repo().join("tests/data/meshes")).unwrap())
         .map(|e| e.unwrap().path())
         .filter(|p| {
             let ext = p.extension().map(|e| e.to_ascii_lowercase());

@@ -1,6 +1,6 @@
 //! The fuzz targets on stable: the entry points of `tests/fuzz/entry.rs`
 //! (what the libFuzzer targets call) on a fixed-seed mutation loop over
-//! the scenario files, a few shared meshes, a summary.json written here,
+//! the scenario files, a few third-party meshes (tests/data/meshes), a summary.json written here,
 //! and every committed reproducer in `tests/fuzz/regressions/`. Asserts
 //! that nothing panics, not that inputs are accepted; a failure names the
 //! target, seed and iteration and writes the input beside the test's
@@ -122,7 +122,7 @@ fn coarsened(text: &str) -> String {
 fn seeds(target: &str) -> Vec<Vec<u8>> {
     let mut seeds = match target {
         "stl" => {
-            let meshes = repo().join("../shared/meshes");
+            let meshes = repo().join("tests/data/meshes");
             let mut seeds: Vec<Vec<u8>> = SHARED_MESHES
                 .iter()
                 .map(|name| meshes.join(name))

@@ -17,4 +17,5 @@ mod report;
 mod resolution;
 mod second_hour;
 mod shard;
+mod standalone;
 mod util;

@@ -190,7 +190,7 @@ mod tests {
 
     fn mesh_path(name: &str) -> std::path::PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../shared/meshes")
+            .join("../tests/data/meshes")
             .join(name)
     }
 

@@ -3,7 +3,7 @@
 //! default); with the skip off the oracle casts every triangle its BVH
 //! traversal hands over, as it did before the skip existed. On every
 //! scenario of `scenarios/` and every third-party mesh of
-//! `shared/meshes/` that loads, the two give the same traces to the bit:
+//! `tests/data/meshes/` that loads, the two give the same traces to the bit:
 //! `yr*`, every contact (travel, level, witness, rate and its error), the
 //! end, the status and the cast count.
 
@@ -81,11 +81,11 @@ fn scenario_parts() -> Vec<(String, Part)> {
     parts
 }
 
-/// Every third-party mesh of `shared/meshes/` that loads, scaled to about
+/// Every third-party mesh of `tests/data/meshes/` that loads, scaled to about
 /// 600 mm as a user's part (`tests/real_meshes.rs`; an empty or broken one
 /// is refused, as that file checks), by path.
 fn real_mesh_parts() -> Vec<(String, Part)> {
-    let dir = repo().join("../shared/meshes");
+    let dir = repo().join("tests/data/meshes");
     let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().path())

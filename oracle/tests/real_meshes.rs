@@ -1,4 +1,4 @@
-//! The oracle on real-world STL files (shared/meshes): they load and
+//! The oracle on real-world STL files (tests/data/meshes): they load and
 //! answer, or are refused with a clear error.
 
 use std::path::{Path, PathBuf};
@@ -10,7 +10,7 @@ use kneeform_oracle::{
 mod util;
 
 fn mesh(name: &str) -> PathBuf {
-    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes")).join(name)
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/meshes")).join(name)
 }
 
 /// Distance from `(x, z)` to the footprint of `knee` placed at `start`

@@ -13,7 +13,9 @@ use kneeform::{
 
 /// UN Regulation No. 21 knee-form inspection: which areas of an interior
 /// part a sliding knee-form strikes (push-and-slide on a height grid, after
-/// Inui, Gunji and Umezu). Lengths in mm, angles in degrees.
+/// Inui, Gunji and Umezu). Lengths in mm, angles in degrees. What is
+/// computed, exactly, and what each figure means: docs/method.md in the
+/// repository.
 #[derive(Debug, Parser)]
 #[command(name = "kneeform", version, about, long_about = None)]
 pub struct Cli {
@@ -157,9 +159,9 @@ pub struct SetupArgs {
     #[arg(long, default_value_t = StrikeRule::DEFAULT_E0, value_name = "MM")]
     pub e0: f64,
     /// How the deflection of a contact is measured: `window` (default,
-    /// SPEC's rule): the knee-form's own level dropped by more than
+    /// docs/method.md's rule): the knee-form's own level dropped by more than
     /// tan(--deflection) x --window over the last --window mm of its travel
-    /// (on the grid and in the exact oracle alike); `x-slope` (SPEC's former
+    /// (on the grid and in the exact oracle alike); `x-slope` (the method's former
     /// baseline, for node-for-node comparison with other implementations):
     /// the surface's rise over one pitch from the point behind it.
     #[arg(

@@ -1,0 +1,122 @@
+//! The repository stands on its own (issue 40): a clone with nothing
+//! beside it builds and passes its tests, so no file of the project names
+//! a folder outside it, and no tracked file is too large for a clone to
+//! carry.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn repo() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The tracked files, as `git ls-files` lists them (the tests run in a
+/// clone); `None` where the tree is not a git checkout (a source archive),
+/// where these checks have nothing to judge.
+fn tracked_files(root: &Path) -> Option<Vec<PathBuf>> {
+    let out = Command::new("git")
+        .arg("-C")
+        .arg(root)
+        .args(["ls-files", "-z"])
+        .output()
+        .ok()?;
+    if !out.status.success() {
+        return None;
+    }
+    let names = String::from_utf8(out.stdout).expect("UTF-8 paths");
+    Some(
+        names
+            .split('\0')
+            .filter(|n| !n.is_empty())
+            .map(PathBuf::from)
+            .collect(),
+    )
+}
+
+/// The tracked files of `root` (relative paths) whose text holds
+/// `needle`, but for the changelog, whose history may name old layouts.
+fn files_naming(root: &Path, needle: &str) -> Vec<PathBuf> {
+    let Some(files) = tracked_files(root) else {
+        return Vec::new();
+    };
+    files
+        .into_iter()
+        .filter(|f| f != Path::new("CHANGELOG.md"))
+        .filter(|f| {
+            std::fs::read(root.join(f)).is_ok_and(|bytes| {
+                bytes
+                    .windows(needle.len())
+                    .any(|w| w == needle.as_bytes())
+            })
+        })
+        .collect()
+}
+
+/// The tracked files of `root` larger than `limit` bytes.
+fn files_over(root: &Path, limit: u64) -> Vec<(PathBuf, u64)> {
+    let Some(files) = tracked_files(root) else {
+        return Vec::new();
+    };
+    files
+        .into_iter()
+        .filter_map(|f| {
+            let len = std::fs::metadata(root.join(&f)).ok()?.len();
+            (len > limit).then_some((f, len))
+        })
+        .collect()
+}
+
+/// Five megabytes: the largest file a clone should carry (issue 40).
+const MAX_TRACKED_BYTES: u64 = 5_000_000;
+
+// The parent folder's name, spelled in two pieces so that this file does
+// not name it itself.
+fn outside() -> String {
+    format!("..{}shared", '/')
+}
+
+#[test]
+fn no_file_of_the_project_names_a_folder_beside_it() {
+    let found = files_naming(repo(), &outside());
+    assert!(
+        found.is_empty(),
+        "tracked files naming {}: {found:?}",
+        outside()
+    );
+}
+
+#[test]
+fn no_tracked_file_is_over_five_megabytes() {
+    let found = files_over(repo(), MAX_TRACKED_BYTES);
+    assert!(found.is_empty(), "tracked files over 5 MB: {found:?}");
+}
+
+/// The two checks find what they look for: a scratch repository with a
+/// file naming the folder beside it and a 6 MB file fails both.
+#[test]
+fn the_checks_find_a_reference_and_a_large_file() {
+    let dir = std::env::temp_dir().join(format!("kneeform-standalone-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let git = |args: &[&str]| {
+        let ok = Command::new("git")
+            .arg("-C")
+            .arg(&dir)
+            .args(args)
+            .output()
+            .is_ok_and(|o| o.status.success());
+        assert!(ok, "git {args:?}");
+    };
+    git(&["init", "-q"]);
+    std::fs::write(dir.join("a.md"), format!("see {}/SPEC.md", outside())).unwrap();
+    std::fs::write(dir.join("CHANGELOG.md"), outside()).unwrap();
+    std::fs::write(dir.join("big.csv"), vec![b'0'; 6_000_000]).unwrap();
+    std::fs::write(dir.join("small.csv"), b"0\n").unwrap();
+    git(&["add", "."]);
+    assert_eq!(files_naming(&dir, &outside()), vec![PathBuf::from("a.md")]);
+    assert_eq!(
+        files_over(&dir, MAX_TRACKED_BYTES),
+        vec![(PathBuf::from("big.csv"), 6_000_000)]
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
