@@ -68,6 +68,7 @@ pub mod shard;
 pub mod strike;
 pub mod summary;
 mod zbuffer;
+pub mod zones;
 
 pub use analysis::{Analysis, AnalysisError, Progress, Status};
 pub use assembly::PartSource;

@@ -21,7 +21,7 @@ const FLOORS: [&[&str]; 10] = [
     &["grid"],
     &["kneeform"],
     &["engine", "direct", "memory", "blind"],
-    &["scenario", "input", "assembly", "sanity", "setup"],
+    &["scenario", "input", "assembly", "sanity", "setup", "zones"],
     &["summary", "analysis"],
     &["harness"],
     &["output"],

@@ -1,0 +1,344 @@
+//! Struck zones: the colliding area as a designer reads it, a list of
+//! connected places rather than a mask of nodes (issue 43, item 1).
+//!
+//! A **zone** is a connected set of the composite's colliding nodes, nodes
+//! joined when they are 8-neighbours on the grid (a diagonal step joins: a
+//! strike along a slanted crease is one zone, not a staircase of specks).
+//! Each node stands for its cell of `p x p` mm around it, so a zone's area
+//! is its node count times `p^2`, as the summary's colliding area is.
+//!
+//! Per zone: the angles whose own mask strikes one of its nodes, written as
+//! runs over the analysed angles ("-30 to -12, 4 to 30"), the largest
+//! composite count among its nodes, its bounding box and centroid in the
+//! part's own coordinates (the nodes' surface points `(x, h, z)` mapped back
+//! by the run's [`Placement`]), and whether a blind spot's cell touches it
+//! (shares or neighbours one of its nodes). A zone of fewer than
+//! [`SPECK_NODES`] nodes is a **speck**: listed, never hidden, with the
+//! nearest zone that is not one (its neighbour), so a reader sees a stray
+//! node beside the area it belongs to rather than as a place of its own.
+//!
+//! **Invariant:** zones partition the composite's colliding nodes; their
+//! ids follow their order, largest area first (ties: the smaller first node
+//! index, row-major), so the same mask gives the same ids on every run.
+
+use crate::blind::BlindSpot;
+use crate::engine::AngleMask;
+use crate::frame::Placement;
+use crate::grid::HeightGrid;
+
+/// Below this many nodes a zone is a speck (listed beside its neighbour):
+/// fewer than a 2 x 2 patch of cells is below what a pitch resolves.
+pub const SPECK_NODES: usize = 4;
+
+/// One connected colliding zone of the composite.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Zone {
+    /// 1 for the largest zone, then by decreasing area.
+    pub id: usize,
+    /// Its colliding nodes.
+    pub nodes: usize,
+    /// Its area (mm^2): `nodes x p^2`.
+    pub area_mm2: f64,
+    /// The smallest corner of its nodes' surface points, in the part's own
+    /// coordinates (mm).
+    pub bbox_min: [f64; 3],
+    /// The largest corner (mm).
+    pub bbox_max: [f64; 3],
+    /// The mean of its nodes' surface points, in the part's own
+    /// coordinates (mm).
+    pub centroid: [f64; 3],
+    /// The analysed angles (degrees) whose mask strikes one of its nodes,
+    /// ascending.
+    pub angles_deg: Vec<f64>,
+    /// The same angles as runs of consecutive analysed angles, e.g.
+    /// `-30 to -12, 4 to 30`.
+    pub angle_runs: String,
+    /// The largest number of angles striking one of its nodes.
+    pub max_count: u16,
+    /// Whether a blind spot's cell shares or neighbours one of its nodes.
+    pub touches_blind_spot: bool,
+    /// Fewer than [`SPECK_NODES`] nodes.
+    pub speck: bool,
+    /// For a speck, the id of the nearest zone that is not a speck (by
+    /// the distance between their closest nodes); `None` otherwise, or
+    /// when every zone is a speck.
+    pub beside: Option<usize>,
+}
+
+/// The zones of a composite: connected (8-neighbour) sets of its colliding
+/// nodes, described as [`Zone`] says, largest first.
+///
+/// `masks` are the per-angle masks the composite counts (an empty mask, an
+/// angle outside a shard, strikes nothing); `angles_deg` the analysed
+/// angles in the order of the run.
+pub fn zones(
+    grid: &HeightGrid,
+    composite: &[u16],
+    masks: &[AngleMask],
+    blind_spots: &[BlindSpot],
+    placement: &Placement,
+) -> Vec<Zone> {
+    let spec = grid.spec;
+    let (nx, nz) = (spec.nx, spec.nz);
+    let labels = label(composite, nx, nz);
+    let count = labels.iter().flatten().map(|&l| l + 1).max().unwrap_or(0);
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); count];
+    for (n, l) in labels.iter().enumerate() {
+        if let Some(l) = *l {
+            members[l].push(n);
+        }
+    }
+    // Largest first; equal sizes by their first node (row-major), which
+    // the labelling's order already is.
+    members.sort_by(|a, b| b.len().cmp(&a.len()).then(a[0].cmp(&b[0])));
+    let mut analysed: Vec<f64> = masks.iter().map(|m| m.angle_deg).collect();
+    analysed.sort_by(f64::total_cmp);
+    analysed.dedup();
+    let area = spec.pitch * spec.pitch;
+    let mut out: Vec<Zone> = members
+        .iter()
+        .enumerate()
+        .map(|(k, nodes)| {
+            let (mut lo, mut hi, mut sum) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3], [0.0; 3]);
+            for &n in nodes {
+                let p = placement.to_part([spec.x(n % nx), grid.h[n], spec.z(n / nx)]);
+                for c in 0..3 {
+                    lo[c] = lo[c].min(p[c]);
+                    hi[c] = hi[c].max(p[c]);
+                    sum[c] += p[c];
+                }
+            }
+            let mut angles_deg: Vec<f64> = masks
+                .iter()
+                .filter(|m| !m.mask.is_empty() && nodes.iter().any(|&n| m.mask[n] != 0))
+                .map(|m| m.angle_deg)
+                .collect();
+            angles_deg.sort_by(f64::total_cmp);
+            angles_deg.dedup();
+            let touches_blind_spot = blind_spots.iter().any(|s| {
+                nodes.iter().any(|&n| {
+                    let (i, j) = (n % nx, n / nx);
+                    // The cell spans columns s.i..=s.i+1 and rows s.j..=s.j+1;
+                    // a node touches it when within one node of those.
+                    i + 1 >= s.i && i <= s.i + 2 && j + 1 >= s.j && j <= s.j + 2
+                })
+            });
+            Zone {
+                id: k + 1,
+                nodes: nodes.len(),
+                area_mm2: nodes.len() as f64 * area,
+                bbox_min: lo,
+                bbox_max: hi,
+                centroid: sum.map(|s| s / nodes.len() as f64),
+                angle_runs: angle_runs(&angles_deg, &analysed),
+                angles_deg,
+                max_count: nodes.iter().map(|&n| composite[n]).max().unwrap_or(0),
+                touches_blind_spot,
+                speck: nodes.len() < SPECK_NODES,
+                beside: None,
+            }
+        })
+        .collect();
+    for k in 0..out.len() {
+        if out[k].speck {
+            out[k].beside = nearest_zone(&members, &out, k, nx);
+        }
+    }
+    out
+}
+
+/// The 8-connected components of the nodes with a non-zero count: per
+/// node its component's index, numbered in the order of their first node
+/// (row-major), or `None` off the area.
+fn label(composite: &[u16], nx: usize, nz: usize) -> Vec<Option<usize>> {
+    let mut labels: Vec<Option<usize>> = vec![None; composite.len()];
+    let mut next = 0;
+    let mut stack = Vec::new();
+    for start in 0..composite.len() {
+        if composite[start] == 0 || labels[start].is_some() {
+            continue;
+        }
+        labels[start] = Some(next);
+        stack.push(start);
+        while let Some(n) = stack.pop() {
+            let (i, j) = ((n % nx) as isize, (n / nx) as isize);
+            for (di, dj) in NEIGHBOURS {
+                let (a, b) = (i + di, j + dj);
+                if a < 0 || b < 0 || a >= nx as isize || b >= nz as isize {
+                    continue;
+                }
+                let m = b as usize * nx + a as usize;
+                if composite[m] != 0 && labels[m].is_none() {
+                    labels[m] = Some(next);
+                    stack.push(m);
+                }
+            }
+        }
+        next += 1;
+    }
+    labels
+}
+
+/// The eight neighbours of a node, as (column, row) steps.
+const NEIGHBOURS: [(isize, isize); 8] = [
+    (-1, -1),
+    (0, -1),
+    (1, -1),
+    (-1, 0),
+    (1, 0),
+    (-1, 1),
+    (0, 1),
+    (1, 1),
+];
+
+/// The id of the zone that is not a speck nearest to zone `k` (the
+/// smallest node-to-node distance, in nodes; ties to the smaller id).
+fn nearest_zone(members: &[Vec<usize>], zones: &[Zone], k: usize, nx: usize) -> Option<usize> {
+    let at = |n: usize| ((n % nx) as f64, (n / nx) as f64);
+    zones
+        .iter()
+        .enumerate()
+        .filter(|(other, z)| *other != k && !z.speck)
+        .map(|(other, z)| {
+            let d = members[k]
+                .iter()
+                .flat_map(|&a| members[other].iter().map(move |&b| (a, b)))
+                .map(|(a, b)| {
+                    let ((xa, za), (xb, zb)) = (at(a), at(b));
+                    (xa - xb).hypot(za - zb)
+                })
+                .fold(f64::INFINITY, f64::min);
+            (d, z.id)
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+        .map(|(_, id)| id)
+}
+
+/// `angles` (ascending, a subset of `analysed`, which is ascending) as runs
+/// of consecutive analysed angles: "-30 to -12, 4 to 30"; a run of one
+/// angle is that angle alone; "none" when empty.
+pub fn angle_runs(angles: &[f64], analysed: &[f64]) -> String {
+    if angles.is_empty() {
+        return "none".into();
+    }
+    let struck: Vec<bool> = analysed
+        .iter()
+        .map(|a| angles.iter().any(|b| b == a))
+        .collect();
+    let mut runs: Vec<String> = Vec::new();
+    let mut k = 0;
+    while k < analysed.len() {
+        if !struck[k] {
+            k += 1;
+            continue;
+        }
+        let first = k;
+        while k + 1 < analysed.len() && struck[k + 1] {
+            k += 1;
+        }
+        runs.push(if first == k {
+            format!("{}", analysed[first])
+        } else {
+            format!("{} to {}", analysed[first], analysed[k])
+        });
+        k += 1;
+    }
+    runs.join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::Side;
+    use crate::grid::GridSpec;
+
+    fn placement() -> Placement {
+        Placement::from(Side::Left)
+    }
+
+    /// A 6 x 4 grid at 2 mm, flat at y = 10.
+    fn grid() -> HeightGrid {
+        let spec = GridSpec::explicit(0.0, 0.0, 6, 4, 2.0);
+        HeightGrid::from_fn(spec, |_, _| 10.0)
+    }
+
+    fn mask(angle_deg: f64, on: &[usize], len: usize) -> AngleMask {
+        let mut mask = vec![0; len];
+        for &n in on {
+            mask[n] = 1;
+        }
+        AngleMask {
+            angle_deg,
+            mask,
+            placed: 1,
+            colliding: on.len(),
+            probes_met: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn runs_of_consecutive_analysed_angles() {
+        let analysed: Vec<f64> = (-30..=30).map(f64::from).collect();
+        let mut angles: Vec<f64> = (-30..=-12).map(f64::from).collect();
+        angles.extend((4..=30).map(f64::from));
+        assert_eq!(angle_runs(&angles, &analysed), "-30 to -12, 4 to 30");
+        assert_eq!(angle_runs(&[0.0], &analysed), "0");
+        assert_eq!(angle_runs(&[], &analysed), "none");
+        // Consecutive in the analysed list, not in whole degrees.
+        assert_eq!(angle_runs(&[-30.0, 0.0], &[-30.0, 0.0, 30.0]), "-30 to 0");
+    }
+
+    #[test]
+    fn diagonal_neighbours_join_and_specks_stand_beside_their_neighbour() {
+        let g = grid();
+        let len = g.spec.len();
+        // Row-major, nx = 6: a 2 x 2 block at columns 0-1 of rows 0-1,
+        // joined diagonally by node (2, 2); a lone node at (5, 0).
+        let block = [0, 1, 6, 7, 14];
+        let masks = [mask(-30.0, &block, len), mask(0.0, &[0, 5], len)];
+        let mut composite = vec![0u16; len];
+        for m in &masks {
+            for (c, &v) in composite.iter_mut().zip(&m.mask) {
+                *c += u16::from(v);
+            }
+        }
+        let z = zones(&g, &composite, &masks, &[], &placement());
+        assert_eq!(z.len(), 2);
+        assert_eq!((z[0].id, z[0].nodes, z[0].area_mm2), (1, 5, 20.0));
+        assert_eq!(z[0].angles_deg, vec![-30.0, 0.0]);
+        assert_eq!(z[0].angle_runs, "-30 to 0");
+        assert_eq!(z[0].max_count, 2);
+        assert!(!z[0].speck);
+        assert_eq!(z[0].bbox_min, [0.0, 10.0, 0.0]);
+        assert_eq!(z[0].bbox_max, [4.0, 10.0, 4.0]);
+        assert_eq!(z[0].centroid, [1.6, 10.0, 1.6]);
+        assert_eq!((z[1].nodes, z[1].speck, z[1].beside), (1, true, Some(1)));
+        assert_eq!(z[1].angle_runs, "0");
+        // The zones partition the colliding nodes.
+        let colliding = composite.iter().filter(|&&c| c > 0).count();
+        assert_eq!(z.iter().map(|z| z.nodes).sum::<usize>(), colliding);
+    }
+
+    #[test]
+    fn a_blind_spot_beside_a_zone_touches_it_and_one_far_away_does_not() {
+        let g = grid();
+        let len = g.spec.len();
+        let masks = [mask(0.0, &[0, 1, 6, 7], len)];
+        let composite: Vec<u16> = masks[0].mask.iter().map(|&v| u16::from(v)).collect();
+        let spot = |i, j| BlindSpot {
+            i,
+            j,
+            x: 0.0,
+            z: 0.0,
+            depth_missed_mm: 1.0,
+            width_mm: 1.0,
+            resolving_pitch_mm: 1.0,
+            y: 0.0,
+            met_angles_deg: Vec::new(),
+        };
+        let near = zones(&g, &composite, &masks, &[spot(2, 1)], &placement());
+        assert!(near[0].touches_blind_spot);
+        let far = zones(&g, &composite, &masks, &[spot(4, 2)], &placement());
+        assert!(!far[0].touches_blind_spot);
+    }
+}
