@@ -403,6 +403,18 @@ impl Analysis {
         self.composite.iter().filter(|&&c| c > 0).count()
     }
 
+    /// The composite's struck zones ([`crate::zones`]), largest first: what
+    /// `zones.csv` and `summary.json`'s `zones` hold.
+    pub fn zones(&self) -> Vec<crate::zones::Zone> {
+        crate::zones::zones(
+            &self.grid,
+            &self.composite,
+            &self.masks,
+            &self.blind_spots,
+            &self.placement(),
+        )
+    }
+
     /// Whether anything is struck.
     pub fn status(&self) -> Status {
         if self.composite_nodes() > 0 {
@@ -507,6 +519,9 @@ impl Analysis {
                 .count(),
             timings: self.timings.clone(),
             warnings: self.warnings.iter().map(ToString::to_string).collect(),
+            // Set by the writer from the results it writes, whole or
+            // merged from shards (`output::write_results`).
+            zones: Vec::new(),
         }
     }
 }

@@ -202,6 +202,10 @@ pub struct Summary {
     /// regulation's, nothing struck. Absent in runs of earlier versions.
     #[serde(default)]
     pub warnings: Vec<String>,
+    /// The composite's struck zones ([`crate::zones`]), largest first, as
+    /// `zones.csv` lists them. Absent in runs of earlier versions.
+    #[serde(default)]
+    pub zones: Vec<crate::zones::Zone>,
 }
 
 /// Why a `summary.json` cannot be used: it does not parse as a summary, or

@@ -35,9 +35,10 @@ fn real_meshes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/meshes")
 }
 
-const OUTPUTS: [&str; 6] = [
+const OUTPUTS: [&str; 7] = [
     "summary.json",
     "composite.csv",
+    "zones.csv",
     "colliding_area.stl",
     "colliding_area.ply",
     "depth.png",

@@ -19,3 +19,4 @@ mod second_hour;
 mod shard;
 mod standalone;
 mod util;
+mod zones;

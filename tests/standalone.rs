@@ -43,11 +43,8 @@ fn files_naming(root: &Path, needle: &str) -> Vec<PathBuf> {
         .into_iter()
         .filter(|f| f != Path::new("CHANGELOG.md"))
         .filter(|f| {
-            std::fs::read(root.join(f)).is_ok_and(|bytes| {
-                bytes
-                    .windows(needle.len())
-                    .any(|w| w == needle.as_bytes())
-            })
+            std::fs::read(root.join(f))
+                .is_ok_and(|bytes| bytes.windows(needle.len()).any(|w| w == needle.as_bytes()))
         })
         .collect()
 }

@@ -169,6 +169,7 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
             }
         );
     }
+    print_zones(&summary.zones);
     if let Some(check) = &analysis.sample_check {
         super::print_check(check);
     }
@@ -192,4 +193,39 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The five largest struck zones, one line each (all of them in
+/// `zones.csv`), and how many more there are.
+fn print_zones(zones: &[kneeform::zones::Zone]) {
+    const SHOWN: usize = 5;
+    if zones.is_empty() {
+        return;
+    }
+    let specks = zones.iter().filter(|z| z.speck).count();
+    eprintln!(
+        "kneeform: {} struck zones ({specks} of them specks under {} nodes), largest first (zones.csv lists them all):",
+        zones.len(),
+        kneeform::zones::SPECK_NODES
+    );
+    for z in zones.iter().take(SHOWN) {
+        let c = z.centroid;
+        eprintln!(
+            "kneeform:   zone {}: {:.0} mm^2 around ({:.1}, {:.1}, {:.1}) mm, angles {}{}",
+            z.id,
+            z.area_mm2,
+            c[0],
+            c[1],
+            c[2],
+            z.angle_runs,
+            if z.touches_blind_spot {
+                "; a blind spot touches it"
+            } else {
+                ""
+            }
+        );
+    }
+    if zones.len() > SHOWN {
+        eprintln!("kneeform:   ... and {} more", zones.len() - SHOWN);
+    }
 }

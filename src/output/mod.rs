@@ -58,9 +58,10 @@ pub const SUMMARY_JSON: &str = "summary.json";
 /// The files kneeform writes into a result directory: a run's, a
 /// verification's, a convergence study's, a shard's, the report, and a
 /// batch item's fingerprint.
-pub(crate) const OWN_FILES: [&str; 18] = [
+pub(crate) const OWN_FILES: [&str; 19] = [
     SUMMARY_JSON,
     "composite.csv",
+    "zones.csv",
     "colliding_points.csv",
     "colliding_area.stl",
     "colliding_area.ply",

@@ -151,12 +151,67 @@ pub fn write_results(
     tables?;
     meshes?;
     pictures?;
+    summary.zones = crate::zones::zones(grid, counts, masks, results.blind_spots, placement);
+    write_zones(&out.path(ZONES_CSV), &summary.zones)?;
     let t_ = &mut summary.timings;
     t_.write_s = started.elapsed().as_secs_f64();
     t_.total_s = t_.read_s + t_.sample_s + t_.blind_s + t_.push_slide_s + t_.check_s + t_.write_s;
     summary.peak_rss_mib = crate::memory::peak_rss_bytes().map(|b| b / (1024.0 * 1024.0));
     write_json(&out.path(super::SUMMARY_JSON), &summary)?;
     Ok(summary)
+}
+
+/// The struck zones' table, one row per zone ([`crate::zones`]).
+pub const ZONES_CSV: &str = "zones.csv";
+
+/// Writes `zones.csv`: one row per struck zone, largest first: its id,
+/// node count and area (mm^2), bounding box and centroid (mm, the part's
+/// own coordinates, to 1 um), the angles striking it as runs, its largest
+/// count, whether a blind spot touches it, and for a speck the zone it
+/// lies beside.
+fn write_zones(path: &Path, zones: &[crate::zones::Zone]) -> Result<(), WriteError> {
+    (|| -> csv::Result<()> {
+        let mut csv = csv::Writer::from_path(path)?;
+        csv.write_record([
+            "zone",
+            "nodes",
+            "area_mm2",
+            "x_min",
+            "y_min",
+            "z_min",
+            "x_max",
+            "y_max",
+            "z_max",
+            "x_centroid",
+            "y_centroid",
+            "z_centroid",
+            "angles",
+            "max_count",
+            "blind_spot",
+            "speck_beside",
+        ])?;
+        let um = super::csv::micrometres;
+        for z in zones {
+            let mut row = vec![z.id.to_string(), z.nodes.to_string(), um(z.area_mm2)];
+            row.extend(
+                z.bbox_min
+                    .iter()
+                    .chain(&z.bbox_max)
+                    .chain(&z.centroid)
+                    .map(|&v| um(v)),
+            );
+            row.extend([
+                z.angle_runs.clone(),
+                z.max_count.to_string(),
+                z.touches_blind_spot.to_string(),
+                z.beside.map_or_else(String::new, |b| b.to_string()),
+            ]);
+            csv.write_record(row)?;
+        }
+        csv.flush()?;
+        Ok(())
+    })()
+    .map_err(WriteError::at(path))
 }
 
 /// Writes `blind_spots.csv`: one row per blind spot ([`crate::blind`]),
