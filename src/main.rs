@@ -64,6 +64,7 @@ fn run(cli: &Cli) -> anyhow::Result<ExitCode> {
         Command::Merge(args) => return cli::merge::run(args),
         Command::Batch(args) => return cli::batch::run(args),
         Command::Report(args) => cli::report::run(args)?,
+        Command::Diff(args) => cli::diff::run(args)?,
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -80,17 +80,7 @@ pub fn zones(
 ) -> Vec<Zone> {
     let spec = grid.spec;
     let (nx, nz) = (spec.nx, spec.nz);
-    let labels = label(composite, nx, nz);
-    let count = labels.iter().flatten().map(|&l| l + 1).max().unwrap_or(0);
-    let mut members: Vec<Vec<usize>> = vec![Vec::new(); count];
-    for (n, l) in labels.iter().enumerate() {
-        if let Some(l) = *l {
-            members[l].push(n);
-        }
-    }
-    // Largest first; equal sizes by their first node (row-major), which
-    // the labelling's order already is.
-    members.sort_by(|a, b| b.len().cmp(&a.len()).then(a[0].cmp(&b[0])));
+    let members = components(composite, nx, nz);
     let mut analysed: Vec<f64> = masks.iter().map(|m| m.angle_deg).collect();
     analysed.sort_by(f64::total_cmp);
     analysed.dedup();
@@ -145,6 +135,23 @@ pub fn zones(
         }
     }
     out
+}
+
+/// The 8-connected components of the nodes of an `nx x nz` grid
+/// (row-major by z) with a non-zero count, each as its nodes' indices in
+/// ascending order, largest first (equal sizes by their first node): the
+/// zones' order, whose ids are their positions plus one.
+pub fn components(counts: &[u16], nx: usize, nz: usize) -> Vec<Vec<usize>> {
+    let labels = label(counts, nx, nz);
+    let count = labels.iter().flatten().map(|&l| l + 1).max().unwrap_or(0);
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); count];
+    for (n, l) in labels.iter().enumerate() {
+        if let Some(l) = *l {
+            members[l].push(n);
+        }
+    }
+    members.sort_by(|a, b| b.len().cmp(&a.len()).then(a[0].cmp(&b[0])));
+    members
 }
 
 /// The 8-connected components of the nodes with a non-zero count: per

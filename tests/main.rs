@@ -4,6 +4,7 @@
 mod analytic;
 mod architecture;
 mod cli;
+mod diff;
 mod direct;
 mod engine;
 mod first_hour;

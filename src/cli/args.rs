@@ -56,6 +56,11 @@ pub enum Command {
     /// with views of the part, the colliding area per angle, and the
     /// verification results of any VERIFY_DIR given.
     Report(ReportArgs),
+    /// Compare two revisions of a part (two `analyze` runs with the same
+    /// knee-form, strike rule, side, frame and angles): the nodes struck
+    /// only in A, only in B and in both, on A's grid, and the struck zones
+    /// that appeared, vanished, grew or shrank.
+    Diff(DiffArgs),
 }
 
 /// How to read the part's files: units, frame and side.
@@ -361,6 +366,27 @@ pub struct ReportArgs {
     /// touches.
     #[arg(long, value_name = "RUN_DIR")]
     pub compare: Option<PathBuf>,
+}
+
+/// `kneeform diff`.
+#[derive(Debug, Args)]
+pub struct DiffArgs {
+    /// The earlier revision's `analyze` output directory (A): the
+    /// comparison is drawn on its grid.
+    pub run_a: PathBuf,
+    /// The later revision's `analyze` output directory (B), mapped onto
+    /// A's grid (each node of A takes the largest count of B's nodes
+    /// within half B's pitch in x and z). Its part, pitch and extent may
+    /// differ from A's.
+    pub run_b: PathBuf,
+    /// Output directory (created; it appears whole or not at all):
+    /// diff.json, diff_nodes.csv, diff_zones.csv, diff.png. An existing
+    /// one is refused unless --force is given.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Replace an existing --out directory of an earlier diff.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// Which starts a comparison uses.

@@ -5,6 +5,7 @@ pub mod args;
 pub mod batch;
 pub mod bench;
 pub mod converge;
+pub mod diff;
 pub mod merge;
 pub mod progress;
 pub mod report;
@@ -230,6 +231,7 @@ pub fn stage_output(out: &Path, force: bool) -> anyhow::Result<OutputDir> {
                 "shard.json",
                 "verify.json",
                 "converge.json",
+                "diff.json",
             ]
             .iter()
             .any(|f| out.join(f).is_file());
@@ -239,7 +241,7 @@ pub fn stage_output(out: &Path, force: bool) -> anyhow::Result<OutputDir> {
                 .is_none();
             ensure!(
                 is_run || is_empty,
-                "--out {} is not a kneeform run directory (no summary.json, verify.json, converge.json or shard.json), so --force will not replace it: choose another --out",
+                "--out {} is not a kneeform run directory (no summary.json, verify.json, converge.json, diff.json or shard.json), so --force will not replace it: choose another --out",
                 out.display()
             );
             if let Some(name) = kneeform::output::foreign_entry(out)

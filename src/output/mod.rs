@@ -58,7 +58,7 @@ pub const SUMMARY_JSON: &str = "summary.json";
 /// The files kneeform writes into a result directory: a run's, a
 /// verification's, a convergence study's, a shard's, the report, and a
 /// batch item's fingerprint.
-pub(crate) const OWN_FILES: [&str; 19] = [
+pub(crate) const OWN_FILES: [&str; 23] = [
     SUMMARY_JSON,
     "composite.csv",
     "zones.csv",
@@ -78,6 +78,10 @@ pub(crate) const OWN_FILES: [&str; 19] = [
     "error_vs_pitch.png",
     "time_vs_pitch.png",
     "batch-item.json",
+    "diff.json",
+    "diff_nodes.csv",
+    "diff_zones.csv",
+    "diff.png",
 ];
 
 /// Whether `name` is a file kneeform writes into a result directory

@@ -21,6 +21,7 @@
 use std::path::{Path, PathBuf};
 
 mod compare;
+mod diff;
 mod document;
 mod error;
 mod html;
@@ -30,6 +31,7 @@ mod verify;
 mod view3d;
 mod views;
 
+pub use self::diff::{NodeState, RevisionDiff, ZoneChange, ZoneDiff, diff_runs, write_diff};
 pub use self::document::MAIN_BORDER;
 pub use self::error::ReportError;
 pub use self::run::grid_spec;

@@ -478,7 +478,7 @@ fn check_counts(summary: &Summary, composite: &NodeCounts) -> Result<(), String>
     Ok(())
 }
 
-fn read_composite(
+pub(super) fn read_composite(
     path: &Path,
     spec: GridSpec,
     frame: &Frame,
@@ -495,7 +495,7 @@ fn read_composite(
 }
 
 /// The run's `--frame`, checked as `analyze` checked it.
-fn run_frame(summary: &Summary, path: &Path) -> Result<Frame, ReportError> {
+pub(super) fn run_frame(summary: &Summary, path: &Path) -> Result<Frame, ReportError> {
     summary
         .frame
         .as_ref()
