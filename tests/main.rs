@@ -20,4 +20,5 @@ mod second_hour;
 mod shard;
 mod standalone;
 mod util;
+mod view3d;
 mod zones;

@@ -425,6 +425,9 @@ pub fn headless(
             "--headless",
             "--no-sandbox",
             "--disable-gpu",
+            // WebGL on the CPU (SwiftShader): Chromium 15x turns it off
+            // by default without a GPU, and the 3D view's tests need it.
+            "--enable-unsafe-swiftshader",
             "--disable-quic",
             "--no-first-run",
             "--disable-background-networking",

@@ -163,6 +163,99 @@
     return m;
   }
 
+  // The overlay: a 2D canvas over the WebGL one (pointer events pass
+  // through), redrawn with every frame: the vehicle axes, the colour
+  // legend, a scale bar and the largest zones' ids.
+  var wrap = document.createElement("div");
+  wrap.style.position = "relative";
+  wrap.style.display = "inline-block";
+  wrap.style.maxWidth = "100%";
+  canvas.parentNode.insertBefore(wrap, canvas);
+  wrap.appendChild(canvas);
+  var overlay = document.createElement("canvas");
+  overlay.width = canvas.width;
+  overlay.height = canvas.height;
+  overlay.className = "view3d-overlay";
+  overlay.style.cssText = "position:absolute;left:1px;top:1px;width:calc(100% - 2px);height:calc(100% - 2px);pointer-events:none;";
+  wrap.appendChild(overlay);
+  var ctx2d = overlay.getContext("2d");
+  var zonesOf = null;
+  function project(m, p) {
+    // Canvas pixels of the point p (offsets from the centre), or null
+    // behind the eye.
+    var x = m[0] * p[0] + m[4] * p[1] + m[8] * p[2] + m[12];
+    var y = m[1] * p[0] + m[5] * p[1] + m[9] * p[2] + m[13];
+    var w = m[3] * p[0] + m[7] * p[1] + m[11] * p[2] + m[15];
+    if (w <= 0) return null;
+    return [(x / w + 1) / 2 * overlay.width, (1 - y / w) / 2 * overlay.height];
+  }
+  function niceLength(mm) {
+    var e = Math.pow(10, Math.floor(Math.log10(mm))), f = mm / e;
+    return (f >= 5 ? 5 : f >= 2 ? 2 : 1) * e;
+  }
+  function drawOverlay(m, b) {
+    var c = ctx2d, W = overlay.width, H = overlay.height;
+    c.clearRect(0, 0, W, H);
+    c.font = "13px sans-serif";
+    c.lineWidth = 2;
+    // The vehicle axes, from the bottom-left corner.
+    var o = [60, H - 60], axes = [["x", [1, 0, 0], "#c0392b"], ["y", [0, 1, 0], "#1e8449"], ["z", [0, 0, 1], "#2471a3"]];
+    axes.forEach(function (a) {
+      var v = a[1], sx = dot(v, b.right), sy = dot(v, b.up);
+      var e = [o[0] + 40 * sx, o[1] - 40 * sy];
+      c.strokeStyle = a[2]; c.fillStyle = a[2];
+      c.beginPath(); c.moveTo(o[0], o[1]); c.lineTo(e[0], e[1]); c.stroke();
+      c.fillText(a[0], e[0] + 4 * Math.sign(sx || 1), e[1] - 4 * Math.sign(sy || 1));
+    });
+    c.fillStyle = "#333";
+    c.fillText("vehicle axes (front -x, z up)", 12, H - 10);
+    // The legend: one swatch per count of the ramp.
+    var n = rampLen, top = 14, left = W - 150, sw = Math.min(14, Math.max(2, Math.floor(180 / n)));
+    c.fillStyle = "rgba(255,255,255,0.85)";
+    c.fillRect(left - 8, top - 4, 150, n * sw + 44);
+    c.fillStyle = "#333";
+    c.fillText("angles struck", left, top + 10);
+    for (var k = 0; k < n; k++) {
+      c.fillStyle = "rgb(" + rampBytes[4 * k] + "," + rampBytes[4 * k + 1] + "," + rampBytes[4 * k + 2] + ")";
+      c.fillRect(left, top + 18 + (n - 1 - k) * sw, 24, sw);
+    }
+    c.fillStyle = "#333";
+    c.fillText(String(n), left + 30, top + 28);
+    c.fillText("1", left + 30, top + 18 + n * sw);
+    c.fillStyle = "rgb(199,199,199)";
+    c.fillRect(left, top + 22 + n * sw, 24, 10);
+    c.fillStyle = "#333";
+    c.fillText("none", left + 30, top + 32 + n * sw);
+    // The scale bar: mm per pixel at the depth of the view's centre.
+    var mmPerPx = 2 * d.radius * cam.dist * Math.tan(fov / 2) / H;
+    var len = niceLength(mmPerPx * 140), px = len / mmPerPx;
+    c.strokeStyle = "#333"; c.fillStyle = "#333";
+    c.beginPath(); c.moveTo(W - 30 - px, H - 24); c.lineTo(W - 30, H - 24);
+    c.moveTo(W - 30 - px, H - 30); c.lineTo(W - 30 - px, H - 18);
+    c.moveTo(W - 30, H - 30); c.lineTo(W - 30, H - 18); c.stroke();
+    c.textAlign = "right";
+    c.fillText(len + " mm (at the view's centre)", W - 30, H - 34);
+    c.textAlign = "left";
+    // The largest zones' ids at their centroids, largest first; a label
+    // that would cover one already drawn is left out (a pick names it).
+    var placed = [];
+    (d.zones || []).forEach(function (z) {
+      var p = project(m, [z.at[0] - d.centre[0], z.at[1] - d.centre[1], z.at[2] - d.centre[2]]);
+      if (!p || p[0] < 0 || p[1] < 0 || p[0] > W || p[1] > H) return;
+      var label = "zone " + z.id;
+      var w = c.measureText(label).width + 8;
+      if (placed.some(function (q) { return Math.abs(q[0] - p[0]) < (q[2] + w) / 2 && Math.abs(q[1] - p[1]) < 18; })) return;
+      placed.push([p[0], p[1], w]);
+      c.fillStyle = "rgba(255,255,255,0.85)";
+      c.fillRect(p[0] - w / 2, p[1] - 9, w, 18);
+      c.strokeStyle = "#333"; c.lineWidth = 1;
+      c.strokeRect(p[0] - w / 2, p[1] - 9, w, 18);
+      c.fillStyle = "#000";
+      c.fillText(label, p[0] - w / 2 + 4, p[1] + 5);
+      c.lineWidth = 2;
+    });
+  }
+
   var picked = null, first = true, pending = false;
   function draw() {
     pending = false;
@@ -194,8 +287,10 @@
       gl.uniform3fv(gl.getUniformLocation(mark, "at"), picked);
       gl.drawArrays(gl.POINTS, 0, 1);
     }
+    drawOverlay(m, b);
     if (first) {
       first = false;
+      root.setAttribute("data-overlay", "axes legend scale-bar zones:" + (d.zones || []).length);
       var px = new Uint8Array(canvas.width * canvas.height * 4), part = 0, coloured = 0;
       gl.readPixels(0, 0, canvas.width, canvas.height, gl.RGBA, gl.UNSIGNED_BYTE, px);
       for (var i = 0; i < px.length; i += 4) {
@@ -206,7 +301,10 @@
       root.setAttribute("data-part-pixels", part);
       root.setAttribute("data-coloured-pixels", coloured);
       root.setAttribute("data-state", "drawn");
-      status.textContent = "Interactive 3D view (" + d.triangles + " triangles, grid " + d.size[0] + " x " + d.size[1] + " nodes).";
+      status.textContent = "Interactive 3D view (" + d.triangles + " triangles" +
+        (d.simplified ? ", simplified from " + d.simplified.original_triangles + ": the face towards the knee-form every " + d.simplified.pitch + " mm" : "") +
+        ", grid " + d.size[0] + " x " + d.size[1] + " nodes).";
+      if (d.simplified) root.setAttribute("data-simplified", d.simplified.original_triangles);
     }
   }
   function redraw() { if (!pending) { pending = true; requestAnimationFrame(draw); } }
@@ -265,6 +363,10 @@
       text += "; outside the grid.";
     } else {
       text += "; nearest node i = " + i + ", j = " + j;
+      if (zonesOf) {
+        var q = (j * d.size[0] + i) * 4, zone = zonesOf[q] * 65536 + zonesOf[q + 1] * 256 + zonesOf[q + 2];
+        text += zone > 0 ? " in zone " + zone + " (zones.csv)" : " in no struck zone";
+      }
       var list = anglesAt(j * d.size[0] + i);
       if (list === null) text += " (this run's composite.csv has no angle sets).";
       else if (list.length === 0) text += ": struck at no angle.";
@@ -309,15 +411,17 @@
     redraw();
   });
 
+  function pixels(img) {
+    var c = document.createElement("canvas");
+    c.width = img.width; c.height = img.height;
+    var ctx = c.getContext("2d");
+    ctx.drawImage(img, 0, 0);
+    return ctx.getImageData(0, 0, img.width, img.height, { colorSpace: "srgb" }).data;
+  }
   var loads = [bitmap(d.nodes_png).then(function (img) { texture(0, d.size[0], d.size[1], img); })];
+  loads.push(bitmap(d.zones_png).then(function (img) { zonesOf = pixels(img); }));
   if (d.masks_png) {
-    loads.push(bitmap(d.masks_png).then(function (img) {
-      var c = document.createElement("canvas");
-      c.width = img.width; c.height = img.height;
-      var ctx = c.getContext("2d");
-      ctx.drawImage(img, 0, 0);
-      masks = ctx.getImageData(0, 0, img.width, img.height, { colorSpace: "srgb" }).data;
-    }));
+    loads.push(bitmap(d.masks_png).then(function (img) { masks = pixels(img); }));
   }
   Promise.all(loads).then(draw, function (e) { unavailable("its data did not load (" + e + ")."); });
 })();
