@@ -167,8 +167,9 @@ fn four_shards_merged_are_the_unsharded_run_byte_for_byte() {
         let order: Vec<&Path> = [3, 0, 2, 1].iter().map(|&k| shards[k].as_path()).collect();
         ok(merge(&order, &merged), "merge");
         let files = assert_same_files(&whole, &merged);
-        // summary, composite, points, STL, PLY, two images, blind spots.
-        assert_eq!(files, 8, "{files} files compared");
+        // summary, composite, zones, points, STL, PLY, two images, blind
+        // spots.
+        assert_eq!(files, 9, "{files} files compared");
         let composite = std::fs::read_to_string(merged.join("composite.csv")).unwrap();
         if name != "thin-rib" {
             assert!(
@@ -800,7 +801,9 @@ fn a_killed_batch_resumes_and_ends_with_a_clean_batch_s_outputs() {
     );
     for item in ["wave", "bump-right", "wave-fine"] {
         let files = assert_same_files(&dir.join("runs").join(item), &clean.join("runs").join(item));
-        assert_eq!(files, 8, "{item}: {files} files");
+        // summary, composite, zones, points, STL, PLY, two images, blind
+        // spots.
+        assert_eq!(files, 9, "{item}: {files} files");
     }
     let runs: Vec<String> = std::fs::read_dir(dir.join("runs"))
         .unwrap()
