@@ -645,7 +645,9 @@ fn a_frame_placing_the_part_beyond_the_bound_is_refused() {
 /// a file named `summary.json` beside their own (`thesis.tex`). Only a
 /// directory of kneeform's files is replaced; the user's folder is left
 /// as it was, with a one-line refusal naming the file. A run with its
-/// report beside it is still replaced.
+/// report (`--report`) is still replaced; since issue 41, item 4, only
+/// files its record (`kneeform-run.json`) lists count as kneeform's, so a
+/// report.html written by hand beside a run is the user's.
 #[test]
 fn force_replaces_only_a_directory_of_kneeform_files() {
     let dir = scratch_dir("hostile-force-foreign");
@@ -679,12 +681,27 @@ fn force_replaces_only_a_directory_of_kneeform_files() {
     // A subdirectory alone is enough to refuse.
     std::fs::remove_file(folder.join("thesis.tex")).unwrap();
     assert!(assert_refused(&force_into_folder(), &dir, "a subdirectory").contains("figures"));
-    // A run with its report beside it is kneeform's own: replaced.
+    // A run with its report is kneeform's own: replaced.
     let run = dir.join("run");
-    small_run(&run, &[]);
-    std::fs::write(run.join("report.html"), "<html></html>").unwrap();
+    small_run(&run, &["--report"]);
+    assert!(run.join("report.html").is_file());
     small_run(&run, &["--force"]);
     assert!(!run.join("report.html").exists(), "replaced whole");
+    // A report.html of the user's beside it is not.
+    std::fs::write(run.join("report.html"), "<html></html>").unwrap();
+    let err = assert_refused(
+        &kneeform(&[
+            "analyze",
+            &scenario("bump"),
+            "--out",
+            &run.display().to_string(),
+            "--force",
+        ]),
+        &dir,
+        "a report.html of the user's",
+    );
+    assert!(err.contains("report.html"), "{err}");
+    assert!(run.join("report.html").is_file());
 }
 
 /// Runs `kneeform batch` on `manifest`, returning its output.

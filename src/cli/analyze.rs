@@ -61,7 +61,13 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
     }
     // Before any work: where the results go, so that an unwritable or
     // occupied --out is said now, not after the computation.
-    let out = super::stage_output(&args.out, args.force)?;
+    let inputs: Vec<&std::path::Path> = args
+        .parts
+        .iter()
+        .chain(&args.ignore)
+        .map(|p| p.as_path())
+        .collect();
+    let out = super::stage_output(&args.out, args.force, &inputs)?;
     super::set_threads(threads)?;
     let bars = Bars::default();
     let mut choice = None;
@@ -183,7 +189,12 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
             ..kneeform::report::ReportOptions::new(&args.out)
         };
         let report = args.out.join("report.html");
-        if let Err(err) = super::write_report(&options, &report, &report) {
+        // Recorded as kneeform's, so that --force may replace it later.
+        let written = super::write_report(&options, &report, &report).and_then(|()| {
+            output::add_to_record(&args.out, &["report.html"])
+                .with_context(|| format!("cannot record report.html in {}", output::RUN_RECORD))
+        });
+        if let Err(err) = written {
             eprintln!(
                 "kneeform: error: {}; the analysis is complete and kept in {}, only its report is missing",
                 super::one_line(&err),

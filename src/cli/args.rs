@@ -67,7 +67,12 @@ pub enum Command {
 #[derive(Debug, Args)]
 pub struct PartArgs {
     /// Factor taking the file's units to mm (e.g. 1000 for metres).
-    #[arg(long, default_value_t = 1.0, value_name = "FACTOR")]
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        value_name = "FACTOR",
+        allow_hyphen_values = true
+    )]
     pub scale: f64,
     /// Side of the vehicle the analysed surface is on: `left` faces -y (the
     /// knee is pushed in +y); `right` faces +y and is mirrored y -> -y for
@@ -79,9 +84,11 @@ pub struct PartArgs {
     /// not modelled in them: three signed part axes, one per vehicle axis
     /// x, y, z (`x,-z,y`: vehicle x is the part's x, vehicle y its -z,
     /// vehicle z its y), or @FILE holding a 4x4 or 3x4 rigid transform
-    /// (row by row; part coordinates in mm, after --scale, to vehicle
+    /// (one row a line; part coordinates in mm, after --scale, to vehicle
     /// coordinates). A proper rotation only (orthonormal, determinant +1,
-    /// within 1e-9): a mirror is --side right. The part is mapped by the
+    /// within 1e-6; one off by more than 1e-9, as a matrix written to 8
+    /// decimals is, is made its nearest rotation and the change recorded
+    /// in summary.json): a mirror is --side right, a scaling is refused. The part is mapped by the
     /// frame first, then mirrored by --side; every result (CSV, STL, PLY,
     /// summary's bounding box) is mapped back to the part's own
     /// coordinates; the images and the report are drawn in vehicle
@@ -253,10 +260,10 @@ pub struct AnalyzeArgs {
     /// existing one is refused unless --force is given.
     #[arg(long, default_value = "kneeform-out", value_name = "DIR")]
     pub out: PathBuf,
-    /// Replace an existing --out directory of an earlier run (one holding
-    /// summary.json, a study's verify.json or converge.json, or a shard's
-    /// shard.json, and no file kneeform did not write; or empty) with this
-    /// run's results, whole.
+    /// Replace an existing --out directory of an earlier result (one whose
+    /// kneeform-run.json, kneeform's record of the files it wrote, lists
+    /// every file in it, unchanged, and which holds none of this run's
+    /// inputs; or empty) with this run's results, whole.
     #[arg(long)]
     pub force: bool,
     /// Also write the evidence report, `report.html`, into the output
@@ -313,9 +320,9 @@ pub struct MergeArgs {
     /// not at all). An existing one is refused unless --force is given.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Replace an existing --out directory of an earlier run (one holding
-    /// summary.json, a study's verify.json or converge.json, or a shard's
-    /// shard.json, and no file kneeform did not write; or empty) with the
+    /// Replace an existing --out directory of an earlier result (as
+    /// analyze --force: its kneeform-run.json lists every file in it,
+    /// unchanged, and it holds no shard merged here; or empty) with the
     /// merged results, whole.
     #[arg(long)]
     pub force: bool,
@@ -404,7 +411,8 @@ pub struct StartArgs {
     #[arg(
         long,
         default_value = "runs:20:5",
-        value_name = "runs:N:L|strip:Z0:Z1|N|all"
+        value_name = "runs:N:L|strip:Z0:Z1|N|all",
+        allow_hyphen_values = true
     )]
     pub starts: String,
     /// Seed of the start sample or of the runs.
@@ -489,6 +497,13 @@ pub struct StudyArgs {
     /// start.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<String>,
+    /// Replace an existing --out directory of an earlier result (as
+    /// analyze --force: its kneeform-run.json lists every file in it,
+    /// unchanged, and it holds no input of this study; or empty) with this
+    /// study's results, whole. Without it an existing --out is refused,
+    /// before any work.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `kneeform verify`.
@@ -513,7 +528,9 @@ pub struct VerifyArgs {
     /// Default: no limit.
     #[arg(long, value_name = "S")]
     pub budget_s: Option<f64>,
-    /// Output directory for verify.csv and verify.json.
+    /// Output directory for verify.csv and verify.json (created; it
+    /// appears whole or not at all). An existing one is refused unless
+    /// --force is given.
     #[arg(long, default_value = "kneeform-verify", value_name = "DIR")]
     pub out: PathBuf,
 }
@@ -537,7 +554,9 @@ pub struct ConvergeArgs {
     /// (exit 2) naming the --shard count that would fit. Default: no limit.
     #[arg(long, value_name = "S")]
     pub budget_s: Option<f64>,
-    /// Output directory for converge.csv, converge.json and the plots.
+    /// Output directory for converge.csv, converge.json and the plots
+    /// (created; it appears whole or not at all). An existing one is
+    /// refused unless --force is given.
     #[arg(long, default_value = "kneeform-converge", value_name = "DIR")]
     pub out: PathBuf,
 }
@@ -661,6 +680,14 @@ impl PartArgs {
     /// Validates the flags into where the part's files are read from:
     /// `files`, less `ignored`, scaled, framed and sided.
     pub fn validate(&self, files: &[PathBuf], ignored: &[PathBuf]) -> anyhow::Result<PartSource> {
+        // The run's files name each part by its path: one that is not
+        // UTF-8 would be stored altered, and `report` could not find it.
+        if let Some(path) = files.iter().chain(ignored).find(|p| p.to_str().is_none()) {
+            anyhow::bail!(
+                "the part path {} is not valid UTF-8, and the run's files could not name it: rename it or link it under a UTF-8 name",
+                path.display()
+            );
+        }
         kneeform::input::check_scale(self.scale).context("--scale")?;
         let frame = match &self.frame {
             None => Frame::none(),

@@ -79,6 +79,20 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
     let switches = analyze_switches();
     let items = kneeform::manifest::plan(&text, &base, &|flag| switches.iter().any(|s| s == flag))
         .map_err(|e| anyhow::anyhow!("manifest {}: {e}", args.manifest.display()))?;
+    // An item asking for help would print it and write no run.
+    for (k, item) in items.iter().enumerate() {
+        if let Some(flag) = item
+            .argv
+            .iter()
+            .find(|a| matches!(a.as_str(), "--help" | "-h" | "--version" | "-V"))
+        {
+            bail!(
+                "manifest {}: item {} asks for {flag}, which runs no analysis: remove it",
+                args.manifest.display(),
+                k + 1
+            );
+        }
+    }
     let exe = std::env::current_exe().context("cannot find this kneeform binary")?;
     let total = items.len();
     let (mut ran, mut skipped) = (0, 0);
@@ -120,10 +134,15 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
             args: argv.clone(),
         };
         let text = serde_json::to_string_pretty(&record)? + "\n";
+        // Under the directory's lock, and recorded as kneeform's in its
+        // kneeform-run.json, so that the item's next run may replace it.
+        let _lock = kneeform::output::DirLock::take(&out)
+            .with_context(|| format!("{what}: cannot record its fingerprint"))?;
         kneeform::output::write_file_atomically(&out.join(FINGERPRINT_FILE), |w| {
             use std::io::Write;
             w.write_all(text.as_bytes())
         })
+        .and_then(|()| kneeform::output::add_to_record(&out, &[FINGERPRINT_FILE]))
         .with_context(|| format!("{what}: cannot record its fingerprint"))?;
         ran += 1;
     }

@@ -33,7 +33,8 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<ExitCode> {
         kind == ShardKind::Analysis || !args.points_csv,
         "--points-csv is for an analysis's shards: a study writes no colliding points"
     );
-    let out = super::stage_output(&args.out, args.force)?;
+    let shards: Vec<&std::path::Path> = args.shards.iter().map(|p| p.as_path()).collect();
+    let out = super::stage_output(&args.out, args.force, &shards)?;
     if kind == ShardKind::Analysis {
         return merge_analysis(args, out);
     }

@@ -48,11 +48,14 @@ pub fn write_report(options: &ReportOptions, out: &Path, shown_as: &Path) -> any
 }
 
 /// The start `verify` and `converge` share: every flag checked (the
-/// command's own options by `check`), the thread pool sized, the part read.
+/// command's own options by `check`), `out` checked, locked and staged
+/// (before any work: the oracle may run for hours, as `analyze` does), the
+/// thread pool sized, the part read.
 pub fn study_inputs(
     study: &StudyArgs,
-    check: Result<(), HarnessError>,
-) -> anyhow::Result<(PartFile, Setup)> {
+    check: anyhow::Result<()>,
+    out: &Path,
+) -> anyhow::Result<(PartFile, Setup, OutputDir)> {
     let (part, setup) = (&study.part, &study.setup);
     let source = part.validate(std::slice::from_ref(&study.path), &[])?;
     anyhow::ensure!(
@@ -60,10 +63,11 @@ pub fn study_inputs(
         "--pitch auto is for analyze: give verify and converge a pitch (mm)"
     );
     let (setup, threads) = setup.validate()?;
-    check.map_err(harness_error)?;
+    check?;
+    let staged = stage_output(out, study.force, &[study.path.as_path()])?;
     set_threads(threads)?;
     let input = source.read()?;
-    Ok((input, setup))
+    Ok((input, setup, staged))
 }
 
 /// `--shard K/N` of a study, parsed; `None` without one.
@@ -86,20 +90,30 @@ pub fn run_study(
     options: harness::StudyOptions,
 ) -> anyhow::Result<ExitCode> {
     let shard = study_shard(study)?;
-    let (input, setup) = study_inputs(study, options.validate())?;
+    // A convergence study's pitches are its --pitches.
+    let pitch_flag = if matches!(options, harness::StudyOptions::Converge(_)) {
+        "--pitches"
+    } else {
+        "--pitch"
+    };
+    let study_error = |e| harness_error_in(e, pitch_flag);
+    let (input, setup, staged) = study_inputs(study, options.validate().map_err(study_error), out)?;
     let bars = progress::Bars::default();
     if let Some(shard) = shard {
         let part =
-            harness::study_shard(&input, &setup, options, shard, &bars).map_err(harness_error)?;
-        return write_study_shard(out, &part);
+            harness::study_shard(&input, &setup, options, shard, &bars).map_err(study_error)?;
+        return write_study_shard(staged, out, &part);
     }
-    let result = harness::study(&input, &setup, options, &bars).map_err(harness_error)?;
+    let result = harness::study(&input, &setup, options, &bars).map_err(study_error)?;
     // A convergence study says how long its one oracle run took (a merge
     // sums its shards').
     if let Some(line) = result.oracle_line(setup.angles.len()) {
         eprintln!("{line}");
     }
-    kneeform::output::write_study(out, &result)?;
+    kneeform::output::write_study_files(&staged, &result)?;
+    staged
+        .commit()
+        .with_context(|| format!("cannot move results into {}", out.display()))?;
     Ok(study::print_study(&result, out))
 }
 
@@ -115,11 +129,13 @@ pub fn print_check(check: &kneeform::summary::SampleCheck) {
     }
 }
 
-/// Writes a study's shard into `out` (staged: it appears whole or not at
-/// all) and says so.
-pub fn write_study_shard(out: &Path, part: &StudyPart) -> anyhow::Result<ExitCode> {
-    let staged = OutputDir::stage(out)
-        .with_context(|| format!("cannot write the shard to {}", out.display()))?;
+/// Writes a study's shard into `staged`, the staged `out` (it appears
+/// whole or not at all), and says so.
+pub fn write_study_shard(
+    staged: OutputDir,
+    out: &Path,
+    part: &StudyPart,
+) -> anyhow::Result<ExitCode> {
     kneeform::shard::study::write_study_shard(&staged, part)?;
     staged
         .commit()
@@ -137,7 +153,14 @@ pub fn write_study_shard(out: &Path, part: &StudyPart) -> anyhow::Result<ExitCod
 
 /// A harness error with the flag it concerns in front, where one does.
 pub fn harness_error(err: HarnessError) -> anyhow::Error {
+    harness_error_in(err, "--pitch")
+}
+
+/// [`harness_error`] of a command whose pitches are given by `pitch_flag`
+/// (`converge`'s `--pitches`).
+pub fn harness_error_in(err: HarnessError, pitch_flag: &str) -> anyhow::Error {
     let flag = match &err {
+        HarnessError::Setup(e) if e.field() == "pitch" => Some(pitch_flag.to_string()),
         HarnessError::Setup(e) => Some(format!("--{}", e.field().replace('_', "-"))),
         HarnessError::Tolerance(_) => Some("--tolerance".into()),
         HarnessError::TieBand(_) => Some("--tie-band".into()),
@@ -205,13 +228,14 @@ pub fn set_threads(threads: Option<usize>) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Checks `out` before any work and stages the run's files beside it. An
-/// existing directory is replaced only with `force`, and only when it is
-/// an earlier run's (it holds `summary.json`; a study's or a shard's
-/// files) or empty: --force must not
-/// remove a directory of someone else's files. Staging creates a directory
-/// beside `out`, so an unwritable place fails here.
-pub fn stage_output(out: &Path, force: bool) -> anyhow::Result<OutputDir> {
+/// Checks `out` before any work and stages the run's files beside it
+/// (the directory's lock taken: one run at a time writes it). An existing
+/// directory is replaced only with `force`, and only when it is empty or
+/// its record (`kneeform-run.json`) proves every file in it kneeform's,
+/// unchanged, and it holds none of this run's `inputs` (a part, a shard):
+/// --force must not remove a directory of someone else's files. Staging
+/// creates a directory beside `out`, so an unwritable place fails here.
+pub fn stage_output(out: &Path, force: bool, inputs: &[&Path]) -> anyhow::Result<OutputDir> {
     use anyhow::{bail, ensure};
     match std::fs::metadata(out) {
         Ok(meta) if !meta.is_dir() => {
@@ -223,34 +247,19 @@ pub fn stage_output(out: &Path, force: bool) -> anyhow::Result<OutputDir> {
                 "--out {} already exists: pass --force to replace it, or choose another --out",
                 out.display()
             );
-            // A run's directory, a study's, or a shard's, holding nothing
-            // but kneeform's files: a folder of the user's with a
-            // summary.json beside their own files is not replaced.
-            let is_run = [
-                kneeform::output::SUMMARY_JSON,
-                "shard.json",
-                "verify.json",
-                "converge.json",
-                "diff.json",
-            ]
-            .iter()
-            .any(|f| out.join(f).is_file());
-            let is_empty = std::fs::read_dir(out)
-                .with_context(|| format!("cannot read --out {}", out.display()))?
-                .next()
-                .is_none();
-            ensure!(
-                is_run || is_empty,
-                "--out {} is not a kneeform run directory (no summary.json, verify.json, converge.json, diff.json or shard.json), so --force will not replace it: choose another --out",
-                out.display()
-            );
-            if let Some(name) = kneeform::output::foreign_entry(out)
+            if let Some(input) = input_inside(out, inputs) {
+                bail!(
+                    "--out {} holds {}, an input of this run, so --force will not replace it: choose another --out",
+                    out.display(),
+                    input.display()
+                );
+            }
+            if let Some(why) = kneeform::output::why_not_replaceable(out)
                 .with_context(|| format!("cannot read --out {}", out.display()))?
             {
                 bail!(
-                    "--out {} holds {}, which kneeform did not write, so --force will not replace it: move it out or choose another --out",
-                    out.display(),
-                    name.to_string_lossy()
+                    "--out {} {why}, so --force will not replace it: move its files out or choose another --out",
+                    out.display()
                 );
             }
         }
@@ -259,6 +268,17 @@ pub fn stage_output(out: &Path, force: bool) -> anyhow::Result<OutputDir> {
     }
     OutputDir::stage_replacing(out)
         .with_context(|| format!("cannot write the results to {}", out.display()))
+}
+
+/// The first of `inputs` inside the directory `out` (or `out` itself),
+/// by their canonical paths; inputs that cannot be resolved (a stream)
+/// are not inside.
+fn input_inside<'a>(out: &Path, inputs: &[&'a Path]) -> Option<&'a Path> {
+    let out = std::fs::canonicalize(out).ok()?;
+    inputs
+        .iter()
+        .copied()
+        .find(|input| std::fs::canonicalize(input).is_ok_and(|p| p.starts_with(&out)))
 }
 
 #[cfg(test)]

@@ -28,6 +28,7 @@ mod csv;
 mod plot;
 mod ply;
 mod png;
+mod record;
 mod results;
 mod stl;
 #[cfg(feature = "harness")]
@@ -44,6 +45,9 @@ pub(crate) use self::png::count_colour;
 pub(crate) use self::png::register_font;
 pub use self::png::{BLIND_COLOUR, NO_PART};
 pub(crate) use self::png::{PngError, write_composite_png, write_depth_png};
+pub use self::record::{
+    RUN_RECORD, RecordedFile, digest_file, is_temporary_name, recorded, why_not_replaceable,
+};
 pub(crate) use self::results::{RunResults, write_results};
 pub use self::results::{WriteOptions, write_analysis};
 pub(crate) use self::stl::write_colliding_area;
@@ -54,59 +58,6 @@ pub use self::studies::{write_study, write_study_files};
 /// A run's record of everything it did (`summary.json`): the one name
 /// every reader and writer uses.
 pub const SUMMARY_JSON: &str = "summary.json";
-
-/// The files kneeform writes into a result directory: a run's, a
-/// verification's, a convergence study's, a shard's, the report, and a
-/// batch item's fingerprint.
-pub(crate) const OWN_FILES: [&str; 23] = [
-    SUMMARY_JSON,
-    "composite.csv",
-    "zones.csv",
-    "colliding_points.csv",
-    "colliding_area.stl",
-    "colliding_area.ply",
-    "composite.png",
-    "depth.png",
-    "blind_spots.csv",
-    "report.html",
-    "shard.json",
-    "shard.bin",
-    "verify.csv",
-    "verify.json",
-    "converge.csv",
-    "converge.json",
-    "error_vs_pitch.png",
-    "time_vs_pitch.png",
-    "batch-item.json",
-    "diff.json",
-    "diff_nodes.csv",
-    "diff_zones.csv",
-    "diff.png",
-];
-
-/// Whether `name` is a file kneeform writes into a result directory
-/// ([`OWN_FILES`], or a study's `verify_<pitch>mm.csv`).
-pub(crate) fn is_own_file(name: &str) -> bool {
-    OWN_FILES.contains(&name)
-        || name
-            .strip_prefix("verify_")
-            .and_then(|rest| rest.strip_suffix("mm.csv"))
-            .is_some_and(|pitch| pitch.parse::<f64>().is_ok())
-}
-
-/// The first entry of the directory `dir` that kneeform did not write (a
-/// file of another name, or any directory): what `--force` must not
-/// delete. `None` when every entry is kneeform's.
-pub fn foreign_entry(dir: &Path) -> io::Result<Option<std::ffi::OsString>> {
-    let mut names: Vec<(std::ffi::OsString, bool)> = std::fs::read_dir(dir)?
-        .map(|e| e.and_then(|e| Ok((e.file_name(), e.file_type()?.is_file()))))
-        .collect::<io::Result<_>>()?;
-    names.sort();
-    Ok(names
-        .into_iter()
-        .find(|(name, is_file)| !(*is_file && name.to_str().is_some_and(is_own_file)))
-        .map(|(name, _)| name))
-}
 
 /// Why a result could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -174,6 +125,18 @@ pub fn write_file_atomically(
     }
     forget_staged(&tmp);
     written
+}
+
+/// Adds the files `names` of the committed result directory `dir` to its
+/// record ([`RUN_RECORD`], rewritten whole or not at all): what kneeform
+/// writes into a result directory after its commit (`analyze --report`'s
+/// report, a batch item's fingerprint), so that `--force` may replace it
+/// later. The caller holds the directory's lock.
+pub fn add_to_record(dir: &Path, names: &[&str]) -> io::Result<()> {
+    let text = record::record_adding(dir, names)?;
+    write_file_atomically(&dir.join(RUN_RECORD), |w| {
+        io::Write::write_all(w, text.as_bytes())
+    })
 }
 
 /// A result directory written atomically: files go into a hidden sibling
@@ -464,8 +427,9 @@ impl OutputDir {
         &self.final_dir
     }
 
-    /// Syncs every staged file and the staging directory to disk, then
-    /// moves every staged entry into the final directory (created if
+    /// Writes the record of the staged files ([`RUN_RECORD`]: what
+    /// `--force` may later replace), syncs every staged file and the
+    /// staging directory to disk, then moves every staged entry into the final directory (created if
     /// missing; files of the same name are replaced), removes the staging
     /// directory and syncs the final directory and its parent. Entries are
     /// moved in name order, so a failure part way leaves a predictable
@@ -477,6 +441,11 @@ impl OutputDir {
         let mut names: Vec<_> = std::fs::read_dir(&self.staging)?
             .map(|entry| entry.map(|e| e.file_name()))
             .collect::<io::Result<_>>()?;
+        // The record of what this run wrote, over the staged files.
+        record::write_record(&self.staging)?;
+        if !names.iter().any(|n| n == RUN_RECORD) {
+            names.push(RUN_RECORD.into());
+        }
         names.sort();
         for name in &names {
             let path = self.staging.join(name);
@@ -599,7 +568,7 @@ mod tests {
             "{staged:?}"
         );
         out.commit().unwrap();
-        assert_eq!(entries(&final_dir), ["a.csv", "b.stl"]);
+        assert_eq!(entries(&final_dir), ["a.csv", "b.stl", RUN_RECORD]);
         assert_eq!(
             std::fs::read_to_string(final_dir.join("a.csv")).unwrap(),
             "angle_deg\n"
@@ -710,7 +679,7 @@ mod tests {
             std::fs::read_to_string(final_dir.join("a.csv")).unwrap(),
             "new"
         );
-        assert_eq!(entries(&final_dir), ["a.csv", "keep.txt"]);
+        assert_eq!(entries(&final_dir), ["a.csv", "keep.txt", RUN_RECORD]);
         std::fs::remove_dir_all(root).unwrap();
     }
 
@@ -724,12 +693,12 @@ mod tests {
         std::fs::write(out.path("report.html"), "old report").unwrap();
         assert!(!final_dir.exists());
         out.commit().unwrap();
-        assert_eq!(entries(&final_dir), ["a.csv", "report.html"]);
+        assert_eq!(entries(&final_dir), ["a.csv", RUN_RECORD, "report.html"]);
         // Replaced: only the new run's files, nothing staged or aside left.
         let out = OutputDir::stage_replacing(&final_dir).unwrap();
         std::fs::write(out.path("a.csv"), "second").unwrap();
         out.commit().unwrap();
-        assert_eq!(entries(&final_dir), ["a.csv"]);
+        assert_eq!(entries(&final_dir), ["a.csv", RUN_RECORD]);
         assert_eq!(
             std::fs::read_to_string(final_dir.join("a.csv")).unwrap(),
             "second"
@@ -754,7 +723,7 @@ mod tests {
         let second = OutputDir::stage(&final_dir).unwrap();
         std::fs::write(second.path("b.csv"), "second").unwrap();
         second.commit().unwrap();
-        assert_eq!(entries(&final_dir), ["a.csv", "b.csv"]);
+        assert_eq!(entries(&final_dir), ["a.csv", "b.csv", RUN_RECORD]);
         std::fs::remove_dir_all(root).unwrap();
     }
 
