@@ -51,34 +51,60 @@ impl Verification {
     pub fn read(dir: &Path) -> Result<Verification, ReportError> {
         let json = |name: &str| -> Result<Option<Value>, ReportError> {
             let path = dir.join(name);
-            match optional_text(&path, MAX_RUN_JSON_BYTES)? {
+            match checked_text(dir, name, MAX_RUN_JSON_BYTES)? {
                 None => Ok(None),
                 Some(text) => serde_json::from_str(&text)
                     .map(Some)
                     .map_err(|source| ReportError::Json { path, source }),
             }
         };
-        let v = Verification {
-            dir: dir.to_path_buf(),
-            verify: json("verify.json")?,
-            verify_csv: optional_text(&dir.join("verify.csv"), MAX_RUN_TABLE_BYTES)?,
-            converge: json("converge.json")?,
-            converge_csv: optional_text(&dir.join("converge.csv"), MAX_RUN_TABLE_BYTES)?,
-            figures: VERIFY_FIGURES
-                .iter()
-                .filter_map(|name| {
-                    crate::limits::read_bounded(&dir.join(name), MAX_RUN_TABLE_BYTES)
-                        .ok()
-                        .map(|bytes| (name.to_string(), bytes))
-                })
-                .collect(),
-        };
-        if v.verify.is_none() && v.converge.is_none() {
+        let verify = json("verify.json")?;
+        let converge = json("converge.json")?;
+        if verify.is_none() && converge.is_none() {
             return Err(ReportError::NotAVerification {
                 dir: dir.to_path_buf(),
             });
         }
-        Ok(v)
+        // Without a record (a directory of an older kneeform), verify.csv
+        // is read no further than its verify.json's pairs could fill.
+        let pairs = verify
+            .as_ref()
+            .and_then(|v| v.pointer("/counts/pairs"))
+            .and_then(Value::as_u64);
+        let csv_bound = pairs.map_or(MAX_RUN_TABLE_BYTES, |p| {
+            (p.saturating_add(1))
+                .saturating_mul(MAX_CSV_ROW_BYTES)
+                .min(MAX_RUN_TABLE_BYTES)
+        });
+        let verify_csv = checked_text(dir, "verify.csv", csv_bound)?;
+        if let (Some(text), Some(pairs)) = (&verify_csv, pairs) {
+            let rows = text.lines().count().saturating_sub(1) as u64;
+            if rows != pairs {
+                return Err(ReportError::Inconsistent {
+                    path: dir.join("verify.csv"),
+                    reason: format!(
+                        "{rows} rows where its verify.json counts {pairs} pairs: the table is not that study's"
+                    ),
+                });
+            }
+        }
+        let figures = VERIFY_FIGURES
+            .iter()
+            .map(|name| {
+                Ok(checked_bytes(dir, name, MAX_RUN_TABLE_BYTES)?.map(|b| (name.to_string(), b)))
+            })
+            .collect::<Result<Vec<_>, ReportError>>()?
+            .into_iter()
+            .flatten()
+            .collect();
+        Ok(Verification {
+            dir: dir.to_path_buf(),
+            verify,
+            verify_csv,
+            converge,
+            converge_csv: checked_text(dir, "converge.csv", MAX_RUN_TABLE_BYTES)?,
+            figures,
+        })
     }
 
     /// The `pass` field of `verify.json`.
@@ -271,13 +297,73 @@ fn list(keys: &[&str]) -> String {
     }
 }
 
-fn optional_text(path: &Path, max_bytes: u64) -> Result<Option<String>, ReportError> {
-    let text = crate::limits::read_bounded(path, max_bytes).and_then(|bytes| {
-        String::from_utf8(bytes)
-            .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
-    });
-    match text {
-        Ok(text) => Ok(Some(text)),
+/// The longest `verify.csv` row read per pair (bytes) where no record
+/// states the table's size: its rows are some 300 bytes.
+const MAX_CSV_ROW_BYTES: u64 = 4096;
+
+/// The file `name` of the study directory `dir` as text, `None` when it
+/// is not there; see [`checked_bytes`].
+fn checked_text(dir: &Path, name: &str, max_bytes: u64) -> Result<Option<String>, ReportError> {
+    let path = dir.join(name);
+    checked_bytes(dir, name, max_bytes)?
+        .map(|bytes| {
+            String::from_utf8(bytes).map_err(|e| ReportError::Io {
+                path: path.clone(),
+                source: std::io::Error::new(std::io::ErrorKind::InvalidData, e),
+            })
+        })
+        .transpose()
+}
+
+/// The file `name` of the study directory `dir`, `None` when it is not
+/// there. Where `dir` holds kneeform's record of the files it wrote
+/// (`kneeform-run.json`), the file must be listed there, and is read only
+/// when it has the recorded size and then only when its SHA-256 is the
+/// recorded one: the report shows nothing of a file changed since the
+/// study wrote it. Without a record (an older kneeform's directory), at
+/// most `max_bytes` are read.
+fn checked_bytes(dir: &Path, name: &str, max_bytes: u64) -> Result<Option<Vec<u8>>, ReportError> {
+    use crate::output::RUN_RECORD;
+    let path = dir.join(name);
+    if !dir.join(RUN_RECORD).is_file() {
+        return optional_bytes(&path, max_bytes);
+    }
+    let refuse = |reason: String| ReportError::Inconsistent {
+        path: path.clone(),
+        reason,
+    };
+    let Some(expected) = crate::output::recorded(dir, name) else {
+        return match std::fs::symlink_metadata(&path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+            _ => Err(refuse(format!(
+                "not in {RUN_RECORD}: the study did not write it"
+            ))),
+        };
+    };
+    let io = |source| ReportError::Io {
+        path: path.clone(),
+        source,
+    };
+    let len = std::fs::metadata(&path).map_err(io)?.len();
+    if len != expected.bytes {
+        return Err(refuse(format!(
+            "{len} bytes where the study wrote {} ({RUN_RECORD}): changed since",
+            expected.bytes
+        )));
+    }
+    let bytes = crate::limits::read_bounded(&path, expected.bytes).map_err(io)?;
+    let sha256 = crate::input::sha256_hex(&bytes);
+    if sha256 != expected.sha256 {
+        return Err(refuse(format!(
+            "its SHA-256 is not the one the study recorded in {RUN_RECORD}: changed since the study wrote it"
+        )));
+    }
+    Ok(Some(bytes))
+}
+
+fn optional_bytes(path: &Path, max_bytes: u64) -> Result<Option<Vec<u8>>, ReportError> {
+    match crate::limits::read_bounded(path, max_bytes) {
+        Ok(bytes) => Ok(Some(bytes)),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
         Err(source) => Err(ReportError::Io {
             path: path.to_path_buf(),
