@@ -44,7 +44,7 @@ use crate::frame::{Frame, Placement};
 use crate::grid::{GridSpec, HeightGrid};
 use crate::output::{OutputDir, RunResults, WriteError};
 use crate::partition::{Shard, ShardSyntax};
-use crate::summary::{AngleSummary, Summary};
+use crate::summary::{AngleSummary, SampleCheck, Summary};
 
 #[cfg(feature = "harness")]
 pub mod study;
@@ -312,6 +312,16 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, ShardError> {
                 s.dir.display()
             )));
         }
+        if let Some(what) = check_difference(
+            first.record.summary.sample_check.as_ref(),
+            s.record.summary.sample_check.as_ref(),
+        ) {
+            return Err(ShardError::Mismatch(format!(
+                "{} and {} are shards of different runs (their sample checks differ in {what}: the shards of one run share --no-check and every other flag)",
+                first.dir.display(),
+                s.dir.display()
+            )));
+        }
         if s.record.common_sha256 != first.record.common_sha256 || s.header != first.header {
             return Err(ShardError::Mismatch(format!(
                 "{} and {} are shards of different runs (their grids or blind spots differ)",
@@ -556,6 +566,33 @@ fn identity(summary: &Summary) -> serde_json::Value {
     v
 }
 
+/// What differs between two shards' sample checks of what the merged
+/// summary states of the whole run's (whether it ran, its starts, seed and
+/// tolerance); `None` when they agree. Their figures and angles are each
+/// shard's own.
+fn check_difference(a: Option<&SampleCheck>, b: Option<&SampleCheck>) -> Option<&'static str> {
+    let (a, b) = match (a, b) {
+        (None, None) => return None,
+        (Some(a), Some(b)) => (a, b),
+        _ => return Some("presence"),
+    };
+    [
+        ("status", a.status == b.status),
+        (
+            "starts",
+            a.starts == b.starts && a.start_positions == b.start_positions,
+        ),
+        ("seed", a.seed == b.seed),
+        (
+            "tolerance",
+            a.tolerance_mm.to_bits() == b.tolerance_mm.to_bits(),
+        ),
+    ]
+    .into_iter()
+    .find(|(_, same)| !same)
+    .map(|(what, _)| what)
+}
+
 /// The first top-level key whose value differs between `a` and `b`.
 fn first_difference(a: &serde_json::Value, b: &serde_json::Value) -> Option<String> {
     let (a, b) = (a.as_object()?, b.as_object()?);
@@ -660,7 +697,8 @@ fn read_shard(dir: &Path) -> Result<ShardFiles, ShardError> {
     let header = {
         let mut head = [0u8; HEADER_LEN];
         use std::io::Read;
-        std::fs::File::open(&bin_path)
+        crate::limits::regular_file(&bin_path)
+            .and_then(|()| std::fs::File::open(&bin_path))
             .and_then(|mut f| f.read_exact(&mut head))
             .map_err(io(&bin_path))?;
         parse_header(&head).ok_or_else(|| ShardError::Corrupt {
