@@ -194,6 +194,7 @@ pub(crate) fn read_part_bytes_bounded(path: &Path) -> Result<Vec<u8>, MeshError>
     if crate::scenario::is_scenario_file(path) {
         return crate::limits::read_bounded(path, crate::limits::MAX_RUN_JSON_BYTES).map_err(io);
     }
+    crate::limits::not_a_device(path).map_err(io)?;
     let file = std::fs::File::open(path).map_err(io)?;
     let meta = file.metadata().map_err(io)?;
     if meta.is_dir() {
@@ -298,6 +299,7 @@ pub(crate) fn part_size(path: &Path) -> Result<PartSize, MeshError> {
             known: true,
         });
     }
+    crate::limits::not_a_device(path).map_err(io)?;
     let file = std::fs::File::open(path).map_err(io)?;
     let meta = file.metadata().map_err(io)?;
     if !meta.is_file() {

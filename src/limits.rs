@@ -75,11 +75,53 @@ pub(crate) const MAX_RUN_JSON_BYTES: u64 = 64 << 20;
 /// (`verify.csv`, `converge.csv`, a PNG): 1 GiB.
 pub(crate) const MAX_RUN_TABLE_BYTES: u64 = 1 << 30;
 
-/// Reads the file at `path` whole, refusing one longer than `max_bytes`:
-/// a regular file by its size, before reading anything; anything else (a
-/// pipe, a device such as `/dev/zero`) once `max_bytes` have been read.
+/// Refuses what is not a regular file (a FIFO, on which opening waits
+/// for a writer for ever; a device such as `/dev/zero`; a directory)
+/// before it is opened: `ErrorKind::InvalidInput`, "not a regular file"
+/// (`IsADirectory` for a directory).
+pub fn regular_file(path: &std::path::Path) -> std::io::Result<()> {
+    let meta = std::fs::metadata(path)?;
+    if meta.is_dir() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::IsADirectory,
+            "is a directory",
+        ));
+    }
+    if !meta.is_file() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file (a pipe or a device): save it to a file first",
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a device (`/dev/zero`, a disk) or a socket before it is
+/// opened: what a part may not be. A part may be a pipe (`/dev/stdin`),
+/// read as a stream.
+pub(crate) fn not_a_device(path: &std::path::Path) -> std::io::Result<()> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let kind = std::fs::metadata(path)?.file_type();
+        if kind.is_char_device() || kind.is_block_device() || kind.is_socket() {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "not a regular file (a device): a part is a file, or a pipe",
+            ));
+        }
+    }
+    #[cfg(not(unix))]
+    let _ = path;
+    Ok(())
+}
+
+/// Reads the regular file at `path` whole, refusing one longer than
+/// `max_bytes` by its size, before reading anything, and anything that is
+/// not a regular file before opening it ([`regular_file`]).
 pub fn read_bounded(path: &std::path::Path, max_bytes: u64) -> std::io::Result<Vec<u8>> {
     use std::io::Read;
+    regular_file(path)?;
     let file = std::fs::File::open(path)?;
     let meta = file.metadata()?;
     let too_long = |what: String| {
@@ -123,6 +165,7 @@ pub(crate) fn open_bounded(
     path: &std::path::Path,
     max_bytes: u64,
 ) -> std::io::Result<std::fs::File> {
+    regular_file(path)?;
     let file = std::fs::File::open(path)?;
     let meta = file.metadata()?;
     if !meta.is_file() {
@@ -173,6 +216,18 @@ pub fn duration_words(seconds: f64) -> String {
     }
 }
 
+/// A number given by the user, echoed (in a message or a file) exactly
+/// but briefly: its shortest round-trip decimal, in exponent form beyond
+/// 1e-6 .. 1e15 (`1e-320`, not its 330 digits; `-1e300`, not 301).
+pub fn echo(value: f64) -> String {
+    let a = value.abs();
+    if value == 0.0 || !value.is_finite() || (1e-6..1e15).contains(&a) {
+        format!("{value}")
+    } else {
+        format!("{value:e}")
+    }
+}
+
 /// A number for a message: short, whatever its size (`1e-300`, not three
 /// hundred digits; `0.25`, not `2.5e-1`).
 pub fn short(value: f64) -> String {
@@ -193,6 +248,20 @@ pub fn short(value: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn echoed_numbers_are_exact_and_brief() {
+        for (v, text) in [
+            (1e-320, "1e-320"),
+            (-1e300, "-1e300"),
+            (299.5, "299.5"),
+            (290.0, "290"),
+            (0.0, "0"),
+        ] {
+            assert_eq!(echo(v), text);
+            assert_eq!(echo(v).parse::<f64>().unwrap(), v);
+        }
+    }
 
     #[test]
     fn short_numbers_stay_short() {
