@@ -107,6 +107,14 @@ pub(crate) fn from_direct([x, y, z]: [f64; 3]) -> [f64; 3] {
 /// 10, and still moves a point 1 m from the origin by at most 1 um.
 pub(crate) const ROTATION_TOL: f64 = 1e-9;
 
+/// How far from a rotation a matrix file's 3 x 3 part may be and still be
+/// taken, made a rotation (its nearest, by polar decomposition): CAD tools
+/// write matrices to 6 or 8 decimals (0.70710678 is within 4e-9 of
+/// cos 45 degrees). The correction is recorded ([`FrameRecord`]'s
+/// `orthonormalised_by`); at this bound a point 1 m from the origin moves
+/// by a few um.
+pub(crate) const ORTHONORMALISE_TOL: f64 = 1e-6;
+
 /// A rigid map from a part file's coordinates (mm) into vehicle
 /// coordinates, or none (the file is in vehicle coordinates already).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -125,6 +133,9 @@ struct Map {
     /// (to rounding). For signed axes it is exact.
     inverse: Matrix3<f64>,
     translation: Translation3<f64>,
+    /// The largest change made to an entry of the given matrix to make it
+    /// a rotation, where one was ([`ORTHONORMALISE_TOL`]).
+    orthonormalised_by: Option<f64>,
 }
 
 /// A frame as `summary.json`, `verify.json` and `converge.json` record it.
@@ -135,6 +146,11 @@ pub struct FrameRecord {
     /// The map from the part's coordinates into vehicle coordinates (mm),
     /// as the rows of a 3 x 4 matrix `[R | t]`.
     pub part_to_vehicle: [[f64; 4]; 3],
+    /// Where the given matrix was a rotation only within
+    /// [`ORTHONORMALISE_TOL`]: the largest change made to one of its
+    /// entries to make it the nearest rotation, `part_to_vehicle`'s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orthonormalised_by: Option<f64>,
 }
 
 /// Why a `--frame` value was refused.
@@ -191,7 +207,8 @@ impl Frame {
     /// numbers separated by spaces, commas or line breaks; `#` starts a
     /// comment) mapping the part's homogeneous coordinates (mm, after
     /// `--scale`) to vehicle coordinates. Refused unless a proper rotation
-    /// within `ROTATION_TOL` with a finite translation.
+    /// within `ORTHONORMALISE_TOL` (made its nearest rotation beyond
+    /// `ROTATION_TOL`) with a finite translation, its rows one a line.
     pub fn parse(value: &str) -> Result<Frame, FrameError> {
         match value.strip_prefix('@') {
             Some(path) => Frame::from_file(Path::new(path), value),
@@ -246,8 +263,12 @@ impl Frame {
             reason,
         };
         let mut numbers = Vec::new();
-        for line in text.lines() {
+        // Numbers per line holding any, with the line's number: rows must
+        // be rows.
+        let mut rows: Vec<(usize, usize)> = Vec::new();
+        for (k, line) in text.lines().enumerate() {
             let line = line.split('#').next().unwrap_or_default();
+            let before = numbers.len();
             for token in line
                 .split(|c: char| c == ',' || c.is_whitespace())
                 .filter(|t| !t.is_empty())
@@ -260,11 +281,23 @@ impl Frame {
                 }
                 numbers.push(v);
             }
+            if numbers.len() > before {
+                rows.push((k + 1, numbers.len() - before));
+            }
         }
         if numbers.len() != 12 && numbers.len() != 16 {
             return Err(bad(format!(
                 "expected a 4x4 or 3x4 matrix (16 or 12 numbers, row by row), found {} numbers",
                 numbers.len()
+            )));
+        }
+        // One row a line (or the whole matrix on one line): 12 numbers in
+        // lines of 4, 3 and 5 are no matrix.
+        if rows.len() > 1
+            && let Some((line, count)) = rows.iter().find(|(_, count)| *count != 4)
+        {
+            return Err(bad(format!(
+                "line {line} holds {count} numbers: write the matrix row by row, 4 numbers a line"
             )));
         }
         if numbers.len() == 16 {
@@ -295,14 +328,26 @@ impl Frame {
             return Err(refuse(format!("its determinant is {det}, a mirror")));
         }
         let off = (m.transpose() * m - Matrix3::identity()).amax();
-        if off > ROTATION_TOL {
+        if off > ORTHONORMALISE_TOL {
             return Err(refuse(format!(
-                "its rows are not orthonormal (R^T R differs from the identity by {off:e})"
+                "its rows are not orthonormal (R^T R differs from the identity by {off:.3e}, more than {ORTHONORMALISE_TOL:e}): a scaling or a shear"
             )));
         }
-        if (det - 1.0).abs() > ROTATION_TOL {
-            return Err(refuse(format!("its determinant is {det}, not 1")));
+        if (det - 1.0).abs() > ORTHONORMALISE_TOL {
+            return Err(refuse(format!(
+                "its determinant is {det:.9}, not 1: a scaling"
+            )));
         }
+        // Within ROTATION_TOL the matrix is taken as given (its inverse
+        // computed); beyond it, up to ORTHONORMALISE_TOL, it is made its
+        // nearest rotation and the change recorded.
+        let (m, orthonormalised_by) = if off > ROTATION_TOL || (det - 1.0).abs() > ROTATION_TOL {
+            let r = nearest_rotation(&m).ok_or_else(|| refuse("it has no inverse".into()))?;
+            let change = (r - m).amax();
+            (r, Some(change))
+        } else {
+            (m, None)
+        };
         let inverse = m
             .try_inverse()
             .ok_or_else(|| refuse("it has no inverse".into()))?;
@@ -312,6 +357,7 @@ impl Frame {
                 rotation: Rotation3::from_matrix_unchecked(m),
                 inverse,
                 translation: Translation3::new(t[0], t[1], t[2]),
+                orthonormalised_by,
             }),
         })
     }
@@ -331,6 +377,7 @@ impl Frame {
                 part_to_vehicle: std::array::from_fn(|row| {
                     [r[(row, 0)], r[(row, 1)], r[(row, 2)], t[row]]
                 }),
+                orthonormalised_by: m.orthonormalised_by,
             }
         })
     }
@@ -339,7 +386,13 @@ impl Frame {
     pub fn from_record(record: &FrameRecord) -> Result<Frame, FrameError> {
         let rows = &record.part_to_vehicle;
         let m = Matrix3::from_fn(|r, c| rows[r][c]);
-        Frame::from_parts(&record.given, m, [rows[0][3], rows[1][3], rows[2][3]])
+        let mut frame = Frame::from_parts(&record.given, m, [rows[0][3], rows[1][3], rows[2][3]])?;
+        // The recorded matrix is the corrected one: the correction is the
+        // record's.
+        if let Some(map) = frame.map.as_mut() {
+            map.orthonormalised_by = map.orthonormalised_by.or(record.orthonormalised_by);
+        }
+        Ok(frame)
     }
 
     /// A point of the part (mm) in vehicle coordinates.
@@ -367,6 +420,14 @@ impl Frame {
             }
         }
     }
+}
+
+/// The rotation nearest `m` (its polar decomposition's: `U V^T` of its
+/// SVD), for a matrix of determinant near +1; `None` where the SVD fails.
+fn nearest_rotation(m: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+    let svd = m.svd(true, true);
+    let r = svd.u? * svd.v_t?;
+    (r.determinant() > 0.0).then_some(r)
 }
 
 /// How a part file's coordinates (mm, after `--scale`) map into SPEC's
