@@ -6,6 +6,7 @@ mod cli;
 use std::process::ExitCode;
 
 use clap::Parser;
+use clap::error::ErrorKind;
 
 use cli::args::{Cli, Command};
 
@@ -14,7 +15,10 @@ use cli::args::{Cli, Command};
 const INTERRUPTED: i32 = 130;
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(err) => return flag_error(&err),
+    };
     // An interrupted run leaves nothing behind: its staged results and
     // temporary files are removed (a commit in progress finishes first).
     let handler = ctrlc::set_handler(|| {
@@ -67,6 +71,42 @@ fn run(cli: &Cli) -> anyhow::Result<ExitCode> {
         Command::Diff(args) => cli::diff::run(args)?,
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// What clap found wrong with the command line, as every error is said:
+/// one line, exit 2 (clap's own is its message, a usage and a tip, on
+/// several). Help and the version are printed as clap prints them.
+fn flag_error(err: &clap::Error) -> ExitCode {
+    if matches!(
+        err.kind(),
+        ErrorKind::DisplayHelp
+            | ErrorKind::DisplayVersion
+            | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+    ) {
+        let _ = err.print();
+        return if err.use_stderr() {
+            ExitCode::from(2)
+        } else {
+            ExitCode::SUCCESS
+        };
+    }
+    // The message is the lines before the usage and the tip (a list of
+    // missing arguments runs on to a second line).
+    let text = err.render().to_string();
+    let message: Vec<&str> = text
+        .lines()
+        .map(str::trim)
+        .take_while(|l| !l.is_empty() && !l.starts_with("Usage:") && !l.starts_with("tip:"))
+        .collect();
+    let message = message.join(" ");
+    let first = message.strip_prefix("error: ").unwrap_or(&message);
+    let first = if first.is_empty() {
+        "the command line is not understood"
+    } else {
+        first
+    };
+    eprintln!("kneeform: error: {first} (`kneeform help COMMAND` lists its flags)");
+    ExitCode::from(2)
 }
 
 /// A reader that went away (`kneeform ... | head`) is not an error.

@@ -217,7 +217,8 @@ pub(super) fn none_chosen(selection: &StartSelection, placed: usize) -> HarnessE
     match *selection {
         StartSelection::Strip { z } => HarnessError::NoneChosen(format!(
             "no placed start lies in the strip {} <= z <= {} mm",
-            z[0], z[1]
+            crate::limits::echo(z[0]),
+            crate::limits::echo(z[1])
         )),
         StartSelection::Runs { length, .. } => HarnessError::NoneChosen(format!(
             "no {length} adjacent placed starts lie in one chain block ({CHAIN_BLOCK} columns) of a row: ask for shorter runs"

@@ -395,7 +395,14 @@ pub(super) fn selection_words(selection: &StartSelection) -> (String, u64) {
     match *selection {
         StartSelection::All => ("all".into(), 0),
         StartSelection::Sample { count, seed } => (count.to_string(), seed),
-        StartSelection::Strip { z } => (format!("strip:{}:{}", z[0], z[1]), 0),
+        StartSelection::Strip { z } => (
+            format!(
+                "strip:{}:{}",
+                crate::limits::echo(z[0]),
+                crate::limits::echo(z[1])
+            ),
+            0,
+        ),
         StartSelection::Runs {
             count,
             length,
