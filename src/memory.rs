@@ -160,25 +160,61 @@ pub(crate) fn limit_bytes() -> Option<(f64, &'static str)> {
 /// "unlimited" as a page-rounded 2^63).
 const NO_LIMIT_BYTES: f64 = (1u64 << 60) as f64;
 
-/// This process's cgroup memory limit (bytes), v2 or v1, where one is set.
+/// This process's cgroup memory limit (bytes), v2 or v1, where one is set:
+/// the least of its own cgroup's and every ancestor's up to the root
+/// ([`cgroup_limit_under`] on this system's `/proc/self/cgroup` and
+/// `/sys/fs/cgroup`).
 fn cgroup_limit_bytes() -> Option<f64> {
-    let read = |path: &str| {
-        let text = crate::limits::read_bounded(std::path::Path::new(path), 4096).ok()?;
+    let own = std::fs::read_to_string("/proc/self/cgroup").ok()?;
+    cgroup_limit_under(std::path::Path::new("/sys/fs/cgroup"), &own)
+}
+
+/// The least memory limit (bytes) of the cgroup that `proc_cgroup` (the
+/// text of `/proc/self/cgroup`) names and of each of its ancestors, under
+/// the cgroup file system mounted at `root`: v2 (`0::/PATH`,
+/// `root/PATH/memory.max`) and v1 (`N:...memory...:/PATH`,
+/// `root/memory/PATH/memory.limit_in_bytes`). A Slurm job's or a
+/// Kubernetes pod's limit is set on its own cgroup, not the root's; a
+/// limit of a parent bounds its children too. `None` where no level sets
+/// one.
+pub(crate) fn cgroup_limit_under(root: &std::path::Path, proc_cgroup: &str) -> Option<f64> {
+    let read = |path: &std::path::Path| {
+        let text = crate::limits::read_bounded(path, 4096).ok()?;
         let value: f64 = std::str::from_utf8(&text).ok()?.trim().parse().ok()?;
         (value < NO_LIMIT_BYTES).then_some(value)
     };
-    // v2: /proc/self/cgroup's "0::/PATH" under /sys/fs/cgroup.
-    let own = std::fs::read_to_string("/proc/self/cgroup").ok();
-    let v2 = own.as_deref().and_then(|t| {
-        t.lines().find_map(|l| l.strip_prefix("0::")).and_then(|p| {
-            read(&format!(
-                "/sys/fs/cgroup{}/memory.max",
-                p.trim_end_matches('/')
-            ))
-        })
-    });
-    v2.or_else(|| read("/sys/fs/cgroup/memory.max"))
-        .or_else(|| read("/sys/fs/cgroup/memory/memory.limit_in_bytes"))
+    // Each level from the cgroup up to the root of `base`, `file` in each.
+    let along = |base: std::path::PathBuf, cgroup: &str, file: &str| -> Vec<f64> {
+        let mut dir = base.clone();
+        dir.extend(
+            cgroup
+                .split('/')
+                .filter(|c| !c.is_empty() && *c != "." && *c != ".."),
+        );
+        let mut limits = Vec::new();
+        loop {
+            limits.extend(read(&dir.join(file)));
+            if dir == base || !dir.pop() {
+                break;
+            }
+        }
+        limits
+    };
+    let mut limits = Vec::new();
+    for line in proc_cgroup.lines() {
+        let mut fields = line.splitn(3, ':');
+        let (Some(_id), Some(controllers), Some(path)) =
+            (fields.next(), fields.next(), fields.next())
+        else {
+            continue;
+        };
+        if controllers.is_empty() {
+            limits.extend(along(root.to_path_buf(), path, "memory.max"));
+        } else if controllers.split(',').any(|c| c == "memory") {
+            limits.extend(along(root.join("memory"), path, "memory.limit_in_bytes"));
+        }
+    }
+    limits.into_iter().reduce(f64::min)
 }
 
 /// `RLIMIT_AS` (`ulimit -v`) less this process's mapped address space
@@ -215,6 +251,50 @@ mod tests {
             assert!(limit <= physical_bytes().unwrap(), "{what}");
             assert!(limit > 0.0);
         }
+    }
+
+    /// Issue 41, item 6: in a child cgroup limited to 1.5 GiB under an
+    /// unlimited root, the root's limit was read (none). A fake cgroup
+    /// file system: the process's own cgroup's limit counts, and a
+    /// parent's lower one bounds it, in v1 and v2 alike.
+    #[test]
+    fn the_limit_is_the_own_cgroups_and_its_ancestors() {
+        let root = crate::output::temp_dir("cgroup");
+        let write = |rel: &str, text: &str| {
+            let path = root.join(rel);
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(path, text).unwrap();
+        };
+        let gib = 1024.0 * 1024.0 * 1024.0;
+        // v1: unlimited root, the job's 1.5 GiB.
+        write("memory/memory.limit_in_bytes", "9223372036854771712\n");
+        write(
+            "memory/slurm/memory.limit_in_bytes",
+            "9223372036854771712\n",
+        );
+        write("memory/slurm/job_7/memory.limit_in_bytes", "1610612736\n");
+        let v1 = "12:cpuset:/slurm/job_7\n4:cpu,cpuacct,memory:/slurm/job_7\n";
+        assert_eq!(cgroup_limit_under(&root, v1), Some(1.5 * gib));
+        // A parent's lower limit bounds the job.
+        write("memory/slurm/memory.limit_in_bytes", "1073741824\n");
+        assert_eq!(cgroup_limit_under(&root, v1), Some(gib));
+        // v2: max at the root, 3 GiB on the pod, 2 GiB on its parent.
+        write("memory.max", "max\n");
+        write("kubepods/memory.max", "2147483648\n");
+        write("kubepods/pod1/memory.max", "3221225472\n");
+        assert_eq!(
+            cgroup_limit_under(&root, "0::/kubepods/pod1\n"),
+            Some(2.0 * gib)
+        );
+        write("kubepods/memory.max", "max\n");
+        assert_eq!(
+            cgroup_limit_under(&root, "0::/kubepods/pod1\n"),
+            Some(3.0 * gib)
+        );
+        // No limit anywhere, or no cgroup line.
+        assert_eq!(cgroup_limit_under(&root, "0::/\n"), None);
+        assert_eq!(cgroup_limit_under(&root, ""), None);
+        std::fs::remove_dir_all(root).unwrap();
     }
 
     #[test]
