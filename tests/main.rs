@@ -7,6 +7,7 @@ mod cli;
 mod diff;
 mod direct;
 mod engine;
+mod evidence;
 mod first_hour;
 mod frames;
 mod fuzz_seeded;
