@@ -184,8 +184,8 @@ fn four_shards_merged_are_the_unsharded_run_byte_for_byte() {
         ok(merge(&order, &merged), "merge");
         let files = assert_same_files(&whole, &merged);
         // summary, composite, zones, points, STL, PLY, two images, blind
-        // spots.
-        assert_eq!(files, 9, "{files} files compared");
+        // spots, and the record of them.
+        assert_eq!(files, 10, "{files} files compared");
         let composite = std::fs::read_to_string(merged.join("composite.csv")).unwrap();
         if name != "thin-rib" {
             assert!(
@@ -351,7 +351,8 @@ fn four_verify_shards_merged_are_the_unsharded_verification_byte_for_byte() {
             "{name}: {}",
             String::from_utf8_lossy(&result.stderr)
         );
-        assert_eq!(assert_same_files(&dir.join("whole"), &merged), 2, "{name}");
+        // verify.csv, verify.json and the record of them.
+        assert_eq!(assert_same_files(&dir.join("whole"), &merged), 3, "{name}");
         let rows = std::fs::read_to_string(merged.join("verify.csv")).unwrap();
         assert_eq!(
             rows.lines().count(),
@@ -435,7 +436,8 @@ fn four_shards_of_a_chained_strip_merged_are_the_unsharded_strip_byte_for_byte()
         "{}",
         String::from_utf8_lossy(&result.stderr)
     );
-    assert_eq!(assert_same_files(&dir.join("whole"), &merged), 2);
+    // verify.csv, verify.json and the record of them.
+    assert_eq!(assert_same_files(&dir.join("whole"), &merged), 3);
     let rows = std::fs::read_to_string(merged.join("verify.csv")).unwrap();
     assert!(
         rows.lines().count() > 3 * 3 * 20,
@@ -457,8 +459,9 @@ fn four_converge_shards_merged_are_the_unsharded_study_byte_for_byte() {
     let merged = dir.join("merged");
     let order: Vec<&Path> = [3, 1, 0, 2].iter().map(|&k| shards[k].as_path()).collect();
     ok(merge_study(&order, &merged), "merge");
-    // converge.csv and .json, a verify_<pitch>mm.csv per pitch, two plots.
-    assert_eq!(assert_same_files(&dir.join("whole"), &merged), 6);
+    // converge.csv and .json, a verify_<pitch>mm.csv per pitch, two plots,
+    // the record of them.
+    assert_eq!(assert_same_files(&dir.join("whole"), &merged), 7);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -612,7 +615,8 @@ fn four_direct_verify_shards_merged_are_the_unsharded_verification_byte_for_byte
             "{tolerance}: {}",
             String::from_utf8_lossy(&result.stderr)
         );
-        assert_eq!(assert_same_files(&dir.join("whole"), &merged), 2);
+        // verify.csv, verify.json and the record of them.
+        assert_eq!(assert_same_files(&dir.join("whole"), &merged), 3);
         let rows = std::fs::read_to_string(merged.join("verify.csv")).unwrap();
         assert_eq!(
             rows.lines().count(),
@@ -644,8 +648,9 @@ fn four_direct_converge_shards_merged_are_the_unsharded_study_byte_for_byte() {
     let merged = dir.join("merged");
     let order: Vec<&Path> = [2, 3, 1, 0].iter().map(|&k| shards[k].as_path()).collect();
     ok(merge_study(&order, &merged), "merge");
-    // converge.csv and .json, a verify_<pitch>mm.csv per pitch.
-    assert_eq!(assert_same_files(&dir.join("whole"), &merged), 4);
+    // converge.csv and .json, a verify_<pitch>mm.csv per pitch, the
+    // record of them.
+    assert_eq!(assert_same_files(&dir.join("whole"), &merged), 5);
     let summary: serde_json::Value =
         serde_json::from_slice(&std::fs::read(merged.join("converge.json")).unwrap()).unwrap();
     assert_eq!(summary["approach"], "direct");
@@ -817,9 +822,9 @@ fn a_killed_batch_resumes_and_ends_with_a_clean_batch_s_outputs() {
     );
     for item in ["wave", "bump-right", "wave-fine"] {
         let files = assert_same_files(&dir.join("runs").join(item), &clean.join("runs").join(item));
-        // summary, composite, zones, points, STL, PLY, two images, blind
-        // spots.
-        assert_eq!(files, 9, "{item}: {files} files");
+        // summary, composite, zones, STL, PLY, two images, blind spots,
+        // batch-item.json and the record of the files.
+        assert_eq!(files, 10, "{item}: {files} files");
     }
     let runs: Vec<String> = std::fs::read_dir(dir.join("runs"))
         .unwrap()
