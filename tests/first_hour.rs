@@ -348,11 +348,14 @@ fn a_summary_written_and_read_back_describes_the_same_grid() {
 fn an_existing_out_is_refused_without_force_and_replaced_whole_with_it() {
     let dir = scratch_dir("force");
     step_part(&dir, "part.stl");
-    ok(kneeform(&dir, &quick("part.stl", "run", &[])), "first run");
+    // A file of an earlier run that this one does not write: it was run
+    // with --points-csv.
+    ok(
+        kneeform(&dir, &quick("part.stl", "run", &["--points-csv"])),
+        "first run",
+    );
+    assert!(dir.join("run/colliding_points.csv").is_file());
     let before = std::fs::read(dir.join("run/summary.json")).unwrap();
-    // A file of an earlier run that this one does not write (it was run
-    // with --points).
-    std::fs::write(dir.join("run/colliding_points.csv"), "from an earlier run").unwrap();
 
     let out = kneeform(&dir, &quick("part.stl", "run", &[]));
     refused(&out, "--force", "second run without --force");

@@ -217,7 +217,7 @@ fn off_a_terminal_progress_comes_as_lines() {
 /// made from another directory, and without `--out` it silently replaced
 /// `./report.html`. The part is found from the run directory's ancestors
 /// (its SHA-256 decides); an existing report is replaced only with
-/// `--force`.
+/// `--force`, and only a report kneeform wrote (issue 41).
 #[test]
 fn report_finds_a_relative_part_from_elsewhere_and_keeps_an_existing_file() {
     let dir = scratch_dir("second-hour-report");
@@ -250,6 +250,20 @@ fn report_finds_a_relative_part_from_elsewhere_and_keeps_an_existing_file() {
         std::fs::read(dir.join("runs/step/report.html")).unwrap(),
         b"my notes"
     );
+    // Nor with --force (issue 41, item 4): the file is not a report
+    // kneeform wrote.
+    let o = report(&["report", ".", "--force"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("not a report kneeform wrote"), "{err}");
+    assert_eq!(
+        std::fs::read(dir.join("runs/step/report.html")).unwrap(),
+        b"my notes"
+    );
+    // A report of kneeform's is replaced with --force.
+    std::fs::remove_file(dir.join("runs/step/report.html")).unwrap();
+    let o = report(&["report", "."]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let o = report(&["report", ".", "--force"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let html = std::fs::read_to_string(dir.join("runs/step/report.html")).unwrap();

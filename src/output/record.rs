@@ -141,7 +141,7 @@ pub fn why_not_replaceable(dir: &Path) -> io::Result<Option<String>> {
         Ok(record) => record,
         Err(e) if e.kind() == io::ErrorKind::NotFound => {
             return Ok(Some(format!(
-                "holds {} and no {RUN_RECORD} (kneeform's record of the files it wrote: results of kneeform before this version have none, and are not replaced)",
+                "is not a kneeform run directory: it holds {} and no {RUN_RECORD} (kneeform's record of the files it wrote; results of kneeform before this version have none, and are not replaced)",
                 entries[0].0.to_string_lossy()
             )));
         }
