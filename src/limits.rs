@@ -79,7 +79,7 @@ pub(crate) const MAX_RUN_TABLE_BYTES: u64 = 1 << 30;
 /// for a writer for ever; a device such as `/dev/zero`; a directory)
 /// before it is opened: `ErrorKind::InvalidInput`, "not a regular file"
 /// (`IsADirectory` for a directory).
-pub fn regular_file(path: &std::path::Path) -> std::io::Result<()> {
+pub(crate) fn regular_file(path: &std::path::Path) -> std::io::Result<()> {
     let meta = std::fs::metadata(path)?;
     if meta.is_dir() {
         return Err(std::io::Error::new(
@@ -219,7 +219,7 @@ pub fn duration_words(seconds: f64) -> String {
 /// A number given by the user, echoed (in a message or a file) exactly
 /// but briefly: its shortest round-trip decimal, in exponent form beyond
 /// 1e-6 .. 1e15 (`1e-320`, not its 330 digits; `-1e300`, not 301).
-pub fn echo(value: f64) -> String {
+pub(crate) fn echo(value: f64) -> String {
     let a = value.abs();
     if value == 0.0 || !value.is_finite() || (1e-6..1e15).contains(&a) {
         format!("{value}")

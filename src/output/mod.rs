@@ -45,9 +45,8 @@ pub(crate) use self::png::count_colour;
 pub(crate) use self::png::register_font;
 pub use self::png::{BLIND_COLOUR, NO_PART};
 pub(crate) use self::png::{PngError, write_composite_png, write_depth_png};
-pub use self::record::{
-    RUN_RECORD, RecordedFile, digest_file, is_temporary_name, recorded, why_not_replaceable,
-};
+pub(crate) use self::record::recorded;
+pub use self::record::{RUN_RECORD, why_not_replaceable};
 pub(crate) use self::results::{RunResults, write_results};
 pub use self::results::{WriteOptions, write_analysis};
 pub(crate) use self::stl::write_colliding_area;

@@ -26,11 +26,11 @@ const MAX_RECORD_BYTES: u64 = 1 << 20;
 
 /// What a record says of one file.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-pub struct RecordedFile {
+pub(crate) struct RecordedFile {
     /// Its size (bytes).
-    pub bytes: u64,
+    pub(crate) bytes: u64,
     /// Its SHA-256, lowercase hex.
-    pub sha256: String,
+    pub(crate) sha256: String,
 }
 
 /// `kneeform-run.json`.
@@ -43,7 +43,7 @@ struct RunRecord {
 }
 
 /// The size and SHA-256 of the regular file `path`, read in pieces.
-pub fn digest_file(path: &Path) -> io::Result<RecordedFile> {
+pub(crate) fn digest_file(path: &Path) -> io::Result<RecordedFile> {
     let meta = std::fs::metadata(path)?;
     if !meta.is_file() {
         return Err(not_regular());
@@ -64,7 +64,7 @@ fn not_regular() -> io::Error {
 /// Whether `name` is a temporary file of [`super::write_file_atomically`]
 /// (`NAME.tmp-PID-N`), which a process killed while writing leaves behind:
 /// kneeform's own, never a user's result.
-pub fn is_temporary_name(name: &str) -> bool {
+pub(crate) fn is_temporary_name(name: &str) -> bool {
     name.rsplit_once(".tmp-").is_some_and(|(stem, tail)| {
         !stem.is_empty()
             && tail.split_once('-').is_some_and(|(pid, n)| {
@@ -120,7 +120,7 @@ fn read_record(dir: &Path) -> io::Result<RunRecord> {
 
 /// What the record of `dir` says of its file `name`: `None` where the
 /// directory has no readable record or the record does not list it.
-pub fn recorded(dir: &Path, name: &str) -> Option<RecordedFile> {
+pub(crate) fn recorded(dir: &Path, name: &str) -> Option<RecordedFile> {
     read_record(dir).ok()?.files.remove(name)
 }
 
