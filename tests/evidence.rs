@@ -659,3 +659,46 @@ fn messages_are_one_short_line() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Item 7 (the analysis's part): the sample check's oracle was not in the
+/// memory allowed: `--max-memory` between the analysis's estimate and the
+/// analysis with its check was accepted and went beyond it. The check is
+/// now not run where it would pass the limit, and the summary says so; the
+/// analysis stands.
+#[test]
+fn the_sample_check_keeps_within_the_memory_allowed() {
+    let dir = scratch_dir("evidence-check-memory");
+    let bump = scenario("bump");
+    let summary = |run: &Path| -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(run.join("summary.json")).unwrap()).unwrap()
+    };
+    let bare = dir.join("bare");
+    ok(quick_analyze(&bump, &bare, &["--no-check"]), "no check");
+    let analysis_mib = summary(&bare)["memory_estimate_mib"].as_f64().unwrap();
+    let checked = dir.join("checked");
+    ok(quick_analyze(&bump, &checked, &[]), "with its check");
+    let with_check_mib = summary(&checked)["memory_estimate_mib"].as_f64().unwrap();
+    assert!(
+        with_check_mib > analysis_mib + 1.0,
+        "{with_check_mib} {analysis_mib}"
+    );
+    assert_eq!(summary(&checked)["sample_check"]["status"], "checked");
+    // Between the two: the analysis fits, its check does not.
+    let between = format!("{}", (analysis_mib + with_check_mib) / 2.0 / 1024.0);
+    let tight = dir.join("tight");
+    let o = ok(
+        quick_analyze(&bump, &tight, &["--max-memory", &between]),
+        "the analysis within --max-memory",
+    );
+    let s = summary(&tight);
+    assert_eq!(
+        s["sample_check"]["status"], "not_run",
+        "{}",
+        s["sample_check"]
+    );
+    let note = s["sample_check"]["note"].as_str().unwrap();
+    assert!(note.contains("--max-memory"), "{note}");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("not run"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -53,6 +53,27 @@ pub fn check_analysis(
             "not run for the direct approach: `kneeform verify --approach direct` checks it",
         ));
     }
+    // The oracle's copy of the part comes on top of what the analysis
+    // holds: where the two would pass the memory allowed, the check is not
+    // run (issue 41, item 7: it was, and the run was killed).
+    let mut need = analysis.memory.clone();
+    if !need.items.iter().any(|(item, _)| *item == "sample check") {
+        need.add_sample_check(analysis.input.part.triangles.len());
+    }
+    if let Err(limit) = crate::setup::check_estimate(&need, setup.max_memory_bytes) {
+        let gib = |b: f64| crate::limits::short(b / crate::setup::GIB);
+        let beyond = match limit {
+            crate::setup::Limit::Allowed(b) => format!("--max-memory {} GiB", gib(b)),
+            crate::setup::Limit::Machine(b, what) => format!("{what} ({} GiB)", gib(b)),
+        };
+        return Ok(SampleCheck::not_run(
+            CheckStatus::NotRun,
+            format!(
+                "not run: the exact oracle's copy of the part would take this run's memory to {} GiB, beyond {beyond}; `kneeform verify` on a sample of starts measures the accuracy",
+                gib(need.bytes())
+            ),
+        ));
+    }
     let picked = check_angles(&setup.angles);
     let footprints: Vec<_> = picked
         .iter()
