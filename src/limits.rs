@@ -219,7 +219,7 @@ pub fn duration_words(seconds: f64) -> String {
 /// A number given by the user, echoed (in a message or a file) exactly
 /// but briefly: its shortest round-trip decimal, in exponent form beyond
 /// 1e-6 .. 1e15 (`1e-320`, not its 330 digits; `-1e300`, not 301).
-pub(crate) fn echo(value: f64) -> String {
+pub fn echo(value: f64) -> String {
     let a = value.abs();
     if value == 0.0 || !value.is_finite() || (1e-6..1e15).contains(&a) {
         format!("{value}")
