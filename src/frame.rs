@@ -146,9 +146,10 @@ pub struct FrameRecord {
     /// The map from the part's coordinates into vehicle coordinates (mm),
     /// as the rows of a 3 x 4 matrix `[R | t]`.
     pub part_to_vehicle: [[f64; 4]; 3],
-    /// Where the given matrix was a rotation only within
-    /// [`ORTHONORMALISE_TOL`]: the largest change made to one of its
-    /// entries to make it the nearest rotation, `part_to_vehicle`'s.
+    /// Where the given matrix was a rotation within 1e-6
+    /// (`ORTHONORMALISE_TOL`) but not within 1e-9: the largest change made
+    /// to one of its entries to make it the nearest rotation,
+    /// `part_to_vehicle`'s.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub orthonormalised_by: Option<f64>,
 }

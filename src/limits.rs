@@ -118,7 +118,7 @@ pub(crate) fn not_a_device(path: &std::path::Path) -> std::io::Result<()> {
 
 /// Reads the regular file at `path` whole, refusing one longer than
 /// `max_bytes` by its size, before reading anything, and anything that is
-/// not a regular file before opening it ([`regular_file`]).
+/// not a regular file before opening it (`regular_file`).
 pub fn read_bounded(path: &std::path::Path, max_bytes: u64) -> std::io::Result<Vec<u8>> {
     use std::io::Read;
     regular_file(path)?;

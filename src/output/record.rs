@@ -128,7 +128,7 @@ pub(crate) fn recorded(dir: &Path, name: &str) -> Option<RecordedFile> {
 /// that follow its name (`holds notes.txt, which kneeform did not write`);
 /// `None` when it may: it is empty, or every entry in it is a file its
 /// record lists, unchanged, or a temporary file of kneeform's
-/// ([`is_temporary_name`]).
+/// (`is_temporary_name`).
 pub fn why_not_replaceable(dir: &Path) -> io::Result<Option<String>> {
     let mut entries: Vec<(std::ffi::OsString, std::fs::FileType)> = std::fs::read_dir(dir)?
         .map(|e| e.and_then(|e| Ok((e.file_name(), e.file_type()?))))
