@@ -279,6 +279,19 @@ fn force_replaces_only_what_the_record_proves_kneeform_wrote() {
     );
     assert!(err.contains("an input of this run"), "{err}");
     assert_eq!(snapshot(&run), before);
+    // Its frame's matrix file alike (recorded by a run that wrote it as
+    // kneeform's: an analysis's add_to_record stands in here).
+    let matrix = run.join("frame.txt");
+    std::fs::write(&matrix, "1 0 0 0\n0 1 0 0\n0 0 1 0\n").unwrap();
+    kneeform::output::add_to_record(&run, &["frame.txt"]).unwrap();
+    let frame = format!("@{}", matrix.display());
+    let err = refused(
+        &quick_analyze(&bump, &run, &["--force", "--frame", &frame]),
+        &dir,
+        "its own frame file",
+    );
+    assert!(err.contains("frame.txt, an input of this run"), "{err}");
+    std::fs::remove_file(&matrix).unwrap();
     // A file of the run changed since: not kneeform's any more.
     let summary = run.join("summary.json");
     let text = std::fs::read_to_string(&summary).unwrap();

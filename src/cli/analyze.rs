@@ -66,6 +66,7 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         .iter()
         .chain(&args.ignore)
         .map(|p| p.as_path())
+        .chain(args.part.frame_file())
         .collect();
     let out = super::stage_output(&args.out, args.force, &inputs)?;
     super::set_threads(threads)?;

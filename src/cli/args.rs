@@ -677,6 +677,14 @@ pub fn with_flag(err: SetupError) -> anyhow::Error {
 }
 
 impl PartArgs {
+    /// The matrix file `--frame @FILE` names, if any: an input of the run.
+    pub fn frame_file(&self) -> Option<&std::path::Path> {
+        self.frame
+            .as_deref()
+            .and_then(|f| f.strip_prefix('@'))
+            .map(std::path::Path::new)
+    }
+
     /// Validates the flags into where the part's files are read from:
     /// `files`, less `ignored`, scaled, framed and sided.
     pub fn validate(&self, files: &[PathBuf], ignored: &[PathBuf]) -> anyhow::Result<PartSource> {

@@ -64,7 +64,10 @@ pub fn study_inputs(
     );
     let (setup, threads) = setup.validate()?;
     check?;
-    let staged = stage_output(out, study.force, &[study.path.as_path()])?;
+    let inputs: Vec<&Path> = std::iter::once(study.path.as_path())
+        .chain(part.frame_file())
+        .collect();
+    let staged = stage_output(out, study.force, &inputs)?;
     set_threads(threads)?;
     let input = source.read()?;
     Ok((input, setup, staged))
