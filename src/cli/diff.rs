@@ -11,7 +11,8 @@ use super::args::DiffArgs;
 const SHOWN: usize = 8;
 
 pub fn run(args: &DiffArgs) -> anyhow::Result<()> {
-    let out = super::stage_output(&args.out, args.force)?;
+    let inputs = [args.run_a.as_path(), args.run_b.as_path()];
+    let out = super::stage_output(&args.out, args.force, &inputs)?;
     let diff = diff_runs(&args.run_a, &args.run_b).context("cannot compare the runs")?;
     write_diff(out.path(".").as_path(), &diff)?;
     out.commit()
