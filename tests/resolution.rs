@@ -112,7 +112,7 @@ fn the_pitch_chosen_for_a_tolerance_passes_verify_there() {
         let auto = AutoPitch {
             tolerance: 1.0,
             budget_s: AutoPitch::DEFAULT_BUDGET_S,
-            starts: AutoPitch::DEFAULT_STARTS,
+            selection: StartSelection::default_for(1),
         };
         let choice = harness::choose_pitch(&input, &setup, &auto, &()).unwrap();
         assert!(choice.pitch_mm <= 1.0, "{name}: {choice:?}");

@@ -423,7 +423,8 @@ fn csvs_and_messages_carry_no_float_noise() {
         ],
     );
     said.push_str(&String::from_utf8_lossy(&verify.stderr));
-    assert!(matches!(verify.status.code(), Some(0 | 1)), "{said}");
+    // Six scattered starts are INCONCLUSIVE (exit 3): a study written all the same.
+    assert!(matches!(verify.status.code(), Some(0 | 1 | 3)), "{said}");
     let converge = kneeform_in(
         &dir,
         &[

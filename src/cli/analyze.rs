@@ -27,7 +27,7 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         (true, Some(tolerance)) => Some(AutoPitch {
             tolerance,
             budget_s: args.budget_s,
-            starts: AutoPitch::DEFAULT_STARTS,
+            selection: kneeform::harness::StartSelection::default_for(1),
         }),
         (true, None) => bail!("--pitch auto needs --tolerance MM: the error it must meet"),
         (false, Some(_)) => bail!(

@@ -33,10 +33,14 @@ pub enum Command {
     /// Time the engine on a paper-sized console (369,408+ triangles, a
     /// 1538 x 801 grid at 1.24 mm, 61 angles) against the paper algorithm.
     Bench(BenchArgs),
-    /// Compare the grid engine with the exact oracle on the same starts.
-    /// Exit 0 when every decided metric is within --tolerance (undecided
-    /// strikes, near the deflection threshold, are shown but never fail),
-    /// 1 when not or when the oracle failed on a start, 2 on error.
+    /// Compare the grid engine with the exact oracle on the same starts and
+    /// judge the colliding area: PASS (exit 0) when every decided exact
+    /// strike away from blind spots lies within --tolerance of the grid's
+    /// colliding area at every angle, FAIL (exit 1) when one lies further,
+    /// INCONCLUSIVE (exit 3) when the evidence cannot support a claim (an
+    /// oracle failure, fewer than 100 decided exact strikes, or a sampled
+    /// place of fewer than 3 adjacent starts); 2 on error. Per-start
+    /// figures and false alarms are reported beside it as diagnostics.
     Verify(VerifyArgs),
     /// Compare grid and oracle at several pitches: errors, fitted orders of
     /// convergence, and the coarsest pitch meeting --tolerance.
@@ -45,7 +49,7 @@ pub enum Command {
     /// (`analyze`, `verify` or `converge --shard K/N`, one directory each)
     /// into its results, byte for byte those of the unsharded command
     /// (clock readings aside). A verification's merge exits as `verify`
-    /// does: 0 when it passes, 1 when it fails, 2 on error.
+    /// does: 0 PASS, 1 FAIL, 3 INCONCLUSIVE, 2 on error.
     Merge(MergeArgs),
     /// Run the analyses a manifest lists (parts, variants), one after the
     /// other, skipping those whose output directory holds a complete run
@@ -285,9 +289,10 @@ pub struct AnalyzeArgs {
     /// `--shard $((JOB_COMPLETION_INDEX + 1))/N`. Default: every angle.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<String>,
-    /// With --pitch auto: the largest decided area distance (mm) allowed
-    /// between the grid's colliding area and the exact knee-form's, on a
-    /// sample of starts, and between the chosen grid and the next finer.
+    /// With --pitch auto: the largest decided area miss distance (mm)
+    /// allowed between the exact knee-form's colliding area and the
+    /// grid's, judged as `verify` and `converge --tolerance` judge it, on
+    /// their default starts: the coarsest pitch whose outcome is PASS.
     #[arg(long, value_name = "MM")]
     pub tolerance: Option<f64>,
     /// With --pitch auto: the longest predicted analysis (seconds) the
@@ -511,9 +516,10 @@ pub struct StudyArgs {
 pub struct VerifyArgs {
     #[command(flatten)]
     pub study: StudyArgs,
-    /// Largest error allowed for every decided metric (mm): push, first
-    /// contact, miss, false alarm and the area distance, over decided
-    /// strikes. Default: sqrt 2 pitches (1.753624 mm at the default
+    /// Largest decided area miss distance allowed (mm): how far a decided
+    /// exact strike away from blind spots may lie from the grid's colliding
+    /// area, at the worst angle (the other metrics are shown against it as
+    /// diagnostics). Default: sqrt 2 pitches (1.753624 mm at the default
     /// 1.24 mm), the grid's own sampling error: a nearest node lies up to
     /// that far from a point of the part, so a correct grid cannot do
     /// better, and a fixed 1 mm below the pitch would fail every correct
@@ -544,8 +550,9 @@ pub struct ConvergeArgs {
     /// nest, e.g. 8,4,2,1,0.5. Overrides --pitch.
     #[arg(long, default_value = "8,4,2,1", value_name = "MM,MM,...")]
     pub pitches: String,
-    /// Name the coarsest pitch whose decided errors (as verify's) are all
-    /// within this (mm).
+    /// Name the coarsest pitch whose outcome, as verify's, is PASS at this
+    /// tolerance (mm): its decided area miss distance within it, on enough
+    /// evidence.
     #[arg(long, value_name = "MM")]
     pub tolerance: Option<f64>,
     /// The longest the exact oracle may take (seconds), as verify's: one

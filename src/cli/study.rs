@@ -8,16 +8,12 @@ use std::process::ExitCode;
 use kneeform::harness::Study;
 
 /// Prints what `study` found (its results are in `out`) and returns the
-/// command's exit status: a verification's 0 when it passes, 1 when it
-/// fails; a convergence study's 0.
+/// command's exit status: a verification's 0 on PASS, 1 on FAIL, 3 when
+/// INCONCLUSIVE; a convergence study's 0.
 pub fn print_study(study: &Study, out: &Path) -> ExitCode {
     let said = study.said(out);
     for line in &said.lines {
         eprintln!("{line}");
     }
-    if said.pass {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(1)
-    }
+    ExitCode::from(said.outcome.map_or(0, |o| o.exit_code()))
 }

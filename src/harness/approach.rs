@@ -211,8 +211,8 @@ impl Study {
     }
 
     /// What the study says of itself, its results being in `out`: the
-    /// lines `verify`, `converge` and `kneeform merge` print, and whether
-    /// it passes (a convergence study always does).
+    /// lines `verify`, `converge` and `kneeform merge` print, and a
+    /// verification's outcome.
     pub fn said(&self, out: &Path) -> Said {
         self.0.said(out)
     }
@@ -230,13 +230,14 @@ impl Study {
 }
 
 /// What a study says of itself: its lines (to the standard error) and
-/// whether it passes (`verify`'s exit status 0; else 1).
+/// its outcome (`verify`'s exit status: [`Outcome::exit_code`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Said {
     /// The lines, in order.
     pub lines: Vec<String>,
-    /// Whether it passes.
-    pub pass: bool,
+    /// A verification's outcome; `None` for a convergence study, which
+    /// judges each pitch in its files and exits 0 once written.
+    pub outcome: Option<crate::summary::Outcome>,
 }
 
 /// One file of a study's results, as its approach describes it; the

@@ -41,22 +41,23 @@ use crate::engine::AngleMask;
 use crate::grid::{GridSpec, HeightGrid};
 use crate::input::PartFile;
 use crate::setup::{GIB, Setup};
-use crate::summary::{PitchChoice, PitchStudyRow};
+use crate::summary::{Outcome, PitchChoice, PitchStudyRow};
 
 /// How to choose the pitch.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct AutoPitch {
     /// The largest decided area distance allowed (mm).
     pub tolerance: f64,
     /// The longest predicted analysis allowed (s).
     pub budget_s: f64,
-    /// Starts traced by the exact oracle.
-    pub starts: usize,
+    /// The starts traced by the exact oracle, on the study's first
+    /// (coarsest) grid: `verify`'s and `converge`'s default
+    /// ([`StartSelection::default_for`]), so that `converge --tolerance`
+    /// on the same starts recommends the pitch chosen here.
+    pub selection: StartSelection,
 }
 
 impl AutoPitch {
-    /// The default sample of exact starts.
-    pub const DEFAULT_STARTS: usize = 40;
     /// The default time budget (s).
     pub const DEFAULT_BUDGET_S: f64 = 600.0;
 }
@@ -110,10 +111,7 @@ pub fn choose_pitch(
             angles: angles.clone(),
             ..setup.clone()
         },
-        &StartSelection::Sample {
-            count: auto.starts,
-            seed: 1,
-        },
+        &auto.selection,
         TieBand::DEFAULT_PER_MM,
         None,
     )?;
@@ -177,13 +175,12 @@ pub fn choose_pitch(
         let (result, masks, grid) = ladder.measure(p, progress)?;
         last_measure_s = Some(measuring.elapsed().as_secs_f64());
         let (comparison, seconds) = (&result.comparison, result.seconds);
-        // Judged: misses from decided strikes away from blind spots, and
-        // false alarms the level error does not explain.
-        let decided = comparison
-            .area
-            .iter()
-            .map(|a| a.miss_decided.max(a.false_alarm_unexplained))
-            .fold(0.0, f64::max);
+        // Judged as `verify` and `converge` judge it: the outcome of the
+        // decided, non-blind area miss distance at the worst angle, on the
+        // coarsest grid's starts (`p0 / p` nodes apart here).
+        let step = ((p0 / p).round() as usize).max(1);
+        let (outcome, why) = comparison.outcome(auto.tolerance, step);
+        let decided = comparison.area_miss_decided();
         let level_error = comparison
             .area
             .iter()
@@ -200,9 +197,19 @@ pub fn choose_pitch(
                 .and_then(|prev| area_change(prev, &struck)),
             predicted_s: seconds * scale,
             memory_gib: need / GIB,
-            meets: finite && decided <= auto.tolerance,
+            meets: outcome == Outcome::Pass,
+            outcome,
         };
         rows.push(row);
+        if outcome == Outcome::Inconclusive {
+            // A finer grid on the same starts has no more evidence to
+            // give where the oracle failed or the sample is too thin.
+            return Err(HarnessError::Inconclusive {
+                tolerance: auto.tolerance,
+                pitch: p,
+                why: why.unwrap_or_default(),
+            });
+        }
         if row.meets {
             return Ok(PitchChoice {
                 pitch_mm: p,
@@ -211,7 +218,7 @@ pub fn choose_pitch(
                 predicted_s: row.predicted_s,
                 study_s: started.elapsed().as_secs_f64(),
                 reason: format!(
-                    "the coarsest pitch whose area distance to the exact knee-form is within {} mm ({:.3} mm on {} sampled starts at angles {:?}: decided misses away from flagged blind spots, and false alarms the grid's level error does not explain; with the level error's false alarms, which strike more on the safe side, {:.3} mm; the whole-part change from the coarser pitch is shown, not judged)",
+                    "the coarsest pitch whose outcome is PASS at {} mm: every decided exact strike away from flagged blind spots lies within {:.3} mm of the grid's colliding area on {} sampled starts at angles {:?}, as `kneeform verify` and `converge` judge it; the grid's area reaches {:.3} mm beyond the exact one (the decided area false-alarm distance, shown, not judged); the whole-part change from the coarser pitch is shown, not judged",
                     auto.tolerance,
                     decided,
                     ladder.starts.len(),

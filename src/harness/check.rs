@@ -177,6 +177,8 @@ pub fn check_analysis(
         unmatched_grid_decided: comparison.unexplained.unmatched_grid,
         tolerance_mm: tolerance,
         exceeds_tolerance: false,
+        decided_strikes: counts.exact_strikes_decided,
+        outcome: None,
     }
     .judged())
 }

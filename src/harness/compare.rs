@@ -21,6 +21,7 @@ use crate::grid::{GridSpec, HeightGrid};
 use crate::kneeform::{GridFootprint, KneeForm};
 use crate::mesh::Triangle;
 use crate::strike::StrikeRule;
+use crate::summary::{Evidence, Outcome};
 
 /// Starts per block of a row whose traces are chained
 /// ([`kneeform_oracle::Chain`]): one start in 64 is traced whole, each
@@ -80,6 +81,19 @@ pub enum StartSelection {
     /// These starts (x, z in mm), placed or not; each must be a node of
     /// the grid compared (of the coarsest one in a convergence study).
     At(Vec<[f64; 2]>),
+}
+
+impl StartSelection {
+    /// `--starts`' default as `verify`, `converge` and `--pitch auto` take
+    /// it: runs of adjacent starts, each a place with a neighbourhood
+    /// ([`crate::summary::MIN_NEIGHBOURHOOD_STARTS`]), seeded by `seed`.
+    pub fn default_for(seed: u64) -> StartSelection {
+        StartSelection::Runs {
+            count: 20,
+            length: 5,
+            seed,
+        }
+    }
 }
 
 /// How to compare.
@@ -373,6 +387,10 @@ pub struct Counts {
     /// Exact contacts in the tie band: either answer is right at this
     /// pitch.
     pub exact_undecided: usize,
+    /// Decided exact strikes away from blind spots: what the verdict's
+    /// area miss distance is measured from ([`crate::summary::Outcome`]).
+    #[serde(default)]
+    pub exact_strikes_decided: usize,
     /// Pairs whose exact knee-form touched a flagged blind spot: their
     /// later disagreements are blind.
     #[serde(default)]
@@ -975,6 +993,7 @@ pub(crate) fn assemble(
         }
         counts.exact_strikes += cmp.exact_strikes;
         counts.exact_undecided += cmp.undecided;
+        counts.exact_strikes_decided += cmp.miss_decided.len();
         let mut push = |name: &str, v: &[f64]| -> usize {
             let (finite, infinite): (Vec<f64>, Vec<f64>) = v.iter().partition(|x| x.is_finite());
             values[metric_index(name)].extend(finite);
@@ -1343,6 +1362,69 @@ impl Comparison {
             .into_iter()
             .map(|f| f.at_pitch(self.band.pitch))
             .collect()
+    }
+
+    /// The outcome at `tolerance` (mm), SPEC's verdict, and why where
+    /// it is inconclusive: the decided, non-blind area miss distance at
+    /// the worst angle, judged on the evidence the comparison holds. Its
+    /// starts are nodes `step` columns or rows apart where adjacent (1 on
+    /// the grid they were chosen on; a convergence study's finer grids
+    /// hold the coarsest grid's starts, `coarsest / pitch` apart).
+    pub fn outcome(&self, tolerance: f64, step: usize) -> (Outcome, Option<String>) {
+        let evidence = Evidence {
+            oracle_failed: self.counts.oracle_failed,
+            decided_strikes: self.counts.exact_strikes_decided,
+            smallest_place: self.smallest_place(step),
+            area_miss_decided: self.area_miss_decided(),
+        };
+        Outcome::judge(&evidence, tolerance)
+    }
+
+    /// The decided, non-blind area miss distance at the worst angle (mm;
+    /// infinite where a decided exact strike has no grid strike at its
+    /// angle; 0 with none).
+    pub fn area_miss_decided(&self) -> f64 {
+        self.area.iter().map(|a| a.miss_decided).fold(0.0, f64::max)
+    }
+
+    /// The fewest starts in one sampled place: the starts compared, grouped
+    /// where one lies at most `step` columns and `step` rows from another
+    /// (diagonals included), the smallest group's size; 0 with no start.
+    pub fn smallest_place(&self, step: usize) -> usize {
+        let mut starts: Vec<(usize, usize)> = self.rows.iter().map(|r| (r.i, r.j)).collect();
+        starts.sort_unstable();
+        starts.dedup();
+        let index: std::collections::HashMap<(usize, usize), usize> =
+            starts.iter().enumerate().map(|(k, &n)| (n, k)).collect();
+        let mut seen = vec![false; starts.len()];
+        let mut smallest = usize::MAX;
+        for first in 0..starts.len() {
+            if seen[first] {
+                continue;
+            }
+            seen[first] = true;
+            let (mut stack, mut size) = (vec![first], 0);
+            while let Some(k) = stack.pop() {
+                size += 1;
+                let (i, j) = starts[k];
+                for di in [-1i64, 0, 1] {
+                    for dj in [-1i64, 0, 1] {
+                        let (ni, nj) = (i as i64 + di * step as i64, j as i64 + dj * step as i64);
+                        if ni < 0 || nj < 0 {
+                            continue;
+                        }
+                        if let Some(&n) = index.get(&(ni as usize, nj as usize))
+                            && !seen[n]
+                        {
+                            seen[n] = true;
+                            stack.push(n);
+                        }
+                    }
+                }
+            }
+            smallest = smallest.min(size);
+        }
+        if starts.is_empty() { 0 } else { smallest }
     }
 
     /// The oracle's failures by reason: how many pairs each.

@@ -26,6 +26,7 @@ use crate::grid::{GridSpec, HeightGrid};
 use crate::input::PartFile;
 use crate::mesh::Triangle;
 use crate::setup::{Sampled, Setup};
+use crate::summary::Outcome;
 use kneeform_oracle::StartTrace;
 
 /// One pitch of a convergence study.
@@ -103,13 +104,27 @@ pub(crate) fn fits(results: &[PitchResult]) -> Vec<(String, Option<Fit>)> {
         .collect()
 }
 
-/// The coarsest pitch whose comparison passes `tolerance` (measured, not
-/// extrapolated).
+/// The coarsest pitch whose outcome at `tolerance` is `PASS` (measured,
+/// not extrapolated): the figure `verify` and `--pitch auto` judge.
 pub(crate) fn recommended_pitch(results: &[PitchResult], tolerance: f64) -> Option<&PitchResult> {
     results
         .iter()
-        .filter(|r| r.comparison.passes(tolerance))
+        .filter(|r| outcome_at(results, r, tolerance).0 == Outcome::Pass)
         .max_by(|a, b| a.pitch.total_cmp(&b.pitch))
+}
+
+/// The outcome of `result`, one of `results` (coarsest first, whose grid
+/// chose the starts), at `tolerance` (mm), and why where inconclusive.
+pub(crate) fn outcome_at(
+    results: &[PitchResult],
+    result: &PitchResult,
+    tolerance: f64,
+) -> (Outcome, Option<String>) {
+    let coarsest = results.first().map_or(result.pitch, |r| r.pitch);
+    // Grids nest: the coarsest grid's adjacent starts lie this many nodes
+    // apart on this one.
+    let step = ((coarsest / result.pitch).round() as usize).max(1);
+    result.comparison.outcome(tolerance, step)
 }
 
 /// `converge.json`.
@@ -164,6 +179,10 @@ pub struct ConvergeSummary {
     /// traced on its own.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub oracle_chain: Option<kneeform_oracle::Chain>,
+    /// What a reader must know first, one line each, as `verify.json`'s:
+    /// the part's sanity checks and the coarsest pitch's comparison's.
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }
 
 /// One pitch's verdict in a convergence study.
@@ -171,8 +190,14 @@ pub struct ConvergeSummary {
 pub struct PitchVerdict {
     /// The pitch (mm).
     pub pitch_mm: f64,
-    /// Whether it passes the tolerance.
+    /// Whether its outcome is `PASS`.
     pub pass: bool,
+    /// Its outcome, as `verify.json`'s.
+    #[serde(default = "super::verify::inconclusive")]
+    pub outcome: Outcome,
+    /// Why it is `INCONCLUSIVE`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outcome_reason: Option<String>,
     /// Misses and false alarms apart, in words.
     pub verdict: String,
     /// The figures beyond the tolerance, with their mechanism.
@@ -526,6 +551,11 @@ impl ConvergeSummary {
             seconds: Vec::new(),
             verdicts: Vec::new(),
             oracle_chain: chain_of(&options.selection, options.pitches[0]),
+            warnings: crate::sanity::part_warnings(&input.part, input.side, &setup.knee)
+                .iter()
+                .chain(&crate::sanity::angle_warnings(&setup.angles))
+                .map(ToString::to_string)
+                .collect(),
         };
         summary.set_results(results);
         summary
@@ -550,15 +580,28 @@ impl ConvergeSummary {
         self.verdicts = match self.tolerance_mm {
             Some(t) => results
                 .iter()
-                .map(|r| PitchVerdict {
-                    pitch_mm: r.pitch,
-                    pass: r.comparison.passes(t),
-                    verdict: r.comparison.verdict(t),
-                    failures: r.comparison.failures(t),
+                .map(|r| {
+                    let (outcome, outcome_reason) = outcome_at(results, r, t);
+                    PitchVerdict {
+                        pitch_mm: r.pitch,
+                        pass: outcome == Outcome::Pass,
+                        outcome,
+                        outcome_reason,
+                        verdict: r.comparison.verdict(t),
+                        failures: r.comparison.failures(t),
+                    }
                 })
                 .collect(),
             None => Vec::new(),
         };
+        // The starts are the same at every pitch: the coarsest pitch's
+        // comparison says what they hold.
+        self.warnings
+            .retain(|w| !w.starts_with(super::verify::VERIFICATION_WARNING));
+        if let Some(coarsest) = results.first() {
+            self.warnings
+                .extend(super::verify::comparison_warnings(&coarsest.comparison));
+        }
     }
 }
 

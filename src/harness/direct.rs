@@ -66,6 +66,7 @@ use crate::kneeform::KneeForm;
 use crate::limits::short;
 use crate::mesh::{Part, Triangle};
 use crate::setup::{Sampled, Setup};
+use crate::summary::Outcome;
 use std::path::Path;
 
 /// The metrics of the direct approach, in the order of `converge.csv`.
@@ -1117,15 +1118,30 @@ fn verification_said(result: &DirectVerification, out: &Path) -> Said {
         c.oracle_failed,
         c.engine_mismatch
     ));
-    let verdict = if s.pass { "PASS" } else { "FAIL" };
+    let verdict = if c.oracle_failed > 0 {
+        "INCONCLUSIVE"
+    } else if s.pass {
+        "PASS"
+    } else {
+        "FAIL"
+    };
     lines.push(format!(
         "kneeform: {verdict} (direct approach) at tolerance {} mm; results in {}",
         crate::limits::short(s.tolerance_mm),
         out.display()
     ));
+    // The direct approach's verdict is its own (no area is judged here):
+    // its pass or fail, or no claim where the oracle failed.
+    let outcome = if c.oracle_failed > 0 {
+        Outcome::Inconclusive
+    } else if s.pass {
+        Outcome::Pass
+    } else {
+        Outcome::Fail
+    };
     Said {
         lines,
-        pass: s.pass,
+        outcome: Some(outcome),
     }
 }
 
@@ -1170,7 +1186,10 @@ fn convergence_said(study: &DirectConvergence, out: &Path) -> Said {
         _ => {}
     }
     lines.push(format!("kneeform: results in {}", out.display()));
-    Said { lines, pass: true }
+    Said {
+        lines,
+        outcome: None,
+    }
 }
 
 #[cfg(test)]

@@ -161,7 +161,7 @@ pub enum HarnessError {
     },
     /// No pitch of the study meets the tolerance.
     #[error(
-        "no pitch down to {finest} mm meets a tolerance of {tolerance} mm: decided area distance to the exact knee-form {studied} (results/README.md says what does not converge)"
+        "no pitch down to {finest} mm meets a tolerance of {tolerance} mm: decided area miss distance to the exact knee-form {studied} (results/README.md says what does not converge)"
     )]
     PitchNotFound {
         /// The tolerance (mm).
@@ -170,6 +170,18 @@ pub enum HarnessError {
         finest: f64,
         /// The study, in words.
         studied: String,
+    },
+    /// A pitch study's evidence cannot support a claim at some pitch.
+    #[error(
+        "the pitch study is INCONCLUSIVE at {pitch} mm for a tolerance of {tolerance} mm: {why}; no pitch is chosen (give one with --pitch, and `kneeform verify` it)"
+    )]
+    Inconclusive {
+        /// The tolerance (mm).
+        tolerance: f64,
+        /// The pitch at which it was inconclusive (mm).
+        pitch: f64,
+        /// Why, in words.
+        why: String,
     },
     /// More shards than starts: some shard would have nothing to compare.
     #[error("{shards} shards of {starts} starts: at most one shard per start")]

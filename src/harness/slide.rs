@@ -29,6 +29,7 @@ use crate::frame::Approach;
 use crate::input::PartFile;
 use crate::limits::short;
 use crate::setup::Setup;
+use crate::summary::Outcome;
 
 /// Push-and-slide's studies.
 pub(crate) struct Slide;
@@ -111,8 +112,12 @@ impl StudyApproach for Slide {
         match kind {
             StudyKind::Verify => serde_json::json!({
                 "pass": false,
+                "outcome": "INCONCLUSIVE",
+                "outcome_reason": null,
                 "area_distance_decided_mm": null,
                 "area_distance_mm": null,
+                "area_miss_decided_mm": null,
+                "area_false_alarm_decided_mm": null,
                 "area_distance": [],
                 "metrics": {},
                 "area_iou": 0.0,
@@ -218,7 +223,9 @@ impl StudyResult for Convergence {
                 "pitch_mm", "metric", "max", "p95", "mean", "n", "seconds", "area_iou", "pass",
             ])?;
             for r in results {
-                let pass = tolerance.map_or(String::new(), |t| r.comparison.passes(t).to_string());
+                let pass = tolerance.map_or(String::new(), |t| {
+                    (super::converge::outcome_at(results, r, t).0 == Outcome::Pass).to_string()
+                });
                 for (metric, s) in &r.comparison.stats {
                     csv.write_record([
                         r.pitch.to_string(),
@@ -582,11 +589,8 @@ fn verification_said(result: &Verification, out: &Path) -> Said {
         s.metrics["level_error_clearance"].max,
         s.metrics["level_error_bound"].max,
     ));
-    if c.exact_strikes == 0 && result.comparison.rows.iter().all(|r| r.grid_colliding == 0) {
-        lines.push(
-            "kneeform: warning: neither the grid nor the exact knee-form strikes anything on these starts: a pass here proves only that (a part smaller than the knee-form, or its surface on the other side: see --scale and --side)"
-                .to_string(),
-            );
+    for w in &s.warnings {
+        lines.push(format!("kneeform: warning: {w}"));
     }
     let mm = |v: Option<f64>| v.map_or("infinite".to_string(), |v| format!("{v:.3} mm"));
     lines.push(format!(
@@ -595,70 +599,85 @@ fn verification_said(result: &Verification, out: &Path) -> Said {
         mm(s.area_distance_decided_mm),
         mm(s.area_distance_mm)
     ));
-    lines.push(format!("{:>29}: {}", "verdict", s.verdict));
-    if s.pass {
-        let explained = if s.failures.is_empty() {
-            String::new()
-        } else {
-            " (the figures beyond it are blind, undecided or the level error's, named above)".into()
-        };
+    lines.push(format!("{:>29}: {}", "figures beyond tolerance", s.verdict));
+    if let Some(w) = s.worst_starts.first() {
         lines.push(format!(
-            "kneeform: PASS at tolerance {} mm{explained}; results in {}",
-            crate::limits::short(s.tolerance_mm),
-            out.display()
-        ));
-    } else {
-        let worst = s.worst_starts.first().map_or(String::new(), |w| {
-            let at = w.at.map_or(String::new(), |[x, z]| {
-                format!(" (the disagreement lies at x = {x:.1}, z = {z:.1} mm)")
-            });
-            // The hint follows the figure's mechanism: a rim or a brief
-            // strike is the grid's sampling, not a feature's width.
-            use super::causes::Mechanism;
-            let mechanism = s
-                .failures
-                .iter()
-                .find(|f| {
-                    f.metric == w.metric && f.value.is_some_and(|v| (v - w.value).abs() < 1e-9)
-                })
-                .map(|f| f.mechanism);
-            let hint = match mechanism {
-                Some(Mechanism::Rim) => "; it lies in the knee-form's rim, which the grid samples late (the nearest node met more than sqrt 2 pitches of travel after the touch, where the outline crosses the grid's rows at a shallow angle): a finer pitch narrows the rim, at half order along the slide".to_string(),
-                Some(Mechanism::Sampling) if w.value > std::f64::consts::SQRT_2 * s.pitch_mm => {
-                    if s.unexplained.miss_brief >= w.value - 1e-9 {
-                        "; a strike lasting less than sqrt 2 pitches of travel before the knee-form touches elsewhere (brief): the grid meets its nodes after it; a pitch finer than the touch resolves it".to_string()
-                    } else {
-                        "; it falls with the pitch against the same exact trace (to half or less at half the pitch, or to a quarter or less at a quarter: first order), as where the exact knee-form strikes along a crease of the part between node rows that the grid's strikes meet later; a finer pitch resolves it".to_string()
-                    }
-                }
-                _ => resolving_pitch(s.pitch_mm, s.tolerance_mm, &w.metric, w.value),
-            };
-            let short = crate::limits::short;
-            format!(
-                "; worst: {} = {:.3} mm, start ({}, {}) angle {}{at}{hint}",
-                w.metric,
-                w.value,
-                short(w.x),
-                short(w.z),
-                short(w.angle_deg),
-            )
-        });
-        lines.push(format!(
-            "kneeform: FAIL at tolerance {} mm ({}){worst}; results in {}",
-            crate::limits::short(s.tolerance_mm),
-            s.failures
-                .iter()
-                .filter(|f| f.fails_verdict)
-                .map(|f| f.phrase())
-                .collect::<Vec<_>>()
-                .join("; "),
-            out.display()
+            "{:>29}: {}",
+            "worst start (diagnostic)",
+            worst_start_words(result, w)
         ));
     }
+    lines.push(format!(
+        "kneeform: {}; results in {}",
+        s.sentence(),
+        out.display()
+    ));
     Said {
         lines,
-        pass: s.pass,
+        outcome: Some(s.outcome),
     }
+}
+
+/// The worst start of a verification, a diagnostic of its area figures
+/// (never its verdict): its figure, where, and what the figure's
+/// mechanism, or refinement against the same exact trace, showed.
+fn worst_start_words(result: &Verification, w: &super::verify::WorstStart) -> String {
+    use super::causes::Mechanism;
+    let s = &result.summary;
+    let at = w.at.map_or(String::new(), |[x, z]| {
+        format!(" (the disagreement lies at x = {x:.1}, z = {z:.1} mm)")
+    });
+    let mechanism = s
+        .failures
+        .iter()
+        .find(|f| f.metric == w.metric && f.value.is_some_and(|v| (v - w.value).abs() < 1e-9))
+        .map(|f| f.mechanism);
+    let row = result
+        .comparison
+        .rows
+        .iter()
+        .find(|r| r.i == w.i && r.j == w.j && r.angle_deg == w.angle_deg);
+    let half = short(s.pitch_mm / 2.0);
+    let refined = row.and_then(|r| r.miss_distance_half_pitch).map(|h| {
+        let quarter = row
+            .and_then(|r| r.miss_distance_quarter_pitch)
+            .map_or(String::new(), |q| {
+                format!(", {q:.3} mm at {} mm", short(s.pitch_mm / 4.0))
+            });
+        // What the refinement showed: a miss that drops far below half
+        // at half the pitch is a second contact site resolved (the grid's
+        // level set by another one), not an error first order in the pitch.
+        let shape = if h <= w.value / 4.0 {
+            "it collapses at half the pitch: the grid's level at this start is set by another contact site, which a finer grid resolves; not an error of first order"
+        } else if h <= w.value / 2.0 {
+            "it falls to half at half the pitch: first order in the pitch"
+        } else {
+            "it falls by less than half at half the pitch"
+        };
+        format!(
+            "; against the same exact trace it is {h:.3} mm at {half} mm{quarter}: {shape}"
+        )
+    });
+    let hint = match (mechanism, refined) {
+        (_, Some(refined)) => refined,
+        (Some(Mechanism::Rim), None) => format!(
+            "; it lies in the knee-form's rim, which the grid samples late (the nearest node met more than sqrt 2 pitches of travel after the touch): a finer pitch narrows the rim, at half order along the slide (`kneeform verify --pitch {half}` measures it)"
+        ),
+        (Some(Mechanism::Sampling), None) if s.unexplained.miss_brief >= w.value - 1e-9 => {
+            format!(
+                "; a strike lasting less than sqrt 2 pitches of travel before the knee-form touches elsewhere (brief): this start's grid meets its nodes after it, its neighbours' may not (`kneeform verify --pitch {half}` measures it)"
+            )
+        }
+        _ => resolving_pitch(s.pitch_mm, s.tolerance_mm, &w.metric, w.value),
+    };
+    format!(
+        "{} = {:.3} mm, start ({}, {}) angle {}{at}{hint}",
+        w.metric,
+        w.value,
+        short(w.x),
+        short(w.z),
+        short(w.angle_deg),
+    )
 }
 
 /// What a convergence study says: its errors per pitch, fitted orders and
@@ -675,8 +694,11 @@ fn convergence_said(study: &Convergence, out: &Path) -> Said {
             .filter(|(m, _)| DECIDED_METRICS.contains(&m.as_str()))
             .map(|(m, s)| format!("{m} {:.3}", s.max))
             .collect();
+        let outcome = study.summary.tolerance_mm.map_or(String::new(), |t| {
+            format!("{}: ", super::converge::outcome_at(results, r, t).0.word())
+        });
         lines.push(format!(
-            "p = {:>6} mm: {} | all strikes: area_distance {:.3} | IoU {:.3} | {} undecided | {:.2} s",
+            "p = {:>6} mm: {outcome}{} | all strikes: area_distance {:.3} | IoU {:.3} | {} undecided | {:.2} s",
             r.pitch,
             maxes.join(", "),
             r.comparison.stat("area_distance").max,
@@ -685,8 +707,18 @@ fn convergence_said(study: &Convergence, out: &Path) -> Said {
             r.seconds
         ));
     }
+    // No exact strike at any pitch: every error is zero because there was
+    // nothing to miss, which is no order and no exactness.
+    let nothing = results
+        .iter()
+        .all(|r| r.comparison.counts.exact_strikes == 0);
+    if nothing {
+        lines.push(
+            "kneeform: warning: the exact knee-form strikes nothing on these starts at any pitch: no error was measured (nothing to miss is not evidence)".into(),
+        );
+    }
     for (m, f) in fitted {
-        if !DECIDED_METRICS.contains(&m.as_str()) {
+        if nothing || !DECIDED_METRICS.contains(&m.as_str()) {
             continue;
         }
         let exact = results
@@ -704,27 +736,41 @@ fn convergence_said(study: &Convergence, out: &Path) -> Said {
     }
     match (study.summary.tolerance_mm, study.recommended()) {
         (Some(t), Some(r)) => lines.push(format!(
-            "kneeform: the coarsest pitch within {t} mm is {} mm; a full 61-angle analysis at it takes about {:.1} s",
+            "kneeform: the coarsest pitch whose outcome at {t} mm is PASS (its decided area miss distance within it, on enough evidence) is {} mm; a full 61-angle analysis at it takes about {:.1} s",
             r.pitch,
             study.summary.predicted_full_time_s.unwrap_or(f64::NAN)
         )),
         (Some(t), None) => {
-            // Why not: the finest pitch's figures that fail the verdict.
+            // Why not: the finest pitch's outcome and why.
             let why = study.summary.verdicts.last().map_or(String::new(), |v| {
-                let failing: Vec<String> = v
-                    .failures
-                    .iter()
-                    .filter(|f| f.fails_verdict)
-                    .map(|f| f.phrase())
-                    .collect();
-                format!(": at {} mm, {}", short(v.pitch_mm), failing.join("; "))
+                let because = match &v.outcome_reason {
+                    Some(reason) => reason.clone(),
+                    None => format!(
+                        "decided area miss distance {}",
+                        results.last().map_or("-".into(), |r| format!(
+                            "{:.3} mm",
+                            r.comparison.area_miss_decided()
+                        ))
+                    ),
+                };
+                format!(
+                    ": at {} mm, {} ({because})",
+                    short(v.pitch_mm),
+                    v.outcome.word()
+                )
             });
-            lines.push(format!("kneeform: no pitch tried is within {} mm{why}", short(t)))
+            lines.push(format!(
+                "kneeform: no pitch tried is within {} mm{why}",
+                short(t)
+            ))
         }
         _ => {}
     }
     lines.push(format!("kneeform: results in {}", out.display()));
-    Said { lines, pass: true }
+    Said {
+        lines,
+        outcome: None,
+    }
 }
 
 #[cfg(test)]

@@ -20,6 +20,7 @@ use crate::input::PartFile;
 use crate::kneeform::{GridFootprint, KneeForm};
 use crate::mesh::Triangle;
 use crate::setup::{GIB, Setup};
+use crate::summary::Outcome;
 
 /// How to verify, beside the analysis [`Setup`].
 #[derive(Debug, Clone, PartialEq)]
@@ -297,6 +298,13 @@ impl VerifySummary {
             pitch_mm: setup.pitch,
             tolerance_mm: options.tolerance,
             pass: false,
+            outcome: Outcome::Inconclusive,
+            outcome_reason: None,
+            warnings: crate::sanity::part_warnings(&input.part, input.side, &setup.knee)
+                .iter()
+                .chain(&crate::sanity::angle_warnings(&setup.angles))
+                .map(ToString::to_string)
+                .collect(),
             verdict: String::new(),
             failures: Vec::new(),
             unexplained: Default::default(),
@@ -307,6 +315,7 @@ impl VerifySummary {
                 setup.knee.radius,
                 setup.knee.thickness,
             ],
+            triangle_side_assumed: setup.knee.triangle_side == KneeForm::default().triangle_side,
             deflection_deg: setup.rule.deflection_deg(),
             sigma: setup.rule.sigma,
             e0_mm: setup.rule.e0,
@@ -316,6 +325,8 @@ impl VerifySummary {
             tie_band_rule: tie_band_rule(options.tie_band_per_mm, setup.rule.window_mm()),
             area_distance_decided_mm: None,
             area_distance_mm: None,
+            area_miss_decided_mm: None,
+            area_false_alarm_decided_mm: None,
             area_distance: Vec::new(),
             starts,
             seed,
@@ -339,7 +350,13 @@ impl VerifySummary {
     /// statistics, counts and worst starts, and the grid side's seconds.
     /// A merge of shards sets them from the merged comparison this way.
     pub fn set_comparison(&mut self, comparison: &Comparison, spec: &GridSpec) {
-        self.pass = comparison.passes(self.tolerance_mm);
+        let (outcome, why) = comparison.outcome(self.tolerance_mm, 1);
+        self.outcome = outcome;
+        self.outcome_reason = why;
+        self.pass = outcome == Outcome::Pass;
+        self.warnings
+            .retain(|w| !w.starts_with(VERIFICATION_WARNING));
+        self.warnings.extend(comparison_warnings(comparison));
         self.verdict = comparison.verdict(self.tolerance_mm);
         self.failures = comparison.failures(self.tolerance_mm);
         self.unexplained = comparison.unexplained;
@@ -359,6 +376,12 @@ impl VerifySummary {
                 .all(|a| a.miss.is_finite() && a.false_alarm.is_finite())
         });
         self.area_distance = comparison.area.clone();
+        let worst = |f: fn(&AreaDistance) -> f64| {
+            let v = comparison.area.iter().map(f).fold(0.0, f64::max);
+            v.is_finite().then_some(v)
+        };
+        self.area_miss_decided_mm = worst(|a| a.miss_decided);
+        self.area_false_alarm_decided_mm = worst(|a| a.false_alarm_decided);
         self.metrics = comparison.stats.iter().cloned().collect();
         self.area_iou = comparison.area_iou;
         self.counts = comparison.counts;
@@ -386,6 +409,95 @@ impl VerifySummary {
             .collect();
         self.timings.grid_s = comparison.grid_s;
     }
+}
+
+impl VerifySummary {
+    /// The sentence a user signs (SPEC, "The verdict"): the outcome with
+    /// its tolerance and pitch, the sample, the undecided contacts and how
+    /// far they may move the area's boundary, the cost side, the blind
+    /// spots met, and the knee-form's L, marked assumed where it is.
+    pub fn sentence(&self) -> String {
+        let short = crate::limits::short;
+        let mm = |v: Option<f64>| v.map_or("infinite".to_string(), |v| format!("{v:.3} mm"));
+        let c = &self.counts;
+        let judged = match self.outcome {
+            Outcome::Inconclusive => format!(
+                "no claim ({})",
+                self.outcome_reason
+                    .as_deref()
+                    .unwrap_or("the evidence is too thin")
+            ),
+            Outcome::Pass => format!(
+                "every decided exact strike away from blind spots lies within {} of the grid's colliding area (worst angle)",
+                mm(self.area_miss_decided_mm)
+            ),
+            Outcome::Fail => format!(
+                "a decided exact strike lies {} from the grid's colliding area (worst angle)",
+                mm(self.area_miss_decided_mm)
+            ),
+        };
+        let decided_and_undecided = c.exact_strikes_decided + c.exact_undecided;
+        let share = if decided_and_undecided == 0 {
+            0.0
+        } else {
+            100.0 * c.exact_undecided as f64 / decided_and_undecided as f64
+        };
+        format!(
+            "{} at tolerance {} mm, pitch {} mm: {judged}; sample: {} start-angle pairs ({} starts), {} decided exact strikes; undecided: {} exact contacts ({share:.0}% of the decided strikes and undecided contacts), which may move the area's boundary by up to {} (the all-strikes area distance); cost: the grid's area reaches {} beyond the exact one (decided area false-alarm distance); blind spots: {} pairs touched one ({} exact strikes judged apart); knee-form L = {} mm{}",
+            self.outcome.word(),
+            short(self.tolerance_mm),
+            short(self.pitch_mm),
+            c.pairs,
+            self.starts,
+            c.exact_strikes_decided,
+            c.exact_undecided,
+            mm(self.area_distance_mm),
+            mm(self.area_false_alarm_decided_mm),
+            c.blind_pairs,
+            c.blind_strikes,
+            short(self.knee_form_mm[0]),
+            if self.triangle_side_assumed {
+                " (ASSUMED: set it with --triangle-side)"
+            } else {
+                " (given)"
+            }
+        )
+    }
+}
+
+/// How the warnings a comparison gives begin, apart from the part's (which
+/// a shard's summary knows before its comparison is merged).
+pub(super) const VERIFICATION_WARNING: &str = "verification: ";
+
+/// The warnings of `comparison`, each beginning [`VERIFICATION_WARNING`]:
+/// what a reader must know before reading its outcome.
+pub(super) fn comparison_warnings(comparison: &Comparison) -> Vec<String> {
+    let c = &comparison.counts;
+    let mut warnings = Vec::new();
+    // (A share's summary, before its pairs are merged, compared none.)
+    if c.pairs == 0 {
+        return warnings;
+    }
+    if c.exact_strikes == 0 {
+        let grid = comparison.rows.iter().any(|r| r.grid_colliding > 0);
+        warnings.push(format!(
+            "{VERIFICATION_WARNING}the exact knee-form strikes nothing on these starts{}: a verification with nothing to miss proves nothing (a part smaller than the knee-form, or its surface on the other side: see --scale and --side)",
+            if grid { "" } else { ", nor does the grid" }
+        ));
+    }
+    if c.oracle_failed > 0 {
+        warnings.push(format!(
+            "{VERIFICATION_WARNING}the exact oracle failed on {} start-angle pairs: they are counted as failures, never as clear",
+            c.oracle_failed
+        ));
+    }
+    if c.blind_pairs > 0 {
+        warnings.push(format!(
+            "{VERIFICATION_WARNING}{} start-angle pairs touched a flagged blind spot: their {} exact strikes from there on are blind, judged apart",
+            c.blind_pairs, c.blind_strikes
+        ));
+    }
+    warnings
 }
 
 /// `selection` as `verify.json` says it: `all`, the sample size,
@@ -428,6 +540,20 @@ pub struct VerifySummary {
     /// level error, no oracle failure, nothing contradictory (undecided
     /// and blind disagreements are reported in `failures`, never failing).
     pub pass: bool,
+    /// SPEC's verdict: `PASS`, `FAIL` (the decided, non-blind area miss
+    /// distance at the worst angle beyond the tolerance) or `INCONCLUSIVE`
+    /// (the evidence cannot support a claim: `outcome_reason` says why).
+    /// `pass` is whether it is `PASS`.
+    #[serde(default = "inconclusive")]
+    pub outcome: Outcome,
+    /// Why the outcome is `INCONCLUSIVE`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outcome_reason: Option<String>,
+    /// What a reader must know before the outcome, one line each: the
+    /// part's sanity checks (units, facing side, angles) and the
+    /// comparison's (nothing struck, oracle failures, blind spots met).
+    #[serde(default)]
+    pub warnings: Vec<String>,
     /// The verdict in words: misses (safety) and false alarms (cost)
     /// apart, each failing figure with its mechanism.
     #[serde(default)]
@@ -447,6 +573,9 @@ pub struct VerifySummary {
     pub angles_deg: Vec<f64>,
     /// Knee-form L, R, W (mm).
     pub knee_form_mm: [f64; 3],
+    /// True when L is the assumed default of 200 mm (as `summary.json`'s).
+    #[serde(default)]
+    pub triangle_side_assumed: bool,
     /// Deflection threshold delta (degrees).
     pub deflection_deg: f64,
     /// The same threshold as a rate, `sigma = tan(delta)`.
@@ -464,8 +593,19 @@ pub struct VerifySummary {
     pub tie_band_rule: String,
     /// The headline: the area distance, decided (mm; `null` if infinite).
     pub area_distance_decided_mm: Option<f64>,
-    /// The area distance over all strikes (mm; `null` if infinite).
+    /// The area distance over all strikes (mm; `null` if infinite): how
+    /// far the undecided contacts may move the area's boundary.
     pub area_distance_mm: Option<f64>,
+    /// The figure the outcome judges: the decided, non-blind area miss
+    /// distance at the worst angle (mm; `null` if infinite: a decided
+    /// exact strike at an angle where the grid strikes nothing).
+    #[serde(default)]
+    pub area_miss_decided_mm: Option<f64>,
+    /// The cost side beside it: the decided area false-alarm distance at
+    /// the worst angle, how far the grid's area reaches beyond the exact
+    /// one (mm; `null` if infinite).
+    #[serde(default)]
+    pub area_false_alarm_decided_mm: Option<f64>,
     /// The area distance per angle.
     pub area_distance: Vec<AreaDistance>,
     /// `all`, or the sample size.
@@ -487,6 +627,12 @@ pub struct VerifySummary {
     /// traced on its own.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub oracle_chain: Option<kneeform_oracle::Chain>,
+}
+
+/// What a file written before outcomes were recorded is read as: it
+/// claimed on evidence no minimum was held to.
+pub(super) fn inconclusive() -> Outcome {
+    Outcome::Inconclusive
 }
 
 /// One of the worst start-angle pairs.

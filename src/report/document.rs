@@ -163,6 +163,9 @@ code, .mono { font-family: 'DejaVu Sans Mono', monospace; font-size: 12px; word-
 .fail { background: #fde0dc; border: 2px solid #c62828; color: #b71c1c; padding: 4px 10px; font-weight: bold; display: inline-block; }
 .check { background: #f4f4f4; border-left: 4px solid #777; padding: 4px 10px; }
 .unknown { background: #eee; border: 2px solid #777; padding: 4px 10px; font-weight: bold; display: inline-block; }
+.inconclusive { background: #fff3c4; border: 2px solid #c9a100; color: #5d4500; padding: 4px 10px; font-weight: bold; display: inline-block; }
+.warnings { background: #fff8e1; border-left: 4px solid #c9a100; padding: 4px 10px; margin: 6px 0; }
+.warnings ul { margin: 2px 0; padding-left: 20px; }
 .missing { color: #999; font-style: italic; }
 .note { color: #333; font-size: 13px; }
 .headline { font-size: 16px; }
@@ -327,10 +330,26 @@ fn result_section(inputs: &Inputs) -> Markup {
                 @if let Some(json) = &v.verify {
                     (verdict_first(k, json, v.verdict(), run.blind_spots.len()))
                 }
+                @if let Some(json) = &v.converge {
+                    (converge_first(k, json))
+                }
             }
+            (warnings_first(inputs))
             @if let Some(check) = &s.sample_check {
                 (sample_check(check))
             }
+            p id="knee-form-first" {
+                "Knee-form: L = " (cite(SUMMARY, j, "/triangle_side_mm")) " mm"
+                @if s.triangle_side_assumed {
+                    " " span class="assumed" {
+                        "ASSUMED default: the regulation's value was not at hand; set it with --triangle-side"
+                    }
+                } @else {
+                    " (given)"
+                }
+                ", R = " (cite(SUMMARY, j, "/radius_mm")) " mm, W = " (cite(SUMMARY, j, "/thickness_mm")) " mm (section 3)."
+            }
+            "\n"
             p class="headline" {
                 "Area the knee-form can strike at some angle: "
                 b { (cite(SUMMARY, j, "/composite_area_mm2")) " mm" (SUP2) }
@@ -398,18 +417,28 @@ fn sample_check(check: &crate::summary::SampleCheck) -> Markup {
     }
 }
 
-/// The verdict of the `k`-th verification, first (issue 24): PASS or FAIL
-/// against its tolerance, the sentence a regulator signs, and on FAIL
-/// each failing figure with its mechanism and the worst start; section 5
-/// has the tables. `blind_cells` is the run's flagged blind spots.
+/// The class and word of a verdict.
+fn verdict_words(verdict: Verdict) -> (&'static str, &'static str) {
+    match verdict {
+        Verdict::Pass => ("pass", "PASS"),
+        Verdict::Fail => ("fail", "FAIL"),
+        Verdict::Inconclusive => ("inconclusive", "INCONCLUSIVE"),
+        Verdict::Unknown => ("unknown", "NO VERDICT IN FILE"),
+    }
+}
+
+/// The verdict of the `k`-th verification, first: its outcome and the
+/// sentence a regulator signs (SPEC, "The verdict"): the figure judged
+/// against the tolerance at the pitch, the sample, the undecided contacts
+/// and how far they may move the area's boundary, the cost side, the blind
+/// spots and the knee-form's L, assumed or given; then, on FAIL, the
+/// figures beyond the tolerance with their mechanism and the worst start
+/// (diagnostics). Section 5 has the tables. `blind_cells` is the run's
+/// flagged blind spots.
 fn verdict_first(k: usize, json: &Value, verdict: Verdict, blind_cells: usize) -> Markup {
     let file = verify_label(k, "verify.json");
     let c = |p: &str| cite(&file, json, p);
-    let (class, word) = match verdict {
-        Verdict::Pass => ("pass", "PASS"),
-        Verdict::Fail => ("fail", "FAIL"),
-        Verdict::Unknown => ("unknown", "NO VERDICT IN FILE"),
-    };
+    let (class, word) = verdict_words(verdict);
     let failing: Vec<(usize, &Value)> = json
         .get("failures")
         .and_then(Value::as_array)
@@ -420,30 +449,45 @@ fn verdict_first(k: usize, json: &Value, verdict: Verdict, blind_cells: usize) -
                 .collect()
         })
         .unwrap_or_default();
+    let assumed = json.get("triangle_side_assumed") == Some(&Value::Bool(true));
     html! {
         p class={ (class) " verdict" } id={ "verdict-first-" (k) } {
-            (word) " (verification " (k + 1) "): "
+            (word) " (verification " (k + 1) ", " code { (c("/outcome")) } "): "
             @match verdict {
-                Verdict::Pass => "every decided exact strike lies within ",
-                _ => "not every decided exact strike was found within ",
+                Verdict::Pass => {
+                    "every decided exact strike away from blind spots lies within "
+                    (c("/area_miss_decided_mm")) " mm of the grid's colliding area (worst angle), within the tolerance of "
+                }
+                Verdict::Fail => {
+                    "a decided exact strike away from blind spots lies "
+                    (c("/area_miss_decided_mm")) " mm (\u{2014}: infinite, no grid strike at that angle) from the grid's colliding area (worst angle), beyond the tolerance of "
+                }
+                _ => {
+                    "no claim: " (c("/outcome_reason")) ". The tolerance asked was "
+                }
             }
-            (c("/tolerance_mm")) " mm of the grid's colliding area at pitch " (c("/pitch_mm")) " mm ("
-            // A sample's size reads as a count; a strip or runs by name.
-            @if json.pointer("/starts").and_then(Value::as_str).is_some_and(|s| s.parse::<usize>().is_ok()) {
-                (c("/starts")) " starts x "
-            } @else {
-                "starts " (c("/starts")) " x "
-            }
+            (c("/tolerance_mm")) " mm, at pitch " (c("/pitch_mm")) " mm. Sample: "
+            (c("/counts/pairs")) " start-angle pairs (starts " (c("/starts")) ", "
             (json.get("angles_deg").and_then(Value::as_array).map_or(0, Vec::len))
-            " angles against the exact oracle; the largest distance from a decided exact strike to the grid's area: "
-            (c("/metrics/area_miss_distance_decided/max")) " mm); "
-            (c("/counts/exact_undecided")) " exact contacts undecided (either answer is right at this pitch); "
-            (blind_cells) " grid cells flagged as blind spots (features narrower than the pitch, section 6)."
+            " angles) against the exact oracle, " (c("/counts/exact_strikes_decided"))
+            " decided exact strikes. Undecided: " (c("/counts/exact_undecided"))
+            " exact contacts (either answer is right at this pitch), which may move the area's boundary by up to "
+            (c("/area_distance_mm")) " mm (the all-strikes area distance). Cost: the grid's area reaches "
+            (c("/area_false_alarm_decided_mm")) " mm beyond the exact one (the decided area false-alarm distance). Blind spots: "
+            (c("/counts/blind_pairs")) " pairs touched one of the " (blind_cells)
+            " grid cells flagged (features narrower than the pitch, section 6). Knee-form L = "
+            (c("/knee_form_mm/0")) " mm"
+            @if assumed {
+                " " span class="assumed" { "ASSUMED default: set it with --triangle-side" }
+            } @else {
+                " (given)"
+            }
+            "."
         }
         "\n"
         @if !failing.is_empty() {
             p class="headline" {
-                "Why it fails: "
+                "Figures beyond the tolerance (diagnostics; the outcome judges the area miss distance alone): "
                 @for (n, (i, _)) in failing.iter().enumerate() {
                     @if n > 0 { "; " }
                     code { (c(&format!("/failures/{i}/metric"))) } " "
@@ -455,7 +499,72 @@ fn verdict_first(k: usize, json: &Value, verdict: Verdict, blind_cells: usize) -
                     " mm at " (c("/worst_starts/0/angle_deg")) " degrees, "
                     code { (c("/worst_starts/0/metric")) } " = " (c("/worst_starts/0/value")) " mm"
                 }
-                ". Mechanisms: sampling (the grid's error at this pitch: a miss that falls to half at half the pitch or to a quarter at a quarter, or a touch briefer than the pitch; a finer pitch resolves it), rim, oracle-failure, unexplained (README, \"When verify fails\")."
+                ". Mechanisms: sampling (the grid's error at this pitch: shown by refinement against the same exact trace, or a touch briefer than the pitch), rim, oracle-failure, unexplained (README, \"When verify fails\")."
+            }
+            "\n"
+        }
+    }
+}
+
+/// Every warning a signature needs, first: the analysis's
+/// (`summary.json`'s `warnings`), each verification's and each
+/// convergence study's (their JSON's `warnings`), each cited.
+fn warnings_first(inputs: &Inputs) -> Markup {
+    let j = &inputs.run.summary_json;
+    let mut cited: Vec<Markup> = Vec::new();
+    let mut of = |file: String, json: &Value| {
+        let n = json
+            .get("warnings")
+            .and_then(Value::as_array)
+            .map_or(0, Vec::len);
+        for w in 0..n {
+            cited.push(cite(&file, json, &format!("/warnings/{w}")));
+        }
+    };
+    of(SUMMARY.to_string(), j);
+    for (k, v) in inputs.verifications.iter().enumerate() {
+        if let Some(json) = &v.verify {
+            of(verify_label(k, "verify.json"), json);
+        }
+        if let Some(json) = &v.converge {
+            of(verify_label(k, "converge.json"), json);
+        }
+    }
+    html! {
+        @if !cited.is_empty() {
+            div class="warnings" id="warnings-first" {
+                b { "Warnings (" (cited.len()) "):" }
+                ul {
+                    @for w in &cited {
+                        li { (w) }
+                    }
+                }
+            }
+            "\n"
+        }
+    }
+}
+
+/// Each convergence study's outcome per pitch, first: the pitch it
+/// recommends and why the finer or coarser ones are not.
+fn converge_first(k: usize, json: &Value) -> Markup {
+    let file = verify_label(k, "converge.json");
+    let c = |p: &str| cite(&file, json, p);
+    let n = json
+        .get("verdicts")
+        .and_then(Value::as_array)
+        .map_or(0, Vec::len);
+    html! {
+        @if n > 0 {
+            p class="check" id={ "converge-first-" (k) } {
+                "Convergence study (verification " (k + 1) "), at a tolerance of "
+                (c("/tolerance_mm")) " mm: "
+                @for v in 0..n {
+                    @if v > 0 { "; " }
+                    (c(&format!("/verdicts/{v}/pitch_mm"))) " mm "
+                    (c(&format!("/verdicts/{v}/outcome")))
+                }
+                ". Recommended pitch (the coarsest PASS): " (c("/recommended_pitch_mm")) " mm."
             }
             "\n"
         }
@@ -1017,11 +1126,7 @@ fn verify_block(k: usize, json: &Value, verdict: Verdict) -> Markup {
     let c = |p: &str| cite(&file, json, p);
     let tolerance = json.get("tolerance_mm").and_then(Value::as_f64);
     let decided = json.get("area_distance_decided_mm").is_some();
-    let (class, word) = match verdict {
-        Verdict::Pass => ("pass", "PASS"),
-        Verdict::Fail => ("fail", "FAIL"),
-        Verdict::Unknown => ("unknown", "NO VERDICT IN FILE"),
-    };
+    let (class, word) = verdict_words(verdict);
     let rest: Vec<(String, String, &Value)> = ["area_iou", "counts", "timings"]
         .iter()
         .filter_map(|key| json.get(*key).map(|v| (*key, v)))
@@ -1029,9 +1134,10 @@ fn verify_block(k: usize, json: &Value, verdict: Verdict) -> Markup {
         .collect();
     html! {
         p class={ (class) " verdict" } id={ "verdict-" (k) } {
-            (word) ": against a tolerance of " (c("/tolerance_mm")) " mm at pitch "
-            (c("/pitch_mm")) " mm (" code { "verify.json" } " " code { "pass" } " = "
-            (c("/pass")) ")"
+            (word) ": the decided area miss distance " (c("/area_miss_decided_mm"))
+            " mm against a tolerance of " (c("/tolerance_mm")) " mm at pitch "
+            (c("/pitch_mm")) " mm (" code { "verify.json" } " " code { "outcome" } " = "
+            (c("/outcome")) ", " code { "pass" } " = " (c("/pass")) ")"
         }
         "\n"
         @if json.get("verdict").is_some_and(|v| v.as_str().is_some_and(|v| !v.is_empty())) {
@@ -1065,7 +1171,7 @@ fn verify_block(k: usize, json: &Value, verdict: Verdict) -> Markup {
                     @for f in ["max", "p95", "mean", "n"] {
                         th class="num" { (f) }
                     }
-                    th { "max within tolerance" }
+                    th { "judged" }
                 }
                 "\n"
                 @for (name, m) in metrics {
@@ -1075,17 +1181,18 @@ fn verify_block(k: usize, json: &Value, verdict: Verdict) -> Markup {
                         @for f in ["max", "p95", "mean", "n"] {
                             td class="num" { (c(&format!("{base}/{f}"))) }
                         }
-                        // Only decided metrics decide a verdict; the others
-                        // (all strikes, undecided included) are shown beside
-                        // them.
+                        // The outcome judges one figure, the decided area
+                        // miss distance; every other metric is a diagnostic
+                        // shown beside it (SPEC, "The verdict"), never
+                        // marked as failing a verdict it does not decide.
                         @match (m.get("max").and_then(Value::as_f64), tolerance) {
-                            _ if decided && !kneeform_decides(name) => {
-                                td { "shown, not a criterion" }
+                            _ if name.as_str() != JUDGED_METRIC => {
+                                td { "diagnostic" }
                             }
                             (Some(max), Some(tol)) if max.abs() <= tol => {
-                                td class="pass-cell" { "yes" }
+                                td class="pass-cell" { "within tolerance" }
                             }
-                            (Some(_), Some(_)) => td class="fail-cell" { b { "no" } },
+                            (Some(_), Some(_)) => td class="fail-cell" { b { "beyond tolerance" } },
                             _ => td { "—" },
                         }
                     }
@@ -1106,10 +1213,8 @@ fn verify_block(k: usize, json: &Value, verdict: Verdict) -> Markup {
     }
 }
 
-/// Whether a metric of `verify.json` is one a verdict rests on.
-fn kneeform_decides(name: &str) -> bool {
-    crate::summary::DECIDED_METRICS.contains(&name)
-}
+/// The metric of `verify.json` the outcome judges.
+const JUDGED_METRIC: &str = "area_miss_distance_decided";
 
 fn converge_block(k: usize, json: &Value) -> Markup {
     let file = verify_label(k, "converge.json");
@@ -1156,11 +1261,13 @@ const SHOWN_ROWS: usize = 20;
 
 /// The columns a `verify.csv` row is ranked by, worst first: the largest
 /// absolute value among them (an empty cell counts 0).
-const RANKED_BY: [&str; 4] = [
+const RANKED_BY: [&str; 5] = [
     "miss_distance_decided",
     "false_alarm_distance_unexplained",
     "first_contact_error_decided",
     "push_error",
+    // `converge.csv`'s: each metric's largest value at each pitch.
+    "max",
 ];
 
 /// A CSV file as a table, its cells as written in the file. A file of more
@@ -1191,7 +1298,7 @@ fn csv_table(name: &str, text: &str) -> Markup {
             .map(f64::abs)
             .fold(0.0, |m, v| if v > m || v.is_nan() { v } else { m })
     };
-    let shown: Vec<&csv::StringRecord> = if total > SHOWN_ROWS {
+    let shown: Vec<&csv::StringRecord> = if total > SHOWN_ROWS && !columns.is_empty() {
         let mut ranked: Vec<(usize, f64)> = records
             .iter()
             .enumerate()
@@ -1204,15 +1311,17 @@ fn csv_table(name: &str, text: &str) -> Markup {
             .map(|&(k, _)| &records[k])
             .collect()
     } else {
-        records.iter().collect()
+        records.iter().take(SHOWN_ROWS).collect()
     };
     html! {
         table class="csv" {
             caption {
                 code { (name) }
                 @if total > SHOWN_ROWS {
-                    ": the " (SHOWN_ROWS) " of " (total) " rows with the largest "
-                    @if columns.is_empty() { "values" } @else {
+                    @if columns.is_empty() {
+                        ": the first " (SHOWN_ROWS) " of " (total) " rows"
+                    } @else {
+                        ": the " (SHOWN_ROWS) " of " (total) " rows with the largest "
                         (columns.iter().map(|&k| &header[k]).collect::<Vec<_>>().join(", "))
                     }
                     "; every row in the attached file: "
@@ -1247,17 +1356,24 @@ fn resolution_section(inputs: &Inputs) -> Markup {
     let run = inputs.run;
     let j = &run.summary_json;
     let blind = &run.blind_spots;
-    // The accuracy at this pitch: a verification's decided area distance
-    // at the run's pitch, else the pitch study's at the chosen pitch.
+    // The accuracy at this pitch: the figure a verification's outcome
+    // judges (its decided area miss distance), where it passed, else the
+    // pitch study's at the chosen pitch. A FAIL or INCONCLUSIVE
+    // verification claims no bound: page one says why.
     let verified = inputs.verifications.iter().enumerate().find_map(|(k, v)| {
         let json = v.verify.as_ref()?;
-        json.get("area_distance_decided_mm")?.as_f64()?;
+        (v.verdict() == Verdict::Pass).then_some(())?;
+        json.get("area_miss_decided_mm")?.as_f64()?;
         Some(cite(
             &verify_label(k, "verify.json"),
             json,
-            "/area_distance_decided_mm",
+            "/area_miss_decided_mm",
         ))
     });
+    let verified_no_claim = inputs
+        .verifications
+        .iter()
+        .any(|v| v.verify.is_some() && v.verdict() != Verdict::Pass);
     let study_len = j
         .pointer("/pitch_study/study")
         .and_then(Value::as_array)
@@ -1315,9 +1431,11 @@ fn resolution_section(inputs: &Inputs) -> Markup {
             p class="headline" {
                 "At this pitch (" (cite(SUMMARY, j, "/pitch_mm")) " mm), "
                 @if let Some(x) = &verified {
-                    "every decided strike is within " b { (x) " mm" } " of the exact one (verification run)"
+                    "every decided exact strike away from blind spots lies within " b { (x) " mm" } " of the grid's colliding area (a verification's PASS)"
+                } @else if verified_no_claim {
+                    "the verification claims no bound on the grid's area (its outcome, on page one, is not PASS)"
                 } @else if let Some(x) = &studied {
-                    "every decided strike is within " b { (x) " mm" } " of the exact one on the pitch study's sampled starts"
+                    "every decided exact strike away from blind spots lies within " b { (x) " mm" } " of the grid's colliding area on the pitch study's sampled starts"
                 } @else {
                     "the distance of the grid's strikes to the exact ones is not measured here (no verification run given)"
                 }
@@ -1359,7 +1477,7 @@ fn resolution_section(inputs: &Inputs) -> Markup {
                 "\n"
                 table class="compact" {
                     "\n"
-                    tr { th { "pitch (mm)" } th { "area distance to exact (mm)" } th { "change from the coarser grid (mm)" } th { "predicted analysis (s)" } th { "memory (GiB)" } th { "meets" } }
+                    tr { th { "pitch (mm)" } th { "decided area miss distance (mm)" } th { "change from the coarser grid (mm)" } th { "predicted analysis (s)" } th { "memory (GiB)" } th { "meets" } }
                     "\n"
                     @for k in 0..study_len {
                         @let c = |f: &str| cite(SUMMARY, j, &format!("/pitch_study/study/{k}/{f}"));

@@ -41,6 +41,8 @@ pub(crate) enum Verdict {
     Pass,
     /// The file says the run failed.
     Fail,
+    /// The file says the run's evidence supports no claim.
+    Inconclusive,
     /// The file gives no verdict.
     Unknown,
 }
@@ -107,9 +109,17 @@ impl Verification {
         })
     }
 
-    /// The `pass` field of `verify.json`.
+    /// The `outcome` field of `verify.json`; in a file written before
+    /// outcomes, its `pass`.
     pub fn verdict(&self) -> Verdict {
-        match self.verify.as_ref().and_then(|v| v.get("pass")) {
+        let json = self.verify.as_ref();
+        match json.and_then(|v| v.get("outcome")).and_then(Value::as_str) {
+            Some("PASS") => return Verdict::Pass,
+            Some("FAIL") => return Verdict::Fail,
+            Some("INCONCLUSIVE") => return Verdict::Inconclusive,
+            _ => {}
+        }
+        match json.and_then(|v| v.get("pass")) {
             Some(Value::Bool(true)) => Verdict::Pass,
             Some(Value::Bool(false)) => Verdict::Fail,
             _ => Verdict::Unknown,
