@@ -649,9 +649,9 @@ impl SampleCheck {
                 )
             }
             CheckStatus::Checked => format!(
-                "{}{head}: per-start decided misses up to {}; per-start decided false alarms up to {}, {}{}; on this sample alone these per-start figures are {} the tolerance of {} mm (sqrt 2 pitches)",
+                "{head}: {}per-start decided misses up to {}; per-start decided false alarms up to {}, {}{}; on this sample alone these per-start figures are {} the tolerance of {} mm (sqrt 2 pitches)",
                 self.outcome.map_or(String::new(), |o| format!(
-                    "{} ({} scattered starts and {} decided exact strikes measure no area: a sample, not the evidence) ",
+                    "{} ({} scattered starts and {} decided exact strikes measure no area: a sample, not the evidence); ",
                     o.word(),
                     self.starts,
                     self.decided_strikes

@@ -282,8 +282,10 @@ fn verify_of_a_framed_part_is_the_original_s() {
         let out = scratch.join(out);
         args.extend_from_slice(&["--out", out.to_str().unwrap()]);
         let result = kneeform(&args);
+        // Six scattered starts measure no area: INCONCLUSIVE (exit 3), a
+        // study written all the same.
         assert!(
-            result.status.success(),
+            matches!(result.status.code(), Some(0 | 3)),
             "{}",
             String::from_utf8_lossy(&result.stderr)
         );

@@ -21,5 +21,6 @@ mod second_hour;
 mod shard;
 mod standalone;
 mod util;
+mod verdict;
 mod view3d;
 mod zones;

@@ -514,7 +514,7 @@ fn every_value_the_report_cites_from_real_studies_is_in_their_files() {
         // A failing verdict (exit 1) is a study all the same.
         let run = kneeform(&dir, &args);
         assert!(
-            matches!(run.status.code(), Some(0 | 1)),
+            matches!(run.status.code(), Some(0 | 1 | 3)),
             "{command}: {}",
             String::from_utf8_lossy(&run.stderr)
         );
@@ -900,4 +900,241 @@ fn without_webgl_the_3d_view_gives_way_to_the_pictures() {
     assert!(dom.contains("No interactive 3D view: this browser has no WebGL 2."));
     assert!(dom.contains("id=\"main-view\""));
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Issue 39: a verification directory of `run`'s part in `dir/name`,
+/// holding `verify` as `verify.json` (and `converge`, `converge_csv`),
+/// stamped with the run's part, knee-form and strike rule.
+fn verification_of(
+    dir: &Path,
+    name: &str,
+    verify: Value,
+    converge: Option<(Value, String)>,
+) -> PathBuf {
+    let out = dir.join(name);
+    std::fs::create_dir_all(&out).unwrap();
+    let summary = read_json(&dir.join("run/summary.json"));
+    let stamp = |mut json: Value| {
+        json["input_sha256"] = summary["sha256"].clone();
+        json["knee_form_mm"] = Value::from(
+            ["triangle_side_mm", "radius_mm", "thickness_mm"]
+                .map(|k| summary[k].clone())
+                .to_vec(),
+        );
+        for key in kneeform::report::STRIKE_RULE_KEYS {
+            if let Some(v) = summary.get(key) {
+                json[key] = v.clone();
+            }
+        }
+        json.to_string()
+    };
+    std::fs::write(out.join("verify.json"), stamp(verify)).unwrap();
+    if let Some((json, csv)) = converge {
+        std::fs::write(out.join("converge.json"), stamp(json)).unwrap();
+        std::fs::write(out.join("converge.csv"), csv).unwrap();
+    }
+    out
+}
+
+/// A verify.json as `kneeform verify` writes it, in the figures the issue
+/// measured on the console: a per-start decided miss of 2.705 mm and
+/// decided false alarms of 64.11 mm beside an area miss of `area_miss`.
+fn console_like(outcome: &str, area_miss: f64) -> Value {
+    serde_json::json!({
+        "pitch_mm": 2.0, "tolerance_mm": 1.754, "pass": outcome == "PASS",
+        "outcome": outcome, "starts": "runs:20:5", "angles_deg": [-30.0, 0.0, 30.0],
+        "triangle_side_assumed": true,
+        "warnings": ["verification: a warning of the verification"],
+        "area_miss_decided_mm": area_miss, "area_false_alarm_decided_mm": 64.11,
+        "area_distance_decided_mm": 64.11, "area_distance_mm": 8.28,
+        "metrics": {
+            "miss_distance_decided": {"max": 2.705, "p95": 1.1, "mean": 0.4, "n": 900},
+            "false_alarm_distance_decided": {"max": 64.11, "p95": 1.0, "mean": 0.5, "n": 900},
+            "area_miss_distance_decided": {"max": area_miss, "p95": 1.0, "mean": 0.8, "n": 3}
+        },
+        "counts": {"pairs": 300, "exact_strikes_decided": 4000, "exact_undecided": 2800,
+                   "blind_pairs": 0, "blind_strikes": 0}
+    })
+}
+
+/// The HTML between `start` (a marker) and the next `</section>`.
+fn section_of<'a>(html: &'a str, start: &str) -> &'a str {
+    let from = html.find(start).unwrap_or_else(|| panic!("no {start}"));
+    &html[from..from + html[from..].find("</section>").unwrap()]
+}
+
+/// Issue 39, "its sentences contradict its numbers": a PASS report's
+/// metric table said "no" under "within tolerance" for per-start
+/// diagnostics (2.705 mm, 64.11 mm) beside its PASS; section 6 said "every
+/// decided strike is within 64.11 mm" beside a FAIL at 1.754 mm; and every
+/// sentence of page one stating a figure agrees with its JSON: the word
+/// with the judged figure against the tolerance. (Each failed before: the
+/// table's "no", section 6's claim, and page one had no judged figure.)
+#[test]
+fn the_report_says_what_its_json_says_and_nothing_contradicts_page_one() {
+    let dir = step_run("report-verdict-sentences", "left");
+    let pass = verification_of(&dir, "pass", console_like("PASS", 1.2), None);
+    let fail = verification_of(&dir, "fail", console_like("FAIL", 2.1), None);
+    for (v, word) in [(&pass, "PASS"), (&fail, "FAIL")] {
+        let html_path = dir.join(format!("{word}.html"));
+        ok(
+            kneeform(
+                &dir,
+                &[
+                    "report",
+                    "run",
+                    v.to_str().unwrap(),
+                    "--out",
+                    html_path.to_str().unwrap(),
+                ],
+            ),
+            "report",
+        );
+        let html = std::fs::read_to_string(&html_path).unwrap();
+        let json = read_json(&v.join("verify.json"));
+        // Page one: the word, then the judged figure cited, and the
+        // relation its word states.
+        let first = section_of(&html, "id=\"verdict-first-0\"");
+        let first = &first[..first.find("</p>").unwrap()];
+        assert!(first.contains(&format!("\">{word} (verification 1)")), "{first}");
+        let cited: Vec<(String, String, String)> = citations(first);
+        let value = |pointer: &str| -> f64 {
+            let (_, _, text) = cited
+                .iter()
+                .find(|(_, p, _)| p == pointer)
+                .unwrap_or_else(|| panic!("{pointer} not cited on page one: {first}"));
+            text.parse().unwrap()
+        };
+        let (miss, tolerance) = (value("/area_miss_decided_mm"), value("/tolerance_mm"));
+        assert_eq!(miss <= tolerance, word == "PASS", "{first}");
+        assert!(first.contains("lies within") == (word == "PASS"), "{first}");
+        for (_, pointer, text) in &cited {
+            let v = json.pointer(pointer).unwrap();
+            assert!(shows(v, text), "{pointer}: {text} against {v}");
+        }
+        for pointer in [
+            "/counts/pairs",
+            "/counts/exact_strikes_decided",
+            "/counts/exact_undecided",
+            "/area_distance_mm",
+            "/area_false_alarm_decided_mm",
+            "/counts/blind_pairs",
+            "/knee_form_mm/0",
+        ] {
+            value(pointer);
+        }
+        assert!(first.contains("ASSUMED"), "{first}");
+        // Section 5's table judges the area miss distance alone: a
+        // per-start diagnostic beyond the tolerance is no "no".
+        let accuracy = section_of(&html, "<section id=\"accuracy\">");
+        assert_eq!(
+            accuracy.matches("fail-cell").count(),
+            usize::from(word == "FAIL"),
+            "{accuracy}"
+        );
+        // Section 6 claims a bound only from a PASS, and only the judged
+        // figure.
+        let resolution = section_of(&html, "<section id=\"resolution\">");
+        assert!(
+            !resolution.contains("verify.json#/area_distance_decided_mm"),
+            "{resolution}"
+        );
+        assert_eq!(
+            resolution.contains("verify.json#/area_miss_decided_mm"),
+            word == "PASS",
+            "{resolution}"
+        );
+    }
+}
+
+/// Issue 39, "it drops the caveats": every warning of the analysis
+/// (summary.json), of each verification and of each convergence study is
+/// on page one, above the main image, with L assumed (none was there).
+#[test]
+fn every_warning_is_on_page_one() {
+    let dir = scratch_dir("report-warnings-first");
+    ok(
+        kneeform(&dir, &["scenario", "step", "--out", "part.stl"]),
+        "scenario",
+    );
+    // A part in inches read as mm: the analysis warns of its size, and of
+    // nothing struck.
+    ok(
+        kneeform(
+            &dir,
+            &[
+                "analyze", "part.stl", "--scale", "0.01", "--pitch", PITCH, ANGLES, "--out",
+                "run",
+            ],
+        ),
+        "analyze",
+    );
+    let summary = read_json(&dir.join("run/summary.json"));
+    let warnings: Vec<String> = summary["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap().to_string())
+        .collect();
+    assert!(
+        warnings.iter().any(|w| w.contains("--scale 25.4")),
+        "{warnings:?}"
+    );
+    let mut converge = console_like("PASS", 1.2);
+    converge["warnings"] = serde_json::json!(["verification: a warning of the convergence"]);
+    let v = verification_of(
+        &dir,
+        "v",
+        console_like("INCONCLUSIVE", 0.0),
+        Some((converge, "pitch_mm,metric,max\n2,push_error,0.1\n".into())),
+    );
+    ok(
+        kneeform(
+            &dir,
+            &["report", "run", v.to_str().unwrap(), "--out", "r.html"],
+        ),
+        "report",
+    );
+    let html = std::fs::read_to_string(dir.join("r.html")).unwrap();
+    let main = html.find("id=\"main-view\"").unwrap();
+    let page_one = &html[..main];
+    for w in warnings.iter().chain([
+        &"verification: a warning of the verification".to_string(),
+        &"verification: a warning of the convergence".to_string(),
+    ]) {
+        let escaped = w.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
+        assert!(page_one.contains(&escaped), "{w} is not on page one");
+    }
+    assert!(page_one.contains("id=\"knee-form-first\""));
+    assert!(page_one.contains("ASSUMED"));
+    assert!(page_one.contains("\">INCONCLUSIVE (verification 1)"));
+}
+
+/// Issue 39: the converge excerpt labelled "the 20 of 78 rows with the
+/// largest values" showed the file's first 20 rows (zeros) and left out
+/// rows up to 32.5 mm. converge.csv is ranked by its `max`.
+#[test]
+fn a_long_converge_csv_shows_its_largest_rows() {
+    let dir = step_run("report-converge-excerpt", "left");
+    let mut csv = String::from("pitch_mm,metric,max,p95,mean,n,seconds,area_iou,pass\n");
+    for k in 0..78 {
+        // The largest last: 32.5 mm.
+        csv.push_str(&format!("4,metric_{k},{},0,0,1,0.1,1,true\n", k as f64 * 32.5 / 77.0));
+    }
+    let converge = serde_json::json!({"pitches_mm": [4.0, 2.0], "tolerance_mm": null,
+        "recommended_pitch_mm": null, "predicted_full_time_s": null});
+    let v = verification_of(&dir, "v", console_like("PASS", 1.2), Some((converge, csv)));
+    ok(
+        kneeform(
+            &dir,
+            &["report", "run", v.to_str().unwrap(), "--out", "r.html"],
+        ),
+        "report",
+    );
+    let html = std::fs::read_to_string(dir.join("r.html")).unwrap();
+    let table = &html[html.find("<code>converge.csv</code>").unwrap()..];
+    let table = &table[..table.find("</table>").unwrap()];
+    assert!(table.contains("rows with the largest max"), "{table}");
+    assert!(table.contains(">metric_77<"), "{table}");
+    assert!(!table.contains(">metric_0<"), "{table}");
 }

@@ -452,7 +452,7 @@ fn verdict_first(k: usize, json: &Value, verdict: Verdict, blind_cells: usize) -
     let assumed = json.get("triangle_side_assumed") == Some(&Value::Bool(true));
     html! {
         p class={ (class) " verdict" } id={ "verdict-first-" (k) } {
-            (word) " (verification " (k + 1) ", " code { (c("/outcome")) } "): "
+            (word) " (verification " (k + 1) "): "
             @match verdict {
                 Verdict::Pass => {
                     "every decided exact strike away from blind spots lies within "
@@ -482,7 +482,7 @@ fn verdict_first(k: usize, json: &Value, verdict: Verdict, blind_cells: usize) -
             } @else {
                 " (given)"
             }
-            "."
+            ". (" code { "verify.json" } " " code { "outcome" } " = " (c("/outcome")) ".)"
         }
         "\n"
         @if !failing.is_empty() {
