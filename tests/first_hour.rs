@@ -133,30 +133,57 @@ fn the_readme_first_command_analyses_and_reports_the_bundled_console() {
     let html = std::fs::read_to_string(dir.join("r.html")).unwrap();
     assert!(html.contains("id=\"main-view\""));
 
-    // Then a verification and a convergence study of it with small
-    // settings, and the report of all three (issue 24, item 2): the worst
-    // rows only, under 5 MB with the 3D view, at most 15 printed pages.
-    let small = ["--angles=-30,0,30", "--starts", "6"];
+    // Then the README's evidence, one step after another in the same
+    // directory as the first command (issue 39, item 4: none collides with
+    // kneeform-out): the analysis with its report, the default
+    // verification, a convergence study and the report of all three (issue
+    // 24, item 2): the worst rows only, under 5 MB with the 3D view, at
+    // most 15 printed pages.
+    let analyze = [
+        "analyze",
+        "scenarios/console_side.stl",
+        "--out",
+        "console",
+        "--report",
+    ];
+    ok(kneeform(&dir, &analyze), "the evidence's analysis");
     let verify = [
-        &["verify", "scenarios/console_side.stl", "--out", "v"][..],
-        &small,
-    ]
-    .concat();
-    ok(kneeform(&dir, &verify), "verify with small settings");
+        "verify",
+        "scenarios/console_side.stl",
+        "--out",
+        "console-verify",
+    ];
+    // The default verification gives a verdict, PASS or FAIL, never
+    // INCONCLUSIVE: its starts measure an area.
+    let verified = kneeform(&dir, &verify);
+    assert!(
+        matches!(verified.status.code(), Some(0 | 1)),
+        "the default verify: {}",
+        stderr(&verified)
+    );
     let converge = [
-        &[
-            "converge",
-            "scenarios/console_side.stl",
-            "--pitches",
-            "4.96,2.48,1.24",
-            "--out",
-            "c",
-        ][..],
-        &small,
-    ]
-    .concat();
-    ok(kneeform(&dir, &converge), "converge with small settings");
-    let report = ["report", "kneeform-out", "v", "c", "--out", "all.html"];
+        "converge",
+        "scenarios/console_side.stl",
+        "--pitches",
+        "4.96,2.48,1.24",
+        "--angles=-30,0,30",
+        "--tolerance",
+        "1.754",
+        "--out",
+        "console-converge",
+    ];
+    ok(
+        kneeform(&dir, &converge),
+        "the evidence's convergence study",
+    );
+    let report = [
+        "report",
+        "console",
+        "console-verify",
+        "console-converge",
+        "--out",
+        "console.html",
+    ];
     ok(
         kneeform(&dir, &report),
         "report with the verification and the study",
@@ -164,20 +191,17 @@ fn the_readme_first_command_analyses_and_reports_the_bundled_console() {
     // These are the README's evidence commands, word for word
     // (tests/readme.rs accounts for that block by this test).
     let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
-    let analyze = [
-        "analyze",
-        "scenarios/console_side.stl",
-        "--out",
-        "kneeform-out",
-        "--report",
-    ];
+    assert!(
+        readme.contains("cargo install --path ."),
+        "README lacks PATH"
+    );
     for args in [&analyze[..], &verify, &converge, &report] {
         let line = format!("kneeform {}", args.join(" "));
         assert!(readme.contains(&line), "README lacks: {line}");
     }
-    let size = std::fs::metadata(dir.join("all.html")).unwrap().len();
+    let size = std::fs::metadata(dir.join("console.html")).unwrap().len();
     assert!(size < 5_000_000, "the report is {size} bytes");
-    if let Some(pages) = crate::util::pdf_pages(&dir.join("all.html"), &dir) {
+    if let Some(pages) = crate::util::pdf_pages(&dir.join("console.html"), &dir) {
         assert!(
             (3..=15).contains(&pages),
             "the report prints to {pages} pages"
@@ -604,7 +628,11 @@ fn report_refuses_a_verification_of_another_part_or_setup() {
         ];
         let out = kneeform(&dir, &args);
         // 0 within the tolerance, 1 beyond: both write the files.
-        assert!(matches!(out.status.code(), Some(0 | 1 | 3)), "{}", stderr(&out));
+        assert!(
+            matches!(out.status.code(), Some(0 | 1 | 3)),
+            "{}",
+            stderr(&out)
+        );
     };
     verify("part.stl", "4", "same");
     verify("other.stl", "4", "other-part");

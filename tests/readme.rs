@@ -90,7 +90,7 @@ const ENTRIES: &[Entry] = &[
     },
     Entry {
         name: "the evidence",
-        key: "kneeform report kneeform-out v c --out all.html",
+        key: "kneeform report console console-verify console-converge --out console.html",
         how: How::Skip(
             "run as written, its report printed to PDF (at most 15 pages) and weighed (under \
              5 MB), by tests/first_hour.rs's \
@@ -139,7 +139,7 @@ const ENTRIES: &[Entry] = &[
     },
     Entry {
         name: "verify --shard",
-        key: "--starts 400 --shard 2/4 --out vshards/2",
+        key: "--starts runs:80:5 --shard 2/4 --out vshards/2",
         how: How::Run(verify_shards),
     },
     Entry {
@@ -522,7 +522,7 @@ fn pitch_auto(ctx: &Ctx) -> Result<(), String> {
     let out = ctx.sh(&ctx.block.text);
     let said = String::from_utf8_lossy(&out.stderr);
     assert!(
-        said.contains("decided misses away from flagged blind spots")
+        said.contains("decided exact strike away from flagged blind spots")
             && said.contains("the whole-part change from the coarser pitch is shown, not judged"),
         "{said}"
     );
@@ -658,14 +658,19 @@ fn verify_shards(ctx: &Ctx) -> Result<(), String> {
             "(the loop's end)",
         ),
         (
-            "--starts 400",
-            "--starts 8 --angles=-30,0,30",
-            "400 starts at 61 angles take about 3 minutes per shard in the test build",
+            "--starts runs:80:5",
+            "--starts runs:8:5 --angles=-30,0,30",
+            "80 runs at 61 angles take minutes per shard in the test build",
         ),
     ]));
     let v = ctx.json("verify/verify.json");
+    assert_eq!(
+        v["outcome"], "PASS",
+        "{}: {}",
+        v["verdict"], v["outcome_reason"]
+    );
     assert_eq!(v["pass"], true, "{}", v["verdict"]);
-    assert_eq!(v["starts"], "8", "{}", v["starts"]);
+    assert_eq!(v["starts"], "runs:8:5", "{}", v["starts"]);
     Ok(())
 }
 

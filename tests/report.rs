@@ -996,7 +996,10 @@ fn the_report_says_what_its_json_says_and_nothing_contradicts_page_one() {
         // relation its word states.
         let first = section_of(&html, "id=\"verdict-first-0\"");
         let first = &first[..first.find("</p>").unwrap()];
-        assert!(first.contains(&format!("\">{word} (verification 1)")), "{first}");
+        assert!(
+            first.contains(&format!("\">{word} (verification 1)")),
+            "{first}"
+        );
         let cited: Vec<(String, String, String)> = citations(first);
         let value = |pointer: &str| -> f64 {
             let (_, _, text) = cited
@@ -1063,8 +1066,7 @@ fn every_warning_is_on_page_one() {
         kneeform(
             &dir,
             &[
-                "analyze", "part.stl", "--scale", "0.01", "--pitch", PITCH, ANGLES, "--out",
-                "run",
+                "analyze", "part.stl", "--scale", "0.01", "--pitch", PITCH, ANGLES, "--out", "run",
             ],
         ),
         "analyze",
@@ -1102,7 +1104,10 @@ fn every_warning_is_on_page_one() {
         &"verification: a warning of the verification".to_string(),
         &"verification: a warning of the convergence".to_string(),
     ]) {
-        let escaped = w.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
+        let escaped = w
+            .replace('&', "&amp;")
+            .replace('<', "&lt;")
+            .replace('>', "&gt;");
         assert!(page_one.contains(&escaped), "{w} is not on page one");
     }
     assert!(page_one.contains("id=\"knee-form-first\""));
@@ -1119,7 +1124,10 @@ fn a_long_converge_csv_shows_its_largest_rows() {
     let mut csv = String::from("pitch_mm,metric,max,p95,mean,n,seconds,area_iou,pass\n");
     for k in 0..78 {
         // The largest last: 32.5 mm.
-        csv.push_str(&format!("4,metric_{k},{},0,0,1,0.1,1,true\n", k as f64 * 32.5 / 77.0));
+        csv.push_str(&format!(
+            "4,metric_{k},{},0,0,1,0.1,1,true\n",
+            k as f64 * 32.5 / 77.0
+        ));
     }
     let converge = serde_json::json!({"pitches_mm": [4.0, 2.0], "tolerance_mm": null,
         "recommended_pitch_mm": null, "predicted_full_time_s": null});

@@ -115,12 +115,15 @@ fn the_pitch_chosen_for_a_tolerance_passes_verify_there() {
             selection: StartSelection::default_for(1),
         };
         let choice = harness::choose_pitch(&input, &setup, &auto, &()).unwrap();
-        assert!(choice.pitch_mm <= 1.0, "{name}: {choice:?}");
+        // Issue 39: the study judges the decided area miss distance alone,
+        // as verify does (the false alarms it also judged kept the wave at
+        // 1 mm); the wave's is within 1 mm at 2 mm.
+        assert!(choice.pitch_mm <= 2.0, "{name}: {choice:?}");
         assert!(choice.study.last().unwrap().meets);
-        // verify on other starts than the study's (another seed, more of
-        // them), at the chosen pitch.
+        // verify on other starts than the study's (another seed), at the
+        // chosen pitch.
         let options = VerifyOptions {
-            selection: StartSelection::Sample { count: 60, seed: 2 },
+            selection: StartSelection::default_for(2),
             tie_band_per_mm: TieBand::DEFAULT_PER_MM,
             tolerance: 1.0,
             budget_s: None,
@@ -130,7 +133,7 @@ fn the_pitch_chosen_for_a_tolerance_passes_verify_there() {
             ..setup.clone()
         };
         let verified = harness::verify(&input, &at_choice, &options, &()).unwrap();
-        let d = verified.summary.area_distance_decided_mm;
+        let d = verified.summary.area_miss_decided_mm;
         assert!(
             d.is_some_and(|d| d <= 1.0),
             "{name} at {} mm: {d:?}",

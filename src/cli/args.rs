@@ -404,19 +404,22 @@ pub struct DiffArgs {
 /// Which starts a comparison uses.
 #[derive(Debug, Args)]
 pub struct StartArgs {
-    /// Starts to compare: `runs:N:L` for N seeded runs of L adjacent
-    /// starts along a row (1 <= L <= 64; the default, 20 runs of 5: small
-    /// strips spread over the part, each costing the oracle about one
-    /// start, their traces chained), `strip:Z0:Z1` for every placed start
+    /// Starts to compare: `patches:N:L:R` for N seeded patches of R
+    /// adjacent start rows of L adjacent starts (the default, 10 patches
+    /// of 3 rows of 5: places measured in x and z, spread over the part,
+    /// each row costing the oracle about one start, its traces chained),
+    /// `runs:N:L` for N seeded runs of L adjacent starts along one row
+    /// (1 <= L <= 64), `strip:Z0:Z1` for every placed start
     /// with Z0 <= z <= Z1 (mm): a whole strip of start rows, whose area
     /// distance is the colliding area a user sees there, a number N for a
     /// seeded random sample of N scattered starts (each traced on its own:
-    /// about 4x the oracle's time of the same number in runs), or `all`
-    /// (every node whose start is placed at some angle).
+    /// about 4x the oracle's time of the same number in runs: too few
+    /// neighbours to measure an area, so INCONCLUSIVE), or `all` (every
+    /// node whose start is placed at some angle).
     #[arg(
         long,
-        default_value = "runs:20:5",
-        value_name = "runs:N:L|strip:Z0:Z1|N|all",
+        default_value = "patches:10:5:3",
+        value_name = "runs:N:L|patches:N:L:R|strip:Z0:Z1|N|all",
         allow_hyphen_values = true
     )]
     pub starts: String,
@@ -449,6 +452,22 @@ impl StartArgs {
                 })?;
             return Ok(StartSelection::Strip { z: [lo, hi] });
         }
+        if let Some(patches) = self.starts.strip_prefix("patches:") {
+            let parts: Vec<Option<usize>> =
+                patches.split(':').map(|p| p.trim().parse().ok()).collect();
+            let &[Some(count), Some(length), Some(rows)] = &parts[..] else {
+                anyhow::bail!(
+                    "--starts {:?}: expected patches:N:L:R (N patches of R rows of L starts)",
+                    self.starts
+                );
+            };
+            return Ok(StartSelection::Patches {
+                count,
+                length,
+                rows,
+                seed: self.seed,
+            });
+        }
         if let Some(runs) = self.starts.strip_prefix("runs:") {
             let (count, length) = runs
                 .split_once(':')
@@ -467,7 +486,7 @@ impl StartArgs {
         }
         let count: usize = self.starts.parse().with_context(|| {
             format!(
-                "--starts {:?}: expected runs:N:L, strip:Z0:Z1, a number of starts or `all`",
+                "--starts {:?}: expected runs:N:L, patches:N:L:R, strip:Z0:Z1, a number of starts or `all`",
                 self.starts
             )
         })?;

@@ -39,7 +39,7 @@ const _: () = assert!(
 pub(crate) fn chain_of(selection: &StartSelection, pitch: f64) -> Option<kneeform_oracle::Chain> {
     matches!(
         selection,
-        StartSelection::Strip { .. } | StartSelection::Runs { .. }
+        StartSelection::Strip { .. } | StartSelection::Runs { .. } | StartSelection::Patches { .. }
     )
     .then_some(kneeform_oracle::Chain {
         pitch,
@@ -78,6 +78,22 @@ pub enum StartSelection {
         /// The seed.
         seed: u64,
     },
+    /// A seeded random sample of `count` patches: a run of `length`
+    /// starts as [`StartSelection::Runs`] has it, and the same columns on
+    /// the `rows - 1` start rows above it, each row beginning its own
+    /// chain block: a place measured in x and z, so that what another
+    /// start row covers in the full analysis is covered here too (SPEC,
+    /// "The verdict").
+    Patches {
+        /// How many patches.
+        count: usize,
+        /// Starts per row of a patch (1 to 64, a chain block).
+        length: usize,
+        /// Adjacent start rows per patch.
+        rows: usize,
+        /// The seed.
+        seed: u64,
+    },
     /// These starts (x, z in mm), placed or not; each must be a node of
     /// the grid compared (of the coarsest one in a convergence study).
     At(Vec<[f64; 2]>),
@@ -85,12 +101,16 @@ pub enum StartSelection {
 
 impl StartSelection {
     /// `--starts`' default as `verify`, `converge` and `--pitch auto` take
-    /// it: runs of adjacent starts, each a place with a neighbourhood
-    /// ([`crate::summary::MIN_NEIGHBOURHOOD_STARTS`]), seeded by `seed`.
+    /// it (`patches:10:5:3`), seeded by `seed`: ten places, each five
+    /// adjacent starts on three adjacent rows, so that a strike another
+    /// start row covers in the full analysis is covered here too; each
+    /// row's run is traced as one chain (results/README.md, "The verdict",
+    /// for the choice).
     pub fn default_for(seed: u64) -> StartSelection {
-        StartSelection::Runs {
-            count: 20,
+        StartSelection::Patches {
+            count: 10,
             length: 5,
+            rows: 3,
             seed,
         }
     }
@@ -194,32 +214,67 @@ pub(super) fn choose_nodes(
             count,
             length,
             seed,
-        } => {
-            // The runs' first nodes: each the first node of its chain
-            // block on its row (where a chain starts), followed on the row
-            // and in the block by `length - 1` nodes of `nodes`.
-            let block = |i: usize| (spec.i_origin + i as i64).div_euclid(CHAIN_BLOCK as i64);
-            let mut heads: Vec<usize> = (0..nodes.len())
-                .filter(|&n| {
-                    let (i, j) = nodes[n];
-                    let first = n == 0 || {
-                        let (pi, pj) = nodes[n - 1];
-                        pj != j || block(pi) != block(i)
-                    };
-                    first
-                        && block(i + length - 1) == block(i)
-                        && (1..length).all(|k| nodes.get(n + k) == Some(&(i + k, j)))
-                })
-                .collect();
-            sample(&mut heads, count, seed);
-            nodes = heads
-                .iter()
-                .flat_map(|&n| nodes[n..n + length].iter().copied())
-                .collect();
-        }
+        } => nodes = patches(spec, &nodes, count, length, 1, seed),
+        StartSelection::Patches {
+            count,
+            length,
+            rows,
+            seed,
+        } => nodes = patches(spec, &nodes, count, length, rows, seed),
         _ => {}
     }
     nodes
+}
+
+/// A seeded sample of `count` patches of `rows` runs of `length` nodes
+/// of `nodes` (row-major), back in row-major order. A run begins at the
+/// first node of its chain block on its row (where a chain starts) and
+/// holds the next `length - 1` nodes of the row in the block; a patch is
+/// a run and the runs of the same columns on the `rows - 1` rows above,
+/// its first row a multiple of `rows` on the lattice, so that patches
+/// never overlap. With one row, a patch is a run.
+fn patches(
+    spec: &crate::grid::GridSpec,
+    nodes: &[(usize, usize)],
+    count: usize,
+    length: usize,
+    rows: usize,
+    seed: u64,
+) -> Vec<(usize, usize)> {
+    let block = |i: usize| (spec.i_origin + i as i64).div_euclid(CHAIN_BLOCK as i64);
+    let index: std::collections::HashMap<(usize, usize), usize> =
+        nodes.iter().enumerate().map(|(k, &n)| (n, k)).collect();
+    // Whether the run of `length` nodes at `(i, j)` is one: its first
+    // node heads its block on its row, and the rest follow it there.
+    let run_at = |i: usize, j: usize| -> bool {
+        let Some(&n) = index.get(&(i, j)) else {
+            return false;
+        };
+        let first = n == 0 || {
+            let (pi, pj) = nodes[n - 1];
+            pj != j || block(pi) != block(i)
+        };
+        first
+            && block(i + length - 1) == block(i)
+            && (1..length).all(|k| nodes.get(n + k) == Some(&(i + k, j)))
+    };
+    let mut heads: Vec<usize> = (0..nodes.len())
+        .filter(|&n| {
+            let (i, j) = nodes[n];
+            (spec.j_origin + j as i64).rem_euclid(rows as i64) == 0
+                && (0..rows).all(|r| run_at(i, j + r))
+        })
+        .collect();
+    sample(&mut heads, count, seed);
+    let mut chosen: Vec<(usize, usize)> = heads
+        .iter()
+        .flat_map(|&n| {
+            let (i, j) = nodes[n];
+            (0..rows).flat_map(move |r| (0..length).map(move |k| (i + k, j + r)))
+        })
+        .collect();
+    chosen.sort_unstable_by_key(|&(i, j)| (j, i));
+    chosen
 }
 
 /// The error for a `selection` that chose no start of the `placed` placed
@@ -236,6 +291,9 @@ pub(super) fn none_chosen(selection: &StartSelection, placed: usize) -> HarnessE
         )),
         StartSelection::Runs { length, .. } => HarnessError::NoneChosen(format!(
             "no {length} adjacent placed starts lie in one chain block ({CHAIN_BLOCK} columns) of a row: ask for shorter runs"
+        )),
+        StartSelection::Patches { length, rows, .. } => HarnessError::NoneChosen(format!(
+            "no {rows} adjacent rows of {length} adjacent placed starts lie in one chain block ({CHAIN_BLOCK} columns): ask for smaller patches"
         )),
         _ => HarnessError::NoStarts,
     }
@@ -1607,6 +1665,66 @@ mod tests {
         assert_eq!(picked.len(), 40);
         // (Node 36 starts the next block, which holds 4 of them.)
         assert!(picked.chunks(8).all(|run| run[0].0 == 3));
+
+        // Patches (issue 39): runs on three adjacent rows, the same
+        // columns, never overlapping, each a place of 15 starts; none
+        // holds row 7's broken run.
+        let picked = choose_nodes(
+            &spec,
+            nodes.clone(),
+            &StartSelection::Patches {
+                count: 12,
+                length: 5,
+                rows: 3,
+                seed: 3,
+            },
+        );
+        assert_eq!(picked.len(), 12 * 15);
+        assert!(picked.is_sorted_by_key(|&(i, j)| (j, i)));
+        let set: HashSet<(usize, usize)> = picked.iter().copied().collect();
+        assert_eq!(set.len(), picked.len(), "patches overlap");
+        for &(i, j) in &picked {
+            let column = spec.i_origin + i as i64;
+            let head = i - (column.rem_euclid(64) as usize).min(i);
+            let first_row = j - (spec.j_origin + j as i64).rem_euclid(3) as usize;
+            // Every node of its patch is picked.
+            for r in 0..3 {
+                for k in 0..5 {
+                    assert!(set.contains(&(head + k, first_row + r)), "{i} {j}");
+                }
+            }
+            assert!(!(j == 7 && (128..192).contains(&column)), "{i} {j}");
+        }
+        let rows = |p: &StartSelection| {
+            let mut c = Comparison {
+                rows: Vec::new(),
+                stats: Vec::new(),
+                area_iou: 0.0,
+                area: Vec::new(),
+                band: TieBand::new(1.0, 1.0, 0.0),
+                counts: Counts::default(),
+                unexplained: Unexplained::default(),
+                grid_s: 0.0,
+            };
+            for (i, j) in choose_nodes(&spec, nodes.clone(), p) {
+                c.rows.push(VerifyRow {
+                    i,
+                    j,
+                    ..row_of(i, j, 0.0, "compared", &Default::default())
+                });
+            }
+            c.smallest_place(1)
+        };
+        assert_eq!(
+            rows(&StartSelection::Patches {
+                count: 12,
+                length: 5,
+                rows: 3,
+                seed: 3
+            }),
+            15
+        );
+        assert_eq!(rows(&StartSelection::Sample { count: 5, seed: 1 }), 1);
     }
 
     /// The refinement's finer grid holds only the rows the footprint

@@ -52,10 +52,13 @@ impl VerifyOptions {
 
 pub(super) fn check_selection(selection: &StartSelection) -> Result<(), HarnessError> {
     match *selection {
-        StartSelection::Sample { count: 0, .. } | StartSelection::Runs { count: 0, .. } => {
-            Err(HarnessError::EmptySample)
-        }
-        StartSelection::Runs { length, .. } if !(1..=CHAIN_BLOCK).contains(&length) => {
+        StartSelection::Sample { count: 0, .. }
+        | StartSelection::Runs { count: 0, .. }
+        | StartSelection::Patches { count: 0, .. }
+        | StartSelection::Patches { rows: 0, .. } => Err(HarnessError::EmptySample),
+        StartSelection::Runs { length, .. } | StartSelection::Patches { length, .. }
+            if !(1..=CHAIN_BLOCK).contains(&length) =>
+        {
             Err(HarnessError::RunLength {
                 length,
                 max: CHAIN_BLOCK,
@@ -520,6 +523,12 @@ pub(super) fn selection_words(selection: &StartSelection) -> (String, u64) {
             length,
             seed,
         } => (format!("runs:{count}:{length}"), seed),
+        StartSelection::Patches {
+            count,
+            length,
+            rows,
+            seed,
+        } => (format!("patches:{count}:{length}:{rows}"), seed),
         StartSelection::At(ref starts) => (format!("{} given", starts.len()), 0),
     }
 }
