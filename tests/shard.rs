@@ -947,6 +947,8 @@ fn runs_of_starts_are_chained_and_bad_runs_are_refused() {
         ("4", "runs:0:4", "at least one start"),
         ("4", "runs:3:65", "1 to 64 starts"),
         ("4", "runs:3", "expected runs:N:L"),
+        ("4", "patches:3:5", "expected patches:N:L:R"),
+        ("4", "patches:3:5:0", "at least one start"),
         (
             "4",
             "all:3",

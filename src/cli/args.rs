@@ -486,7 +486,7 @@ impl StartArgs {
         }
         let count: usize = self.starts.parse().with_context(|| {
             format!(
-                "--starts {:?}: expected runs:N:L, patches:N:L:R, strip:Z0:Z1, a number of starts or `all`",
+                "--starts {:?}: expected runs:N:L, strip:Z0:Z1, a number of starts or `all` (or patches:N:L:R)",
                 self.starts
             )
         })?;

@@ -668,6 +668,7 @@ fn worst_start_words(result: &Verification, w: &super::verify::WorstStart) -> St
                 "; a strike lasting less than sqrt 2 pitches of travel before the knee-form touches elsewhere (brief): this start's grid meets its nodes after it, its neighbours' may not (`kneeform verify --pitch {half}` measures it)"
             )
         }
+        (Some(Mechanism::LevelError), None) => "; the grid's level error (its level deeper than the exact one by at most the stated bound): a false alarm on the safe side, which the outcome does not judge".to_string(),
         _ => resolving_pitch(s.pitch_mm, s.tolerance_mm, &w.metric, w.value),
     };
     format!(
