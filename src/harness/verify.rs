@@ -488,6 +488,12 @@ pub(super) fn comparison_warnings(comparison: &Comparison) -> Vec<String> {
             if grid { "" } else { ", nor does the grid" }
         ));
     }
+    if c.exact_strikes > 0 && c.exact_strikes_decided == 0 {
+        warnings.push(format!(
+            "{VERIFICATION_WARNING}none of the {} exact strikes on these starts is decided (each within the tie band of the threshold, or blind): the area miss distance is measured from nothing",
+            c.exact_strikes
+        ));
+    }
     if c.oracle_failed > 0 {
         warnings.push(format!(
             "{VERIFICATION_WARNING}the exact oracle failed on {} start-angle pairs: they are counted as failures, never as clear",

@@ -512,13 +512,22 @@ fn verdict_first(k: usize, json: &Value, verdict: Verdict, blind_cells: usize) -
 fn warnings_first(inputs: &Inputs) -> Markup {
     let j = &inputs.run.summary_json;
     let mut cited: Vec<Markup> = Vec::new();
+    // A warning given by several files (the part's size, by the analysis
+    // and its verification) is shown once, cited from the first.
+    let mut said: Vec<Value> = Vec::new();
     let mut of = |file: String, json: &Value| {
         let n = json
             .get("warnings")
             .and_then(Value::as_array)
             .map_or(0, Vec::len);
         for w in 0..n {
-            cited.push(cite(&file, json, &format!("/warnings/{w}")));
+            let pointer = format!("/warnings/{w}");
+            let text = json.pointer(&pointer);
+            if text.is_some_and(|t| said.contains(t)) {
+                continue;
+            }
+            said.extend(text.cloned());
+            cited.push(cite(&file, json, &pointer));
         }
     };
     of(SUMMARY.to_string(), j);
