@@ -245,3 +245,45 @@ fn blind_spots_are_located_in_the_parts_coordinates_whatever_the_frame() {
     }
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// Issue 39: `converge --tolerance T` and `--pitch auto --tolerance T`
+/// judge the same figure on the same starts, so they name the same pitch
+/// (on the console, 1 mm at 1 mm: results/README.md). Before, the study
+/// judged false alarms too, on scattered starts, and `converge` 0.62 mm
+/// where it chose 0.5.
+#[test]
+fn converge_and_pitch_auto_name_the_same_pitch() {
+    use kneeform::harness::{self, AutoPitch, ConvergeOptions, StartSelection, TieBand};
+    let input = kneeform::read_part(&scenario_file("wave"), 1.0, Side::Left).unwrap();
+    let setup = Setup {
+        angles: vec![-30.0, 0.0, 30.0],
+        ..Setup::default()
+    };
+    let auto = AutoPitch {
+        tolerance: 1.0,
+        budget_s: AutoPitch::DEFAULT_BUDGET_S,
+        selection: StartSelection::default_for(1),
+    };
+    let choice = harness::choose_pitch(&input, &setup, &auto, &()).unwrap();
+    // The study's ladder: four tolerances down to half the tolerance.
+    let options = ConvergeOptions {
+        pitches: vec![4.0, 2.0, 1.0, 0.5],
+        selection: StartSelection::default_for(1),
+        tie_band_per_mm: TieBand::DEFAULT_PER_MM,
+        tolerance: Some(1.0),
+        budget_s: None,
+    };
+    let study = harness::converge(&input, &setup, &options, &()).unwrap();
+    let recommended = study.summary.recommended_pitch_mm;
+    assert_eq!(recommended, Some(choice.pitch_mm), "{choice:?}");
+    // The same figure at every pitch both measured.
+    for row in &choice.study {
+        let k = options
+            .pitches
+            .iter()
+            .position(|&p| p == row.pitch_mm)
+            .unwrap();
+        let theirs = study.results[k].comparison.area_miss_decided();
+        assert_eq!(row.exact_area_distance_mm, Some(theirs), "{}", row.pitch_mm);
+    }
+}

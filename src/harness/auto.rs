@@ -115,9 +115,15 @@ pub fn choose_pitch(
         TieBand::DEFAULT_PER_MM,
         None,
     )?;
+    // The exact side is resolved to a tenth of the pitch it is traced for
+    // (the oracle's witness tolerance): half the tolerance judged is fine
+    // enough for every pitch whose figure is held to that tolerance, and
+    // it is what `converge --pitches p0,..,T/2 --tolerance T` traces, so
+    // the two compare the same exact traces. The ladder's finest pitch,
+    // p0 / 64, made the console's 450 pairs about an hour.
     let tracing = Tracing {
         share: ladder.laid().starts.clone(),
-        finest,
+        finest: finest.max(auto.tolerance / 2.0),
         within_s: Some(auto.budget_s),
         refuse_beyond_s: None,
         memory: None,
