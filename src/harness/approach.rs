@@ -230,7 +230,8 @@ impl Study {
 }
 
 /// What a study says of itself: its lines (to the standard error) and
-/// its outcome (`verify`'s exit status: [`Outcome::exit_code`]).
+/// its outcome (`verify`'s exit status:
+/// [`crate::summary::Outcome::exit_code`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Said {
     /// The lines, in order.
