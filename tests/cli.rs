@@ -453,7 +453,10 @@ fn verify_warns_when_nothing_is_struck_on_either_side() {
     let flat = run("flat-wall.toml", "flat");
     let stderr = String::from_utf8_lossy(&flat.stderr);
     assert_eq!(flat.status.code(), Some(3), "{stderr}");
-    assert!(stderr.contains("strikes nothing on these starts"), "{stderr}");
+    assert!(
+        stderr.contains("strikes nothing on these starts"),
+        "{stderr}"
+    );
     let ramp = run("ramp.toml", "ramp");
     let stderr = String::from_utf8_lossy(&ramp.stderr);
     assert!(!stderr.contains("strikes nothing"), "{stderr}");
