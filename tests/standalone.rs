@@ -117,3 +117,96 @@ fn the_checks_find_a_reference_and_a_large_file() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The method document (issue 40, item 1) defines every column that
+/// `verify.csv` and `converge.csv` write and every metric `converge.csv`
+/// names, read from a verification and a convergence study run here; the
+/// README, `results/README.md`, `--help` and the report's verdict cite it.
+#[test]
+fn the_method_document_defines_every_figure_and_is_cited() {
+    let method = std::fs::read_to_string(repo().join("docs/method.md")).expect("docs/method.md");
+    let dir = crate::util::scratch_dir("method-document");
+    let part = crate::util::scenario("bump");
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_kneeform"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            matches!(out.status.code(), Some(0 | 1 | 3)),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out
+    };
+    let at = |name: &str| dir.join(name).display().to_string();
+    run(&[
+        "analyze",
+        &part,
+        "--pitch",
+        "8",
+        "--angles=-30,0,30",
+        "--no-check",
+        "--out",
+        &at("run"),
+    ]);
+    run(&[
+        "verify",
+        &part,
+        "--pitch",
+        "8",
+        "--angles=0",
+        "--starts",
+        "runs:2:3",
+        "--out",
+        &at("v"),
+    ]);
+    run(&[
+        "converge",
+        &part,
+        "--pitches",
+        "16,8",
+        "--angles=0",
+        "--starts",
+        "4",
+        "--out",
+        &at("c"),
+    ]);
+    let header = |file: &str| -> Vec<String> {
+        let mut csv = csv::Reader::from_path(dir.join(file)).unwrap();
+        csv.headers().unwrap().iter().map(String::from).collect()
+    };
+    let mut names = header("v/verify.csv");
+    names.extend(header("c/converge.csv"));
+    let mut csv = csv::Reader::from_path(dir.join("c/converge.csv")).unwrap();
+    let metric = csv
+        .headers()
+        .unwrap()
+        .iter()
+        .position(|h| h == "metric")
+        .unwrap();
+    names.extend(csv.records().map(|r| r.unwrap()[metric].to_string()));
+    names.sort();
+    names.dedup();
+    let undefined: Vec<&String> = names
+        .iter()
+        .filter(|n| !method.contains(&format!("`{n}`")))
+        .collect();
+    assert!(undefined.is_empty(), "not in docs/method.md: {undefined:?}");
+
+    for file in ["README.md", "results/README.md"] {
+        let text = std::fs::read_to_string(repo().join(file)).unwrap();
+        assert!(text.contains("docs/method.md"), "{file} does not cite it");
+    }
+    let help = run(&["--help"]);
+    assert!(String::from_utf8_lossy(&help.stdout).contains("docs/method.md"));
+    run(&["report", &at("run"), &at("v"), "--out", &at("report.html")]);
+    let page = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    let verdict = page.find("id=\"verdict-first-0\"").expect("the verdict");
+    let paragraph = &page[verdict..verdict + page[verdict..].find("</p>").unwrap()];
+    assert!(
+        paragraph.contains("docs/method.md") && paragraph.contains(env!("CARGO_PKG_VERSION")),
+        "{paragraph}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

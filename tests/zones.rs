@@ -151,3 +151,41 @@ fn analyze_writes_zones_csv_beside_the_summary() {
     assert!(stderr.contains("kneeform:   zone 1: "), "{stderr}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The report lists the zones (a table of the largest, cited from
+/// `summary.json`) and boxes the largest ones' ids on the face-on view.
+#[test]
+fn the_report_tables_the_zones_and_labels_them_on_the_part() {
+    let dir = scratch_dir("zones-report");
+    let out = dir.join("run");
+    let bin = env!("CARGO_BIN_EXE_kneeform");
+    let run = std::process::Command::new(bin)
+        .args(["analyze", &crate::util::scenario("switch-boss")])
+        .args([
+            "--pitch",
+            "4",
+            "--angles=-30,0,30",
+            "--no-check",
+            "--report",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    crate::util::ok(run, "analyze --report");
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    let zones = summary["zones"].as_array().unwrap();
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let table = page.find("id=\"zones-table\"").expect("the zones' table");
+    let table = &page[table..table + page[table..].find("</table>").unwrap()];
+    assert_eq!(table.matches("<tr>").count(), 1 + zones.len().min(15));
+    assert!(table.contains("data-src=\"summary.json#/zones/0/area_mm2\""));
+    let labels = page
+        .find("aria-label=\"the largest struck zones' ids\"")
+        .expect("the labels");
+    let labels = &page[labels..labels + page[labels..].find("</svg>").unwrap()];
+    let non_specks = zones.iter().filter(|z| z["speck"] == false).count();
+    assert_eq!(labels.matches("<text").count(), non_specks.min(12));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

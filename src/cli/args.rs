@@ -17,7 +17,13 @@ use kneeform::{
 /// computed, exactly, and what each figure means: docs/method.md in the
 /// repository.
 #[derive(Debug, Parser)]
-#[command(name = "kneeform", version, about, long_about = None)]
+#[command(
+    name = "kneeform",
+    version,
+    about,
+    long_about = None,
+    after_help = "What is computed, exactly, and what every figure and verdict means: docs/method.md in kneeform's repository."
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
