@@ -1644,6 +1644,90 @@ fn run_figures_section(figures: &[(String, Vec<u8>)]) -> Markup {
     }
 }
 
+/// Zones labelled on the face-on view, largest first.
+const LABELLED_ZONES: usize = 12;
+/// Zones listed in the report's table, largest first (`zones.csv` lists
+/// them all).
+const TABLED_ZONES: usize = 15;
+
+/// The largest zones' ids ([`crate::zones`], from `summary.json`) at their
+/// centroids on the face-on view `view`, as an SVG overlay on its picture;
+/// specks are left out (the table names them).
+fn zone_labels_svg(run: &super::run::Run, view: &super::render::View) -> Markup {
+    let (w, h) = (view.width as f64, view.height as f64);
+    let sign = if view.camera.right[0] + view.camera.right[1] < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    let direct = run.summary.approach == Approach::Direct;
+    let labels: Vec<(usize, f64, f64)> = run
+        .summary
+        .zones
+        .iter()
+        .filter(|z| !z.speck)
+        .take(LABELLED_ZONES)
+        .filter_map(|z| {
+            let v = run.frame.to_vehicle(z.centroid);
+            let across = if direct { v[1] } else { v[0] };
+            let c = (sign * across - view.u_left) / view.mm_per_px;
+            let r = (view.v_top - v[2]) / view.mm_per_px;
+            ((0.0..=w).contains(&c) && (0.0..=h).contains(&r)).then_some((z.id, c, r))
+        })
+        .collect();
+    html! {
+        @if !labels.is_empty() {
+            svg class="axes-overlay" viewBox=(format!("0 0 {w} {h}")) role="img"
+                aria-label="the largest struck zones' ids" {
+                @for (id, c, r) in labels {
+                    @let width = 10.0 + 8.0 * id.to_string().len() as f64;
+                    (svg_empty("rect", &[("x", &format!("{:.1}", c - width / 2.0)), ("y", &format!("{:.1}", r - 9.0)), ("width", &format!("{width:.1}")), ("height", &"18"), ("fill", &"white"), ("fill-opacity", &"0.85"), ("stroke", &"#222")]))
+                    text x=(format!("{c:.1}")) y=(format!("{:.1}", r + 5.0)) font-size="13" text-anchor="middle" { (id) }
+                }
+            }
+        }
+    }
+}
+
+/// The struck zones' table (the largest [`TABLED_ZONES`], from
+/// `summary.json`'s `zones`); a run of an earlier version says it has
+/// none listed.
+fn zones_table(run: &super::run::Run) -> Markup {
+    let s = &run.summary;
+    let j = &run.summary_json;
+    let specks = s.zones.iter().filter(|z| z.speck).count();
+    html! {
+        @if s.zones.is_empty() {
+            @if s.composite_nodes > 0 {
+                p class="note" { "This run lists no struck zones (a run of an earlier version): analyse it again for " code { "zones.csv" } "." }
+            }
+        } @else {
+            p {
+                b { "Struck zones: " } (s.zones.len()) " connected areas of the composite (8-connected nodes), "
+                (specks) " of them specks under " (crate::zones::SPECK_NODES) " nodes, each listed beside the zone nearest it; the "
+                (s.zones.len().min(TABLED_ZONES)) " largest below, all in " code { "zones.csv" } ". Coordinates in mm, the part's own."
+            }
+            "\n"
+            table class="compact" id="zones-table" {
+                tr { th { "zone" } th { "area (mm" (SUP2) ")" } th { "centroid x, y, z" } th { "angles striking it (degrees)" } th { "most angles at a node" } th { "blind spot touches it" } th { "speck beside zone" } }
+                @for (k, z) in s.zones.iter().enumerate().take(TABLED_ZONES) {
+                    @let at = |field: &str| cite(SUMMARY, j, &format!("/zones/{k}/{field}"));
+                    tr {
+                        td { (at("id")) }
+                        td { (at("area_mm2")) }
+                        td { (at("centroid/0")) ", " (at("centroid/1")) ", " (at("centroid/2")) }
+                        td { (at("angle_runs")) }
+                        td { (at("max_count")) }
+                        td { (at("touches_blind_spot")) }
+                        td { @if z.beside.is_some() { (at("beside")) } @else { "-" } }
+                    }
+                }
+            }
+            "\n"
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1772,89 +1856,5 @@ mod tests {
         assert_eq!(tick_step(10.0), 10.0);
         assert_eq!(tick_step(11.0), 20.0);
         assert_eq!(tick_step(0.3), 0.5);
-    }
-}
-
-/// Zones labelled on the face-on view, largest first.
-const LABELLED_ZONES: usize = 12;
-/// Zones listed in the report's table, largest first (`zones.csv` lists
-/// them all).
-const TABLED_ZONES: usize = 15;
-
-/// The largest zones' ids ([`crate::zones`], from `summary.json`) at their
-/// centroids on the face-on view `view`, as an SVG overlay on its picture;
-/// specks are left out (the table names them).
-fn zone_labels_svg(run: &super::run::Run, view: &super::render::View) -> Markup {
-    let (w, h) = (view.width as f64, view.height as f64);
-    let sign = if view.camera.right[0] + view.camera.right[1] < 0.0 {
-        -1.0
-    } else {
-        1.0
-    };
-    let direct = run.summary.approach == Approach::Direct;
-    let labels: Vec<(usize, f64, f64)> = run
-        .summary
-        .zones
-        .iter()
-        .filter(|z| !z.speck)
-        .take(LABELLED_ZONES)
-        .filter_map(|z| {
-            let v = run.frame.to_vehicle(z.centroid);
-            let across = if direct { v[1] } else { v[0] };
-            let c = (sign * across - view.u_left) / view.mm_per_px;
-            let r = (view.v_top - v[2]) / view.mm_per_px;
-            ((0.0..=w).contains(&c) && (0.0..=h).contains(&r)).then_some((z.id, c, r))
-        })
-        .collect();
-    html! {
-        @if !labels.is_empty() {
-            svg class="axes-overlay" viewBox=(format!("0 0 {w} {h}")) role="img"
-                aria-label="the largest struck zones' ids" {
-                @for (id, c, r) in labels {
-                    @let width = 10.0 + 8.0 * id.to_string().len() as f64;
-                    (svg_empty("rect", &[("x", &format!("{:.1}", c - width / 2.0)), ("y", &format!("{:.1}", r - 9.0)), ("width", &format!("{width:.1}")), ("height", &"18"), ("fill", &"white"), ("fill-opacity", &"0.85"), ("stroke", &"#222")]))
-                    text x=(format!("{c:.1}")) y=(format!("{:.1}", r + 5.0)) font-size="13" text-anchor="middle" { (id) }
-                }
-            }
-        }
-    }
-}
-
-/// The struck zones' table (the largest [`TABLED_ZONES`], from
-/// `summary.json`'s `zones`); a run of an earlier version says it has
-/// none listed.
-fn zones_table(run: &super::run::Run) -> Markup {
-    let s = &run.summary;
-    let j = &run.summary_json;
-    let specks = s.zones.iter().filter(|z| z.speck).count();
-    html! {
-        @if s.zones.is_empty() {
-            @if s.composite_nodes > 0 {
-                p class="note" { "This run lists no struck zones (a run of an earlier version): analyse it again for " code { "zones.csv" } "." }
-            }
-        } @else {
-            p {
-                b { "Struck zones: " } (s.zones.len()) " connected areas of the composite (8-connected nodes), "
-                (specks) " of them specks under " (crate::zones::SPECK_NODES) " nodes, each listed beside the zone nearest it; the "
-                (s.zones.len().min(TABLED_ZONES)) " largest below, all in " code { "zones.csv" } ". Coordinates in mm, the part's own."
-            }
-            "\n"
-            table class="compact" id="zones-table" {
-                tr { th { "zone" } th { "area (mm" (SUP2) ")" } th { "centroid x, y, z" } th { "angles striking it (degrees)" } th { "most angles at a node" } th { "blind spot touches it" } th { "speck beside zone" } }
-                @for (k, z) in s.zones.iter().enumerate().take(TABLED_ZONES) {
-                    @let at = |field: &str| cite(SUMMARY, j, &format!("/zones/{k}/{field}"));
-                    tr {
-                        td { (at("id")) }
-                        td { (at("area_mm2")) }
-                        td { (at("centroid/0")) ", " (at("centroid/1")) ", " (at("centroid/2")) }
-                        td { (at("angle_runs")) }
-                        td { (at("max_count")) }
-                        td { (at("touches_blind_spot")) }
-                        td { @if z.beside.is_some() { (at("beside")) } @else { "-" } }
-                    }
-                }
-            }
-            "\n"
-        }
     }
 }
