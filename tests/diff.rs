@@ -128,3 +128,28 @@ fn runs_computed_differently_are_refused() {
     assert!(!out.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `report RUN --compare EARLIER_RUN` with a run of the same approach
+/// opens the page with what changed: the moved bump's zone vanished from
+/// where it was and appeared where it is, before section 1.
+#[test]
+fn the_report_opens_with_the_changes_from_an_earlier_revision() {
+    let dir = scratch_dir("diff-report");
+    let a = analyse(&dir, &part(&dir, "a", &bump(0.0)), "a", &[]);
+    let b = analyse(&dir, &part(&dir, "b", &bump(40.0)), "b", &[]);
+    let page = dir.join("report.html").display().to_string();
+    ok(
+        kneeform(&["report", &b, "--compare", &a, "--out", &page]),
+        "report --compare",
+    );
+    let page = std::fs::read_to_string(&page).unwrap();
+    let (revision, result) = (
+        page.find("<section id=\"revision\"").expect("the changes"),
+        page.find("<section id=\"result\"").expect("section 1"),
+    );
+    assert!(revision < result, "the changes come first");
+    let table = &page[revision..result];
+    assert!(table.contains("<td>vanished</td>") && table.contains("<td>appeared</td>"));
+    assert!(table.contains("id=\"revision-view\""));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

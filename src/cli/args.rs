@@ -377,7 +377,11 @@ pub struct ReportArgs {
     /// (its SHA-256 must still be the run's).
     #[arg(long, value_name = "FILE")]
     pub part: Option<PathBuf>,
-    /// Another `analyze` run of the same part with the other --approach
+    /// Another `analyze` run. Of the same approach: an earlier revision of
+    /// the part (same knee-form, rule, side, frame and angles), and the
+    /// page opens with what changed (as `kneeform diff RUN_DIR RUN`: the
+    /// area struck only before, only now, the zones that appeared,
+    /// vanished, grew or shrank). Of the other --approach, the same part
     /// (slide against direct): both areas painted on the same rendered
     /// part, with the area only push-and-slide strikes (what the direct
     /// approach cannot reach) and the area only the direct approach

@@ -445,6 +445,23 @@ pub fn write_diff(dir: &Path, diff: &RevisionDiff) -> Result<(), ReportError> {
     Ok(())
 }
 
+/// [`write_diff`]'s picture as PNG bytes (for the report's page).
+pub(super) fn picture_png(diff: &RevisionDiff) -> Result<Vec<u8>, ReportError> {
+    let (width, height, rgb) = picture(diff);
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder
+        .write_header()
+        .and_then(|mut w| w.write_image_data(&rgb))
+        .map_err(|e| ReportError::Io {
+            path: PathBuf::from("diff.png"),
+            source: std::io::Error::other(e),
+        })?;
+    Ok(bytes)
+}
+
 /// The picture's pixels: each node a square of `scale` pixels (at least
 /// one; small grids enlarged to about 800 pixels across), x to the right,
 /// z up.

@@ -66,6 +66,9 @@ pub(crate) struct Inputs<'a> {
     /// The comparison with a run of the other approach, with the PNG of
     /// each of its figures.
     pub comparison: Option<(&'a Comparison, &'a [Vec<u8>])>,
+    /// The comparison with an earlier revision of the part (`--compare`
+    /// given a run of the same approach), with its picture's PNG.
+    pub revision: Option<(&'a super::diff::RevisionDiff, &'a [u8])>,
 }
 
 /// The version of this build, as the page names it.
@@ -115,6 +118,9 @@ pub(crate) fn document(inputs: &Inputs) -> String {
                     }
                 }
                 "\n"
+                @if let Some((d, png)) = inputs.revision {
+                    (revision_section(d, png))
+                }
                 (result_section(inputs))
                 @if let Some((c, pngs)) = inputs.comparison {
                     (compare_section(run, c, pngs))
@@ -1725,6 +1731,74 @@ fn zones_table(run: &super::run::Run) -> Markup {
             }
             "\n"
         }
+    }
+}
+
+/// What changed from an earlier revision of the part (`report RUN
+/// --compare EARLIER_RUN`, [`super::diff`]): first on the page, since a
+/// designer comparing revisions reads it first.
+fn revision_section(d: &super::diff::RevisionDiff, png: &[u8]) -> Markup {
+    use super::diff::{NodeState, ZoneChange};
+    let cell = d.cell_mm2();
+    let area = |s: NodeState| fmt_num(d.count(s) as f64 * cell);
+    let changed: Vec<&super::diff::ZoneDiff> = d
+        .zones
+        .iter()
+        .filter(|z| z.change != ZoneChange::Unchanged)
+        .collect();
+    let word = |c: ZoneChange| match c {
+        ZoneChange::Appeared => "appeared",
+        ZoneChange::Vanished => "vanished",
+        ZoneChange::Grew => "grew",
+        ZoneChange::Shrank => "shrank",
+        ZoneChange::Unchanged => "unchanged",
+    };
+    let ids = |v: &[usize]| {
+        v.iter()
+            .map(ToString::to_string)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    html! {
+        section id="revision" {
+            "\n"
+            h2 { "Changes from the earlier revision" }
+            "\n"
+            p class="headline" {
+                "Against " code { (d.a_dir.display()) } " (part " code { (d.a.input_file) } "): struck only in the earlier revision "
+                b { (area(NodeState::OnlyA)) " mm" (SUP2) } ", only in this one "
+                b { (area(NodeState::OnlyB)) " mm" (SUP2) } ", in both " (area(NodeState::Both)) " mm" (SUP2)
+                "; " (changed.len()) " zones changed. " (d.mapping) " (the earlier revision's grid, as "
+                code { "kneeform diff" } " compares them)."
+            }
+            "\n"
+            @if !changed.is_empty() {
+                table class="compact" id="revision-table" {
+                    tr { th { "change" } th { "area before (mm" (SUP2) ")" } th { "area now (mm" (SUP2) ")" } th { "change (mm" (SUP2) ")" } th { "around x, z (mm)" } th { "zones before" } th { "zones now" } }
+                    @for z in changed.iter().take(20) {
+                        tr {
+                            td { (word(z.change)) }
+                            td { (fmt_num(z.area_a_mm2)) }
+                            td { (fmt_num(z.area_b_mm2)) }
+                            td { (fmt_num(z.change_mm2)) }
+                            td { (fmt_num(z.centroid_xz[0])) ", " (fmt_num(z.centroid_xz[1])) }
+                            td { (ids(&z.a_zones)) }
+                            td { (ids(&z.b_zones)) }
+                        }
+                    }
+                }
+                "\n"
+            }
+            figure {
+                img class="view" id="revision-view" alt="nodes struck only before, only now, and in both"
+                    src={ "data:image/png;base64," (super::html::base64(png)) };
+                figcaption {
+                    "The earlier revision's grid face on, x to the right and z up, one square per node: orange struck only before, blue only now, purple in both, grey in neither."
+                }
+            }
+            "\n"
+        }
+        "\n"
     }
 }
 

@@ -106,8 +106,20 @@ fn build_report(options: &ReportOptions) -> Result<(String, Report), ReportError
     let masks = run.angle_masks(&angles, angle_bits.as_ref())?;
     let masks: Vec<(f64, NodeCounts)> = angles.into_iter().zip(masks).collect();
     let views = render_views(&run, &masks);
+    // A run of the same approach is another revision of the part: what
+    // changed, on the earlier one's grid; a run of the other approach is
+    // the side-by-side comparison.
+    let revision = match &options.compare {
+        Some(dir) if same_approach(dir, &run)? => {
+            let diff = diff::diff_runs(dir, &options.run_dir)?;
+            let png = diff::picture_png(&diff)?;
+            Some((diff, png))
+        }
+        _ => None,
+    };
     let comparison = match &options.compare {
         None => None,
+        Some(_) if revision.is_some() => None,
         Some(dir) => {
             let other = Run::read(dir, options.part.as_deref())?;
             let comparison = compare::Comparison::new(&run, other)?;
@@ -146,6 +158,7 @@ fn build_report(options: &ReportOptions) -> Result<(String, Report), ReportError
         pngs: &pngs,
         run_figures: &run_figures,
         comparison: comparison.as_ref().map(|(c, pngs)| (c, pngs.as_slice())),
+        revision: revision.as_ref().map(|(d, png)| (d, png.as_slice())),
     });
     let report = Report {
         part_path: run.part_path,
@@ -153,6 +166,22 @@ fn build_report(options: &ReportOptions) -> Result<(String, Report), ReportError
         render_s: views.render_s,
     };
     Ok((html, report))
+}
+
+/// Whether the run in `dir` has `run`'s approach (another revision of the
+/// part, for `--compare`), from its `summary.json`.
+fn same_approach(dir: &Path, run: &Run) -> Result<bool, ReportError> {
+    let path = dir.join(crate::output::SUMMARY_JSON);
+    let text = crate::limits::read_text_bounded(&path).map_err(|source| ReportError::Io {
+        path: path.clone(),
+        source,
+    })?;
+    let other =
+        crate::summary::Summary::from_json(&text).map_err(|e| ReportError::Inconsistent {
+            path: path.clone(),
+            reason: e.to_string(),
+        })?;
+    Ok(other.approach == run.summary.approach)
 }
 
 /// Builds the report and writes it to `out` through a temporary file in the
