@@ -239,7 +239,8 @@ fn the_report_compares_a_direct_run_with_a_slide_run_of_the_same_part() {
     let area: f64 = cells[1].parse().unwrap();
     assert!(nodes >= 37, "{nodes} nodes only push-and-slide strikes");
     assert_eq!(area, nodes as f64 * 64.0);
-    // Two runs of one approach are not a comparison: one line, exit 2.
+    // A run is not compared with itself (two runs of one approach are two
+    // revisions of a part: tests/diff.rs): one line, exit 2.
     let out = kneeform_cli(
         &dir,
         &["report", "slide", "--compare", "slide", "--out", "x.html"],
@@ -247,7 +248,7 @@ fn the_report_compares_a_direct_run_with_a_slide_run_of_the_same_part() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(err.contains("the run's approach"), "{err}");
+    assert!(err.contains("the report's run itself"), "{err}");
 }
 
 #[test]

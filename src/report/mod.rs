@@ -109,6 +109,19 @@ fn build_report(options: &ReportOptions) -> Result<(String, Report), ReportError
     // A run of the same approach is another revision of the part: what
     // changed, on the earlier one's grid; a run of the other approach is
     // the side-by-side comparison.
+    if let Some(dir) = &options.compare {
+        let same = |a: &Path, b: &Path| {
+            std::fs::canonicalize(a)
+                .ok()
+                .is_some_and(|a| std::fs::canonicalize(b).ok() == Some(a))
+        };
+        if same(dir, &options.run_dir) {
+            return Err(ReportError::Inconsistent {
+                path: dir.clone(),
+                reason: "it is the report's run itself: --compare takes another run (an earlier revision of the part, or the other approach)".into(),
+            });
+        }
+    }
     let revision = match &options.compare {
         Some(dir) if same_approach(dir, &run)? => {
             let diff = diff::diff_runs(dir, &options.run_dir)?;
