@@ -166,6 +166,9 @@ pub struct GridFootprint {
     /// The pitch (mm) of the grid it was laid on; the engine and the
     /// harness refuse a footprint of another grid.
     pub pitch: f64,
+    /// The cross-section itself, whose outline the surface level samples
+    /// ([`crate::surface`]).
+    pub shape: Footprint,
     /// Rows sorted by `dj`.
     pub rows: Vec<FootprintRow>,
     /// Indices into `rows`, sorted by `d0` (ties by `dj`).
@@ -207,6 +210,7 @@ impl GridFootprint {
         GridFootprint {
             angle_deg,
             pitch,
+            shape: footprint,
             rows,
             slide_order,
             groups,

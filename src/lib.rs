@@ -67,6 +67,7 @@ pub mod setup;
 pub mod shard;
 pub mod strike;
 pub mod summary;
+mod surface;
 mod zbuffer;
 pub mod zones;
 

@@ -63,6 +63,36 @@ impl RateEstimate {
     }
 }
 
+/// Which level the knee-form's face follows (SPEC v4, "The level follows
+/// the grid's surface"): the nodes only, or the grid's piecewise-linear
+/// surface between them. It travels with the rule, so every run, study
+/// and summary that records the rule records it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Level {
+    /// SPEC's default until the gate holds: the level drops only at the
+    /// nodes the slide meets.
+    #[default]
+    Node,
+    /// The minimum of the grid's surface `S` over the swept footprint,
+    /// evaluated as SPEC v4 says ([`crate::surface`]); window rule only,
+    /// fast algorithm and the slide approach only.
+    Surface,
+}
+
+impl Level {
+    /// Every level, as `--level` offers them.
+    pub const ALL: [Level; 2] = [Level::Node, Level::Surface];
+
+    /// The name, as `--level` takes it and every summary records it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Level::Node => "node",
+            Level::Surface => "surface",
+        }
+    }
+}
+
 /// What the rule reads of one node met by a slide.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Meeting {
@@ -97,6 +127,9 @@ pub struct StrikeRule {
     /// The deflection window `W` (mm, > 0) of [`RateEstimate::Window`].
     #[serde(default = "default_window")]
     pub window: f64,
+    /// The level the face follows (`node` where a file predates it).
+    #[serde(default)]
+    pub level: Level,
 }
 
 fn default_window() -> f64 {
@@ -127,12 +160,18 @@ impl StrikeRule {
             sigma: deflection_deg.to_radians().tan(),
             rate: RateEstimate::default(),
             window: Self::DEFAULT_WINDOW_MM,
+            level: Level::Node,
         }
     }
 
     /// The same rule with the deflection measured by `rate`.
     pub fn with_rate(self, rate: RateEstimate) -> StrikeRule {
         StrikeRule { rate, ..self }
+    }
+
+    /// The same rule with the face following `level`.
+    pub fn with_level(self, level: Level) -> StrikeRule {
+        StrikeRule { level, ..self }
     }
 
     /// The same rule with the deflection window `window` (mm).
@@ -295,6 +334,7 @@ mod tests {
             sigma: 0.1,
             rate: RateEstimate::Window,
             window: 5.0,
+            level: Level::Node,
         };
         assert!(rule.strikes(met(0.0, 0.0, 0.2, 0.6, 1.0)));
         assert!(!rule.strikes(met(0.0, 0.0, 0.2, 0.4, 1.0)));

@@ -220,6 +220,7 @@ fn fast_and_paper_equal_brute_force_at_exact_thresholds() {
         sigma,
         rate,
         window: 4.0,
+        ..StrikeRule::default()
     };
     let rules = [
         rule(0.5, 0.0, RateEstimate::XSlope),

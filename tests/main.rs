@@ -20,6 +20,7 @@ mod resolution;
 mod second_hour;
 mod shard;
 mod standalone;
+mod surface;
 mod util;
 mod verdict;
 mod view3d;

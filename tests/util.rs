@@ -530,3 +530,302 @@ impl Image {
             .collect()
     }
 }
+
+/// A point the surface level evaluates: its value (mm) and where it is
+/// (grid units).
+type Sample = (f64, [f64; 2]);
+
+/// SPEC v4's surface `S` at `(u, w)` in grid units: each closed cell split
+/// along its `(i, j)-(i+1, j+1)` diagonal, `+inf` off the grid or where a
+/// corner is infinite; a point on the last column or row in the cell
+/// before it.
+fn surface_at(grid: &HeightGrid, u: f64, w: f64) -> f64 {
+    let (nx, nz) = (grid.spec.nx, grid.spec.nz);
+    if nx < 2 || nz < 2 || !(u >= 0.0 && w >= 0.0) || u > (nx - 1) as f64 || w > (nz - 1) as f64 {
+        return f64::INFINITY;
+    }
+    let (i, j) = (
+        (u.floor() as usize).min(nx - 2),
+        (w.floor() as usize).min(nz - 2),
+    );
+    let (fx, fz) = (u - i as f64, w - j as f64);
+    let h = |a: usize, b: usize| grid.h[(j + b) * nx + i + a];
+    let (h00, h10, h01, h11) = (h(0, 0), h(1, 0), h(0, 1), h(1, 1));
+    if [h00, h10, h01, h11].iter().any(|v| !v.is_finite()) {
+        return f64::INFINITY;
+    }
+    if fx >= fz {
+        h00 + fx * (h10 - h00) + fz * (h11 - h10)
+    } else {
+        h00 + fz * (h01 - h00) + fx * (h11 - h01)
+    }
+}
+
+/// SPEC v4's tie tolerance at the cell holding `(u, w)`: a quarter of the
+/// largest second difference centred on one of its corners (x, z and
+/// both diagonals, finite ones), capped at a quarter pitch.
+fn surface_tau(grid: &HeightGrid, u: f64, w: f64) -> f64 {
+    let (nx, nz) = (grid.spec.nx as i64, grid.spec.nz as i64);
+    if nx < 2 || nz < 2 || !(u >= 0.0 && w >= 0.0) || u > (nx - 1) as f64 || w > (nz - 1) as f64 {
+        return 0.0;
+    }
+    let (i, j) = (
+        (u.floor() as i64).min(nx - 2),
+        (w.floor() as i64).min(nz - 2),
+    );
+    let h = |a: i64, b: i64| {
+        if (0..nx).contains(&a) && (0..nz).contains(&b) {
+            grid.h[(b * nx + a) as usize]
+        } else {
+            f64::INFINITY
+        }
+    };
+    let mut most = 0.0f64;
+    for (ci, cj) in [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)] {
+        for (di, dj) in [(1, 0), (0, 1), (1, 1), (1, -1)] {
+            let d = h(ci - di, cj - dj) - 2.0 * h(ci, cj) + h(ci + di, cj + dj);
+            if d.is_finite() {
+                most = most.max(d.abs());
+            }
+        }
+    }
+    (most / 4.0).min(0.25 * grid.spec.pitch)
+}
+
+/// The knee-form's outline at `angle_deg` as SPEC v4 samples it, in
+/// pitches from the reference point, `(leading, trailing)`, each by
+/// increasing z: the bottom, every quarter pitch (the rows exactly), the
+/// top, and midpoints in z wherever two samples lie more than a quarter
+/// pitch apart. The outline's ends are the library's `row_interval`: the
+/// samples' positions are the contract's, to the bit.
+pub fn surface_outline(knee: &KneeForm, angle_deg: f64, p: f64) -> [Vec<[f64; 2]>; 2] {
+    let shape = kneeform::Footprint::new(knee, angle_deg);
+    let (z_lo, z_hi) = shape.z_range();
+    let mut dws = vec![z_lo / p];
+    let (m_lo, m_hi) = (
+        (z_lo / p / 0.25).ceil() as i64,
+        (z_hi / p / 0.25).floor() as i64,
+    );
+    for m in m_lo..=m_hi {
+        dws.push(if m % 4 == 0 {
+            (m / 4) as f64
+        } else {
+            m as f64 * 0.25
+        });
+    }
+    dws.push(z_hi / p);
+    dws.dedup();
+    let side = |leading: bool| {
+        let at = |dw: f64| {
+            shape
+                .row_interval(dw * p)
+                .map(|(a, b)| [if leading { a } else { b } / p, dw])
+        };
+        fn fill(
+            at: &dyn Fn(f64) -> Option<[f64; 2]>,
+            a: [f64; 2],
+            b: [f64; 2],
+            out: &mut Vec<[f64; 2]>,
+            depth: u32,
+        ) {
+            if (a[0] - b[0]).hypot(a[1] - b[1]) <= 0.25 || depth >= 20 {
+                return;
+            }
+            if let Some(mid) = at((a[1] + b[1]) / 2.0) {
+                fill(at, a, mid, out, depth + 1);
+                out.push(mid);
+                fill(at, mid, b, out, depth + 1);
+            }
+        }
+        let mut out: Vec<[f64; 2]> = Vec::new();
+        for &dw in &dws {
+            if let Some(here) = at(dw) {
+                if let Some(&before) = out.last() {
+                    fill(&at, before, here, &mut out, 0);
+                }
+                out.push(here);
+            }
+        }
+        out
+    };
+    [side(true), side(false)]
+}
+
+/// SPEC v4's surface level, per start, evaluating everything (no bound,
+/// no early end): the push over the whole outline and the nodes inside;
+/// steps of `p / 8` over the leading outline and the nodes met; the
+/// bisection between witnesses more than `p / 2` apart; the tie set; the
+/// window rule on the level curve; the node nearest each struck witness.
+/// The readings where SPEC leaves a choice are `kneeform`'s
+/// (`src/surface.rs`'s module comment). Returns the mask and the number
+/// of placed starts.
+pub fn brute_force_surface(
+    grid: &HeightGrid,
+    knee: &KneeForm,
+    angle_deg: f64,
+    (e0, sigma, window): (f64, f64, f64),
+) -> (Vec<u8>, usize) {
+    let GridSpec {
+        nx, nz, pitch: p, ..
+    } = grid.spec;
+    let v = triangle(knee, angle_deg);
+    let r = knee.radius;
+    let [lead, trail] = surface_outline(knee, angle_deg, p);
+    let du_max = lead.iter().map(|s| s[0]).fold(f64::NEG_INFINITY, f64::max);
+    let mut mask = vec![0u8; nx * nz];
+    let mut placed = 0;
+    let nearest = |at: [f64; 2]| {
+        let (i, j) = ((at[0] - 0.5).ceil() as usize, (at[1] - 0.5).ceil() as usize);
+        j * nx + i
+    };
+    // The first lowest of `points` (value, where) below `limit`.
+    let lowest = |points: &mut dyn Iterator<Item = Sample>, limit: f64| {
+        let mut best: Option<Sample> = None;
+        for (value, at) in points {
+            if value < limit && best.is_none_or(|b| value < b.0) {
+                best = Some((value, at));
+            }
+        }
+        best
+    };
+    let outline_at = |t: f64, i0: usize, j0: usize| -> Vec<Sample> {
+        let base = i0 as f64 - t / 8.0;
+        lead.iter()
+            .map(|&[du, dw]| {
+                let at = [base + du, j0 as f64 + dw];
+                (surface_at(grid, at[0], at[1]), at)
+            })
+            .collect()
+    };
+    for j0 in 0..nz {
+        for i0 in 0..nx {
+            // The nodes inside and in front, rows by j, each row's nodes
+            // in front by distance.
+            let mut inside: Vec<Sample> = Vec::new();
+            let mut front: Vec<(f64, f64, [f64; 2])> = Vec::new();
+            for j in 0..nz {
+                let dz = (j as f64 - j0 as f64) * p;
+                let Some(a) = row_start(&v, r, dz) else {
+                    continue;
+                };
+                let mut row: Vec<(f64, f64, [f64; 2])> = Vec::new();
+                for i in 0..nx {
+                    let dx = (i as f64 - i0 as f64) * p;
+                    let h = grid.h[j * nx + i];
+                    if distance_to_triangle(&v, dx, dz) <= r + TOL {
+                        inside.push((h, [i as f64, j as f64]));
+                    } else if dx < a {
+                        row.push((a - dx, h, [i as f64, j as f64]));
+                    }
+                }
+                row.sort_by(|x, y| x.0.total_cmp(&y.0));
+                front.extend(row);
+            }
+            let mut push: Vec<Sample> = outline_at(0.0, i0, j0);
+            let base = i0 as f64;
+            push.extend(trail.iter().map(|&[du, dw]| {
+                let at = [base + du, j0 as f64 + dw];
+                (surface_at(grid, at[0], at[1]), at)
+            }));
+            push.extend(inside);
+            let Some((yr, pushed_at)) = lowest(&mut push.into_iter(), f64::INFINITY) else {
+                continue;
+            };
+            placed += 1;
+            let mut f = yr;
+            let mut witness = pushed_at;
+            // (travel, level after) at each fall.
+            let mut after: Vec<(f64, f64)> = Vec::new();
+            // A fall to `value` at travel `t` steps, its witness `at`, the
+            // outline's points there `points`.
+            let mut fall = |t: f64,
+                            value: f64,
+                            at: [f64; 2],
+                            points: &[Sample],
+                            f: &mut f64,
+                            witness: &mut [f64; 2]| {
+                if value >= *f {
+                    return;
+                }
+                let s = t * p / 8.0;
+                if value < *f - e0 {
+                    let back = after
+                        .iter()
+                        .rev()
+                        .find(|&&(u, _)| u <= s - window + TOL)
+                        .map_or(yr, |&(_, level)| level);
+                    if back - value > sigma * window {
+                        mask[nearest(at)] = 1;
+                        for &(pv, pat) in points {
+                            if pv <= value + surface_tau(grid, pat[0], pat[1]) {
+                                mask[nearest(pat)] = 1;
+                            }
+                        }
+                    }
+                    *witness = at;
+                }
+                *f = value;
+                after.push((s, value));
+            };
+            let apart = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]) > 0.5;
+            front.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let mut cursor = 0;
+            let mut k = 0u64;
+            loop {
+                k += 1;
+                let t = k as f64;
+                let s = t * p / 8.0;
+                if base - t / 8.0 + du_max < 0.0 && cursor == front.len() {
+                    break;
+                }
+                let points = outline_at(t, i0, j0);
+                let mut here: Vec<Sample> = points.clone();
+                // The nodes met by this step, rows by j, each by distance.
+                let first = cursor;
+                while cursor < front.len() && front[cursor].0 <= s + TOL {
+                    cursor += 1;
+                }
+                let mut met = front[first..cursor].to_vec();
+                met.sort_by(|x, y| x.2[1].total_cmp(&y.2[1]).then(x.0.total_cmp(&y.0)));
+                here.extend(met.iter().map(|n| (n.1, n.2)));
+                let Some((value, at)) = lowest(&mut here.into_iter(), f64::INFINITY) else {
+                    continue;
+                };
+                if value < f - e0 && apart(witness, at) {
+                    // Bisection, midpoints applied in travel order.
+                    let (f0, w_lo) = (f, witness);
+                    fn halves(
+                        (lo, hi): (f64, f64),
+                        (w_lo, w_hi): ([f64; 2], [f64; 2]),
+                        depth: u32,
+                        eval: &mut dyn FnMut(f64) -> (Vec<Sample>, Option<Sample>),
+                        apply: &mut dyn FnMut(f64, Sample, &[Sample]),
+                    ) {
+                        if depth >= 5 || (w_lo[0] - w_hi[0]).hypot(w_lo[1] - w_hi[1]) <= 0.5 {
+                            return;
+                        }
+                        let mid = (lo + hi) / 2.0;
+                        let (points, low) = eval(mid);
+                        let w_mid = low.map_or(w_lo, |l| l.1);
+                        halves((lo, mid), (w_lo, w_mid), depth + 1, eval, apply);
+                        if let Some(low) = low {
+                            apply(mid, low, &points);
+                        }
+                        halves((mid, hi), (w_mid, w_hi), depth + 1, eval, apply);
+                    }
+                    let mut eval = |mid: f64| {
+                        let points = outline_at(mid, i0, j0);
+                        let low = lowest(&mut points.clone().into_iter(), f0);
+                        (points, low)
+                    };
+                    let mut apply = |mid: f64, (value, at): Sample, pts: &[Sample]| {
+                        fall(mid, value, at, pts, &mut f, &mut witness);
+                    };
+                    halves((t - 1.0, t), (w_lo, at), 0, &mut eval, &mut apply);
+                }
+                fall(t, value, at, &points, &mut f, &mut witness);
+            }
+        }
+    }
+    (mask, placed)
+}

@@ -9,7 +9,8 @@
 use crate::grid::HeightGrid;
 use crate::grid::NODE_TOL;
 use crate::kneeform::GridFootprint;
-use crate::strike::{LevelHistory, Meeting, StrikeRule};
+use crate::strike::{Level, LevelHistory, Meeting, StrikeRule};
+use crate::surface::{SurfaceFootprint, SurfaceGrid};
 
 /// A deliberate mistake in the grid side of a comparison, for the tests
 /// that show the harness catches a broken engine. Crate-private: no
@@ -175,6 +176,9 @@ fn slide(
             front: spec.x(i0) + f64::from(row.kf) * p + row.d0,
         })
         .collect();
+    if rule.level == Level::Surface {
+        return surface_slide(grid, fp, (i0, j0), rule, push_rows);
+    }
     let short = |r: &crate::kneeform::FootprintRow| {
         fault == Some(Fault::FootprintRowShort) && Some(r.dj) == leading
     };
@@ -296,6 +300,36 @@ fn slide(
         k = end;
     }
     trace
+}
+
+/// [`slide`] under the surface level (SPEC v4): [`crate::surface::trace`]
+/// alone, with no fault and no neighbour joined (its bisections follow the
+/// start's own contacts, so two starts' curves need not agree once they
+/// meet), each strike at the node nearest its witness.
+fn surface_slide(
+    grid: &HeightGrid,
+    fp: &GridFootprint,
+    (i0, j0): (usize, usize),
+    rule: &StrikeRule,
+    push_rows: Vec<FootprintSpan>,
+) -> GridTrace {
+    let spec = grid.spec;
+    let surface = SurfaceGrid::new(grid);
+    let trace = crate::surface::trace(&surface, &SurfaceFootprint::new(fp), (i0, j0), rule);
+    GridTrace {
+        yr: trace.yr,
+        colliding: trace
+            .strikes
+            .iter()
+            .map(|&((i, j), travel)| GridContact {
+                node: (i, j),
+                point: [spec.x(i), grid.at(i, j), spec.z(j)],
+                travel,
+            })
+            .collect(),
+        push_rows,
+        levels: trace.levels,
+    }
 }
 
 /// Completes `trace`, slid on its own up to the tie group at travel `s`

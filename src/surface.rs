@@ -1,0 +1,605 @@
+//! SPEC v4, "The level follows the grid's surface": the grid's
+//! piecewise-linear surface `S` ([`SurfaceGrid`]), the knee-form's outline
+//! as the surface level samples it ([`SurfaceFootprint`]), and one start's
+//! push and slide on `S` ([`trace`]).
+//!
+//! `S` interpolates the node heights linearly on the two triangles of each
+//! closed cell `[x_i, x_i+1] x [z_j, z_j+1]`, split along its diagonal from
+//! `(i, j)` to `(i+1, j+1)`; a cell with a node of infinite height has no
+//! surface (`+inf`). Positions are in grid units (`u = (x - x_0) / p`,
+//! `w = (z - z_0) / p`), so a start's samples at travel `s_k = k p / 8`
+//! sit at `u = (i0 - k / 8) + du`, the same position, to the bit, for
+//! every start that reaches it.
+//!
+//! **The evaluation, as SPEC v4 writes it, with the readings where it
+//! leaves a choice:**
+//!
+//! * the outline is sampled at every `p / 4` in z (which holds the rows'
+//!   exact crossings), at its top and bottom, and between two samples more
+//!   than `p / 4` apart at the midpoint in z, recursively (the outline runs
+//!   steeply near its top and bottom);
+//! * the **push** evaluates the nodes inside and the whole outline, leading
+//!   (`a(dz)`) and trailing (`b(dz)`): `yr` is their minimum, its witness
+//!   the first lowest point in the order leading, trailing, nodes;
+//! * each **step** `k >= 1` evaluates the leading outline at `s_k`, then
+//!   the nodes met in `(s_{k-1}, s_k]` (a node at distance `d` is met when
+//!   `d <= s_k + 1e-9`), rows by `dj`, each row's nodes by distance; the
+//!   level falls to the step's minimum; a fall of more than `e0` is a
+//!   **contact**, its witness the first lowest point in that order;
+//! * **bisection**: when a step's contact witness lies more than `p / 2`
+//!   from the previous contact's (the push's for the first), the travel
+//!   between the step before and this one is bisected, at most 5 levels:
+//!   a midpoint evaluates the leading outline only; its witness is its
+//!   first lowest point below the level `f0` held before the step (the
+//!   left end's witness where none is below it); a half is bisected only
+//!   while its end witnesses are more than `p / 2` apart; midpoints are
+//!   applied in travel order, each fall of more than `e0` a contact;
+//! * **ties**: a contact that strikes marks, beside its witness, every
+//!   outline point of the same travel whose value is within `tau` of the
+//!   new level, `tau` read at that point's own cell ([`SurfaceGrid::tau`]);
+//! * **strike**: SPEC's window rule on this level curve, through
+//!   [`StrikeRule::window_strikes`] with the new level as `h` (whatever the
+//!   rule's rate: the surface level has the window rule only);
+//! * the mask holds the node nearest each struck witness (a tie to the
+//!   smaller `i`, then the smaller `j`).
+//!
+//! [`trace`] skips work where it provably changes nothing: a run of
+//! [`BLOCK`] outline samples is not evaluated while a lower bound of every
+//! node its cells read ([`SurfaceGrid::bound`]) is at or above the level
+//! (the level only falls), and the slide ends once such a bound of
+//! everything still ahead is. `tests/surface.rs` holds it equal to a
+//! brute force transcribed from SPEC that evaluates everything.
+
+use crate::grid::{HeightGrid, NODE_TOL};
+use crate::kneeform::GridFootprint;
+use crate::strike::{LevelHistory, StrikeRule};
+
+/// Steps per pitch: the travels `s_k = k p / 8`.
+pub(crate) const STEPS_PER_PITCH: f64 = 8.0;
+/// Outline samples per pitch, in z and at most apart along the outline.
+const SAMPLES_PER_PITCH: f64 = 4.0;
+/// Witnesses further apart than this (pitches) call for a bisection.
+const BISECT_APART: f64 = 0.5;
+/// Bisection levels.
+const BISECT_DEPTH: u32 = 5;
+/// Outline samples per run that [`trace`] skips as one.
+pub(crate) const BLOCK: usize = 16;
+/// Nodes per side of the blocks whose minima bound the surface.
+const COARSE: usize = 4;
+/// The largest `tau`, in pitches.
+const TAU_CAP: f64 = 0.25;
+
+/// The grid's surface `S`, with the block minima that bound it.
+#[derive(Debug)]
+pub(crate) struct SurfaceGrid<'a> {
+    grid: &'a HeightGrid,
+    /// Minimum finite height per block of `COARSE x COARSE` nodes.
+    coarse: Vec<f64>,
+    /// Blocks per coarse row.
+    cnx: usize,
+    /// Per coarse row, the prefix minimum of `coarse` along it.
+    prefix: Vec<f64>,
+}
+
+impl<'a> SurfaceGrid<'a> {
+    /// The surface of `grid`.
+    pub fn new(grid: &'a HeightGrid) -> SurfaceGrid<'a> {
+        let (nx, nz) = (grid.spec.nx, grid.spec.nz);
+        let cnx = nx.div_ceil(COARSE).max(1);
+        let cnz = nz.div_ceil(COARSE).max(1);
+        let mut coarse = vec![f64::INFINITY; cnx * cnz];
+        for j in 0..nz {
+            for i in 0..nx {
+                let c = &mut coarse[(j / COARSE) * cnx + i / COARSE];
+                *c = c.min(grid.at(i, j));
+            }
+        }
+        let mut prefix = coarse.clone();
+        for row in prefix.chunks_exact_mut(cnx) {
+            for b in 1..cnx {
+                row[b] = row[b].min(row[b - 1]);
+            }
+        }
+        SurfaceGrid {
+            grid,
+            coarse,
+            cnx,
+            prefix,
+        }
+    }
+
+    /// The cell `(i, j)` holding `(u, w)` and the position in it, or
+    /// `None` off the grid. A point on the last column or row belongs to
+    /// the cell before it.
+    #[inline(always)]
+    fn cell(&self, u: f64, w: f64) -> Option<(usize, usize, f64, f64)> {
+        let (nx, nz) = (self.grid.spec.nx, self.grid.spec.nz);
+        if nx < 2 || nz < 2 || !(u >= 0.0 && w >= 0.0) {
+            return None;
+        }
+        if u > (nx - 1) as f64 || w > (nz - 1) as f64 {
+            return None;
+        }
+        let i = (u.floor() as usize).min(nx - 2);
+        let j = (w.floor() as usize).min(nz - 2);
+        Some((i, j, u - i as f64, w - j as f64))
+    }
+
+    /// `S` at `(u, w)` (grid units): `+inf` off the grid and on a cell
+    /// with a node of infinite height.
+    #[inline(always)]
+    pub fn at(&self, u: f64, w: f64) -> f64 {
+        let Some((i, j, fx, fz)) = self.cell(u, w) else {
+            return f64::INFINITY;
+        };
+        let nx = self.grid.spec.nx;
+        let h = &self.grid.h;
+        let n = j * nx + i;
+        let (h00, h10, h01, h11) = (h[n], h[n + 1], h[n + nx], h[n + nx + 1]);
+        if !(h00.is_finite() && h10.is_finite() && h01.is_finite() && h11.is_finite()) {
+            return f64::INFINITY;
+        }
+        if fx >= fz {
+            h00 + fx * (h10 - h00) + fz * (h11 - h10)
+        } else {
+            h00 + fz * (h01 - h00) + fx * (h11 - h01)
+        }
+    }
+
+    /// A bound of `S`'s interpolation error at the cell holding `(u, w)`
+    /// (mm): a quarter of the largest second difference of the heights
+    /// (along x, z and both diagonals) centred on one of the cell's
+    /// corners, at most `p / 4`. A second difference is `p^2 h''` on a
+    /// smooth surface (the interpolation error is about `p^2 |h''| / 8`,
+    /// so this is twice it) and `p |delta g|` across a crease (the error
+    /// is `p |delta g| / 4`). Where the heights are all equal it is 0.
+    pub fn tau(&self, u: f64, w: f64) -> f64 {
+        let Some((i, j, _, _)) = self.cell(u, w) else {
+            return 0.0;
+        };
+        let (nx, nz) = (self.grid.spec.nx as i64, self.grid.spec.nz as i64);
+        let h = |i: i64, j: i64| {
+            if (0..nx).contains(&i) && (0..nz).contains(&j) {
+                self.grid.at(i as usize, j as usize)
+            } else {
+                f64::INFINITY
+            }
+        };
+        let mut second = 0.0f64;
+        for (ci, cj) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            let (ci, cj) = (i as i64 + ci, j as i64 + cj);
+            for (di, dj) in [(1, 0), (0, 1), (1, 1), (1, -1)] {
+                let d = h(ci - di, cj - dj) - 2.0 * h(ci, cj) + h(ci + di, cj + dj);
+                if d.is_finite() {
+                    second = second.max(d.abs());
+                }
+            }
+        }
+        (second / 4.0).min(TAU_CAP * self.grid.spec.pitch)
+    }
+
+    /// A lower bound of `S` at every point of the cells in columns
+    /// `c_lo..=c_hi` and rows `w_lo..=w_hi` (grid units): the least height
+    /// of their nodes, read from the block minima (`+inf` off the grid),
+    /// less a margin for rounding.
+    #[inline]
+    pub fn bound(&self, (c_lo, c_hi): (i64, i64), (w_lo, w_hi): (f64, f64)) -> f64 {
+        let (nx, nz) = (self.grid.spec.nx as i64, self.grid.spec.nz as f64);
+        if c_hi < 0 || c_lo > nx - 1 || w_hi < 0.0 || w_lo > nz - 1.0 {
+            return f64::INFINITY;
+        }
+        let column = |c: i64| (c.clamp(0, nx - 1) as usize) / COARSE;
+        let row = |v: f64| (v.max(0.0).min(nz - 1.0) as usize) / COARSE;
+        let (b_lo, b_hi) = (column(c_lo), column(c_hi));
+        let (r_lo, r_hi) = (row(w_lo.floor()), row(w_hi.floor() + 1.0));
+        let mut least = f64::INFINITY;
+        for r in r_lo..=r_hi {
+            for &c in &self.coarse[r * self.cnx + b_lo..=r * self.cnx + b_hi] {
+                least = least.min(c);
+            }
+        }
+        below(least)
+    }
+
+    /// [`SurfaceGrid::bound`] of every node in columns `0..=u_hi` and rows
+    /// `w_lo..=w_hi` (grid units).
+    pub fn bound_before(&self, u_hi: f64, (w_lo, w_hi): (f64, f64)) -> f64 {
+        let (nx, nz) = (self.grid.spec.nx as f64, self.grid.spec.nz as f64);
+        if u_hi < 0.0 || w_hi < 0.0 || w_lo > nz - 1.0 {
+            return f64::INFINITY;
+        }
+        let clip = |v: f64, n: f64| (v.max(0.0).min(n - 1.0) as usize) / COARSE;
+        let b = clip(u_hi.floor() + 1.0, nx);
+        let (r_lo, r_hi) = (clip(w_lo.floor(), nz), clip(w_hi.floor() + 1.0, nz));
+        let mut least = f64::INFINITY;
+        for r in r_lo..=r_hi {
+            least = least.min(self.prefix[r * self.cnx + b]);
+        }
+        below(least)
+    }
+}
+
+/// A value a little below `v`, by more than the rounding of an
+/// interpolation between heights of its size.
+#[inline(always)]
+fn below(v: f64) -> f64 {
+    if v.is_finite() {
+        v - 1e-9 * (1.0 + v.abs())
+    } else {
+        v
+    }
+}
+
+/// The knee-form's outline at one angle as the surface level samples it,
+/// and the footprint's rows on the grid.
+#[derive(Debug, Clone)]
+pub(crate) struct SurfaceFootprint {
+    /// The leading outline `(a(dz) / p, dz / p)`, by increasing `dz`.
+    pub lead: Vec<[f64; 2]>,
+    /// The trailing outline `(b(dz) / p, dz / p)`, by increasing `dz`.
+    pub trail: Vec<[f64; 2]>,
+    /// Runs of [`BLOCK`] leading samples: the range and its extent
+    /// `(du_lo, du_hi, dw_lo, dw_hi)`.
+    pub blocks: Vec<(std::ops::Range<usize>, [f64; 4])>,
+    /// The extent of the leading outline, `(du_max, dw_lo, dw_hi)`.
+    pub extent: (f64, f64, f64),
+    /// The footprint's rows: `(dj, klo, khi, kf, d0)`, by `dj`.
+    pub rows: Vec<(i32, i32, i32, i32, f64)>,
+    /// The pitch (mm).
+    pub pitch: f64,
+}
+
+impl SurfaceFootprint {
+    /// The outline of `fp`'s shape, sampled as SPEC v4 says.
+    pub fn new(fp: &GridFootprint) -> SurfaceFootprint {
+        let p = fp.pitch;
+        let shape = &fp.shape;
+        let (z_lo, z_hi) = shape.z_range();
+        let step = 1.0 / SAMPLES_PER_PITCH;
+        let m_lo = (z_lo / p / step).ceil() as i64;
+        let m_hi = (z_hi / p / step).floor() as i64;
+        // dz / p: the bottom, the lattice of p / 4 (rows exactly), the top.
+        let mut dws = vec![z_lo / p];
+        dws.extend((m_lo..=m_hi).map(|m| {
+            if m % 4 == 0 {
+                (m / 4) as f64
+            } else {
+                m as f64 * step
+            }
+        }));
+        dws.push(z_hi / p);
+        dws.dedup();
+        let side = |pick: fn((f64, f64)) -> f64| -> Vec<[f64; 2]> {
+            let at = |dw: f64| shape.row_interval(dw * p).map(|iv| [pick(iv) / p, dw]);
+            let mut out: Vec<[f64; 2]> = Vec::new();
+            let mut prev: Option<[f64; 2]> = None;
+            for &dw in &dws {
+                let Some(here) = at(dw) else { continue };
+                if let Some(before) = prev {
+                    refine(&at, before, here, &mut out, 0);
+                }
+                out.push(here);
+                prev = Some(here);
+            }
+            out
+        };
+        let lead = side(|iv| iv.0);
+        let trail = side(|iv| iv.1);
+        let blocks = (0..lead.len())
+            .step_by(BLOCK)
+            .map(|lo| {
+                let hi = (lo + BLOCK).min(lead.len());
+                let mut e = [
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                ];
+                for &[du, dw] in &lead[lo..hi] {
+                    e = [e[0].min(du), e[1].max(du), e[2].min(dw), e[3].max(dw)];
+                }
+                (lo..hi, e)
+            })
+            .collect();
+        let extent = lead.iter().fold(
+            (f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY),
+            |(u, lo, hi), &[du, dw]| (u.max(du), lo.min(dw), hi.max(dw)),
+        );
+        SurfaceFootprint {
+            lead,
+            trail,
+            blocks,
+            extent,
+            rows: fp
+                .rows
+                .iter()
+                .map(|r| (r.dj, r.klo, r.khi, r.kf, r.d0))
+                .collect(),
+            pitch: p,
+        }
+    }
+}
+
+/// Inserts, in z order, the outline samples between `a` and `b` (grid
+/// units) that keep consecutive ones at most `p / 4` apart: the midpoint
+/// in z, recursively (at most 20 levels).
+fn refine(
+    at: &impl Fn(f64) -> Option<[f64; 2]>,
+    a: [f64; 2],
+    b: [f64; 2],
+    out: &mut Vec<[f64; 2]>,
+    depth: u32,
+) {
+    let apart = (a[0] - b[0]).hypot(a[1] - b[1]);
+    if apart <= 1.0 / SAMPLES_PER_PITCH || depth >= 20 {
+        return;
+    }
+    let Some(mid) = at((a[1] + b[1]) / 2.0) else {
+        return;
+    };
+    refine(at, a, mid, out, depth + 1);
+    out.push(mid);
+    refine(at, mid, b, out, depth + 1);
+}
+
+/// One start's push and slide on the surface.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct SurfaceTrace {
+    /// The pushed level (mm), `+inf` when not placed.
+    pub yr: f64,
+    /// Each struck node `(i, j)` with the travel (mm) of its strike, in
+    /// travel order (a node may recur).
+    pub strikes: Vec<((usize, usize), f64)>,
+    /// `(travel, level)` after each evaluation that lowered the level.
+    pub levels: Vec<(f64, f64)>,
+}
+
+/// A point evaluated: its value and where it is (grid units).
+#[derive(Debug, Clone, Copy)]
+struct Point {
+    value: f64,
+    at: [f64; 2],
+}
+
+/// The first lowest of the points handed in.
+#[derive(Debug, Clone, Copy)]
+struct Lowest(Option<Point>);
+
+impl Lowest {
+    #[inline(always)]
+    fn take(&mut self, value: f64, at: [f64; 2]) {
+        if value < self.0.map_or(f64::INFINITY, |p| p.value) {
+            self.0 = Some(Point { value, at });
+        }
+    }
+}
+
+/// The slide's state.
+struct Slide<'s, 'g> {
+    sg: &'s SurfaceGrid<'g>,
+    sf: &'s SurfaceFootprint,
+    rule: &'s StrikeRule,
+    i0: f64,
+    j0: f64,
+    f: f64,
+    witness: [f64; 2],
+    history: LevelHistory,
+    out: SurfaceTrace,
+    /// Per block: the columns its bound was read for, and the bound.
+    cached: Vec<(i64, f64)>,
+}
+
+/// The columns whose cells the samples of a run with extent `e` read
+/// when the outline's reference sits at `base` (grid units): a function
+/// of the first column alone, so that a bound read for it holds while it
+/// stays.
+fn columns(base: f64, e: &[f64; 4]) -> (i64, i64) {
+    let first = (base + e[0]).floor() as i64;
+    (first, first + (e[1] - e[0]).ceil() as i64 + 2)
+}
+
+/// Whether two witnesses lie more than `p / 2` apart.
+fn apart(a: [f64; 2], b: [f64; 2]) -> bool {
+    (a[0] - b[0]).hypot(a[1] - b[1]) > BISECT_APART
+}
+
+/// The node nearest `(u, w)` (a tie to the smaller index).
+fn nearest(at: [f64; 2]) -> (usize, usize) {
+    ((at[0] - 0.5).ceil() as usize, (at[1] - 0.5).ceil() as usize)
+}
+
+impl Slide<'_, '_> {
+    /// The leading outline at travel `t` steps: its first lowest point
+    /// below `limit`, skipping runs whose bound is at or above it.
+    fn lowest_below(&mut self, t: f64, limit: f64) -> Lowest {
+        let base = self.i0 - t / STEPS_PER_PITCH;
+        let mut lowest = Lowest(None);
+        for (b, (range, e)) in self.sf.blocks.iter().enumerate() {
+            let cols = columns(base, e);
+            if self.cached[b].0 != cols.0 {
+                let bound = self.sg.bound(cols, (self.j0 + e[2], self.j0 + e[3]));
+                self.cached[b] = (cols.0, bound);
+            }
+            if self.cached[b].1 >= limit {
+                continue;
+            }
+            for &[du, dw] in &self.sf.lead[range.clone()] {
+                let at = [base + du, self.j0 + dw];
+                let value = self.sg.at(at[0], at[1]);
+                if value < limit {
+                    lowest.take(value, at);
+                }
+            }
+        }
+        lowest
+    }
+
+    /// A fall of the level to `value` at travel `t` steps, its witness
+    /// `at`: a contact when by more than `e0`, judged and marked.
+    fn fall(&mut self, t: f64, value: f64, at: [f64; 2]) {
+        if value >= self.f {
+            return;
+        }
+        let p = self.sf.pitch;
+        let s = t * p / STEPS_PER_PITCH;
+        let before = self.f;
+        if self.rule.is_contact(value, before) {
+            let earlier = self.history.earlier(s, self.rule.window);
+            if self.rule.window_strikes(value, earlier) {
+                self.out.strikes.push((nearest(at), s));
+                self.ties(t, s, value, at);
+            }
+            self.witness = at;
+        }
+        self.f = value;
+        self.history.push(s, value);
+        self.out.levels.push((s, value));
+    }
+
+    /// Marks the leading outline's points at travel `t` steps (`s` mm)
+    /// within `tau` of the new level `level`, beside the witness `at`.
+    fn ties(&mut self, t: f64, s: f64, level: f64, at: [f64; 2]) {
+        let base = self.i0 - t / STEPS_PER_PITCH;
+        let reach = level + TAU_CAP * self.sf.pitch;
+        for (range, e) in &self.sf.blocks {
+            let bound = self
+                .sg
+                .bound(columns(base, e), (self.j0 + e[2], self.j0 + e[3]));
+            if bound > reach {
+                continue;
+            }
+            for &[du, dw] in &self.sf.lead[range.clone()] {
+                let here = [base + du, self.j0 + dw];
+                let value = self.sg.at(here[0], here[1]);
+                if here != at && value <= level + self.sg.tau(here[0], here[1]) {
+                    self.out.strikes.push((nearest(here), s));
+                }
+            }
+        }
+    }
+
+    /// SPEC v4's bisection of the travel between `lo` and `hi` steps, the
+    /// witnesses at its ends `w_lo` and `w_hi`, `f0` the level before the
+    /// step at `hi`.
+    fn bisect(
+        &mut self,
+        (lo, hi): (f64, f64),
+        (w_lo, w_hi): ([f64; 2], [f64; 2]),
+        f0: f64,
+        depth: u32,
+    ) {
+        if depth >= BISECT_DEPTH || !apart(w_lo, w_hi) {
+            return;
+        }
+        let mid = (lo + hi) / 2.0;
+        let lowest = self.lowest_below(mid, f0);
+        let w_mid = lowest.0.map_or(w_lo, |p| p.at);
+        self.bisect((lo, mid), (w_lo, w_mid), f0, depth + 1);
+        if let Some(point) = lowest.0 {
+            self.fall(mid, point.value, point.at);
+        }
+        self.bisect((mid, hi), (w_mid, w_hi), f0, depth + 1);
+    }
+}
+
+/// SPEC v4's push and slide of the start at node `(i0, j0)` on the
+/// surface of `sg`, its outline `sf`, under `rule` (whose window is read;
+/// its rate and level are not).
+pub(crate) fn trace(
+    sg: &SurfaceGrid,
+    sf: &SurfaceFootprint,
+    (i0, j0): (usize, usize),
+    rule: &StrikeRule,
+) -> SurfaceTrace {
+    let grid = sg.grid;
+    let (nx, nz) = (grid.spec.nx as i64, grid.spec.nz as i64);
+    let p = sf.pitch;
+    let (u0, w0) = (i0 as f64, j0 as f64);
+    // The push: the whole outline, then the nodes inside.
+    let mut push = Lowest(None);
+    for &[du, dw] in sf.lead.iter().chain(&sf.trail) {
+        let at = [u0 + du, w0 + dw];
+        push.take(sg.at(at[0], at[1]), at);
+    }
+    // Per row on the grid: its row, the column of its first node in
+    // front, its d0.
+    let mut rows: Vec<(usize, i64, f64)> = Vec::with_capacity(sf.rows.len());
+    for &(dj, klo, khi, kf, d0) in &sf.rows {
+        let j = j0 as i64 + i64::from(dj);
+        if !(0..nz).contains(&j) {
+            continue;
+        }
+        for k in klo..=khi {
+            let i = i0 as i64 + i64::from(k);
+            if (0..nx).contains(&i) {
+                push.take(grid.at(i as usize, j as usize), [i as f64, j as f64]);
+            }
+        }
+        rows.push((j as usize, i0 as i64 + i64::from(kf), d0));
+    }
+    let Some(pushed) = push.0 else {
+        return SurfaceTrace {
+            yr: f64::INFINITY,
+            ..SurfaceTrace::default()
+        };
+    };
+    let mut slide = Slide {
+        sg,
+        sf,
+        rule,
+        i0: u0,
+        j0: w0,
+        f: pushed.value,
+        witness: pushed.at,
+        history: LevelHistory::new(pushed.value),
+        out: SurfaceTrace {
+            yr: pushed.value,
+            ..SurfaceTrace::default()
+        },
+        cached: vec![(i64::MIN, 0.0); sf.blocks.len()],
+    };
+    // Nodes met so far per row.
+    let mut met = vec![0i64; rows.len()];
+    let (du_max, dw_lo, dw_hi) = sf.extent;
+    let rows_span = (w0 + dw_lo, w0 + dw_hi);
+    let mut k = 0u64;
+    loop {
+        k += 1;
+        let t = k as f64;
+        let s = t * p / STEPS_PER_PITCH;
+        // The furthest column anything still ahead can read.
+        let outline_at = u0 - t / STEPS_PER_PITCH + du_max;
+        let node_at = rows
+            .iter()
+            .zip(&met)
+            .map(|(r, m)| r.1 - m)
+            .max()
+            .unwrap_or(-1);
+        if outline_at < 0.0 && node_at < 0 {
+            break;
+        }
+        if sg.bound_before(outline_at.max(node_at as f64), rows_span) >= slide.f {
+            break;
+        }
+        let mut step = slide.lowest_below(t, slide.f);
+        for ((j, first, d0), m) in rows.iter().zip(&mut met) {
+            loop {
+                let i = first - *m;
+                if i < 0 || d0 + *m as f64 * p > s + NODE_TOL {
+                    break;
+                }
+                if i < nx {
+                    step.take(grid.at(i as usize, *j), [i as f64, *j as f64]);
+                }
+                *m += 1;
+            }
+        }
+        let Some(point) = step.0 else { continue };
+        if rule.is_contact(point.value, slide.f) && apart(slide.witness, point.at) {
+            let (f0, w_lo) = (slide.f, slide.witness);
+            slide.bisect((t - 1.0, t), (w_lo, point.at), f0, 0);
+        }
+        slide.fall(t, point.value, point.at);
+    }
+    slide.out
+}
