@@ -490,6 +490,7 @@ impl Analysis {
             sigma: setup.rule.sigma,
             e0_mm: setup.rule.e0,
             rate: setup.rule.rate.name().into(),
+            level: setup.rule.level,
             window_mm: setup.rule.window_mm(),
             algorithm: setup.algorithm,
             approach: setup.approach,

@@ -15,7 +15,7 @@ use crate::kneeform::{Footprint, GridFootprint, KneeForm};
 use crate::limits::{self, short};
 use crate::memory::MemoryEstimate;
 use crate::mesh::{Bbox, Part, Triangle};
-use crate::strike::StrikeRule;
+use crate::strike::{Level, RateEstimate, StrikeRule};
 
 /// Where the grid lies.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -130,6 +130,11 @@ pub enum SetupError {
     /// `MAX_GRID_NODES`.
     #[error("the grid size must be from 1,1 to {} nodes in all, got {},{}", crate::limits::MAX_GRID_NODES, .0[0], .0[1])]
     GridSize([usize; 2]),
+    /// The surface level asked with what it has no form for: the x-slope
+    /// rate, the paper-literal algorithm or the direct approach (the
+    /// reason, in words).
+    #[error("the surface level {0}")]
+    Level(&'static str),
 }
 
 impl SetupError {
@@ -146,6 +151,7 @@ impl SetupError {
             SetupError::E0(_) => "e0",
             SetupError::GridOrigin(_) => "grid_origin",
             SetupError::GridSize(_) => "grid_size",
+            SetupError::Level(_) => "level",
         }
     }
 }
@@ -216,6 +222,23 @@ impl Setup {
         if self.rule.window_mm().is_some() {
             let longest = limits::MAX_WINDOW_MM.min(limits::MAX_WINDOW_PITCHES * self.pitch);
             within("window", self.rule.window, limits::MIN_PITCH_MM, longest)?;
+        }
+        if self.rule.level == Level::Surface {
+            if self.rule.rate != RateEstimate::Window {
+                return Err(SetupError::Level(
+                    "takes --rate window only (the x-slope rule reads the node behind a node)",
+                ));
+            }
+            if self.algorithm != Algorithm::Fast {
+                return Err(SetupError::Level(
+                    "has no paper-literal form: use --algorithm fast",
+                ));
+            }
+            if self.approach != Approach::Slide {
+                return Err(SetupError::Level(
+                    "applies to --approach slide only (the direct approach's erosion is per node)",
+                ));
+            }
         }
         if let GridPlacement::Explicit { origin, size } = self.grid {
             if !origin

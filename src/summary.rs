@@ -140,6 +140,10 @@ pub struct Summary {
     /// SPEC's rule: the level's drop over the last `window_mm` of travel)
     /// or `x-slope` (the rise from the node one pitch behind it).
     pub rate: String,
+    /// The level the knee-form's face follows: `node` or `surface`
+    /// (SPEC v4). `node` in runs of earlier versions.
+    #[serde(default)]
+    pub level: crate::strike::Level,
     /// The deflection window `W` (mm) of the `window` rule; absent under
     /// `x-slope` and in runs of earlier versions (which had no window).
     #[serde(default, skip_serializing_if = "Option::is_none")]

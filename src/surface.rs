@@ -23,15 +23,17 @@
 //!   the first lowest point in the order leading, trailing, nodes;
 //! * each **step** `k >= 1` evaluates the leading outline at `s_k`, then
 //!   the nodes met in `(s_{k-1}, s_k]` (a node at distance `d` is met when
-//!   `d <= s_k + 1e-9`), rows by `dj`, each row's nodes by distance; the
-//!   level falls to the step's minimum; a fall of more than `e0` is a
-//!   **contact**, its witness the first lowest point in that order;
+//!   `d <= s_k + 1e-9`), rows by `dj`; a step whose minimum lies more
+//!   than `e0` below the level is a **contact**, its witness the first
+//!   lowest point in that order, and the level falls to it; a smaller
+//!   fall is rounding and leaves the level (SPEC's `e0`: so a plate at
+//!   the level is skipped, not evaluated at every step);
 //! * **bisection**: when a step's contact witness lies more than `p / 2`
 //!   from the previous contact's (the push's for the first), the travel
 //!   between the step before and this one is bisected, at most 5 levels:
 //!   a midpoint evaluates the leading outline only; its witness is its
-//!   first lowest point below the level `f0` held before the step (the
-//!   left end's witness where none is below it); a half is bisected only
+//!   first lowest point more than `e0` below the level `f0` held before
+//!   the step (the left end's witness where none is); a half is bisected only
 //!   while its end witnesses are more than `p / 2` apart; midpoints are
 //!   applied in travel order, each fall of more than `e0` a contact;
 //! * **ties**: a contact that strikes marks, beside its witness, every
@@ -46,8 +48,8 @@
 //! [`trace`] skips work where it provably changes nothing: a run of
 //! [`BLOCK`] outline samples is not evaluated while a lower bound of every
 //! node its cells read ([`SurfaceGrid::bound`]) is at or above the level
-//! (the level only falls), and the slide ends once such a bound of
-//! everything still ahead is. `tests/surface.rs` holds it equal to a
+//! less `e0` (the level only falls), and the slide ends once such a bound
+//! of everything still ahead is. `tests/surface.rs` holds it equal to a
 //! brute force transcribed from SPEC that evaluates everything.
 
 use crate::grid::{HeightGrid, NODE_TOL};
@@ -245,6 +247,9 @@ pub(crate) struct SurfaceFootprint {
     pub extent: (f64, f64, f64),
     /// The footprint's rows: `(dj, klo, khi, kf, d0)`, by `dj`.
     pub rows: Vec<(i32, i32, i32, i32, f64)>,
+    /// Indices into `rows` in the order the slide meets their first nodes
+    /// in front (by `d0`, then `dj`).
+    pub slide_order: Vec<u32>,
     /// The pitch (mm).
     pub pitch: f64,
 }
@@ -315,6 +320,7 @@ impl SurfaceFootprint {
                 .iter()
                 .map(|r| (r.dj, r.klo, r.khi, r.kf, r.d0))
                 .collect(),
+            slide_order: fp.slide_order.clone(),
             pitch: p,
         }
     }
@@ -434,23 +440,22 @@ impl Slide<'_, '_> {
         lowest
     }
 
-    /// A fall of the level to `value` at travel `t` steps, its witness
-    /// `at`: a contact when by more than `e0`, judged and marked.
+    /// The level's fall to `value` at travel `t` steps, its witness `at`,
+    /// where it falls by more than `e0` (a contact): judged and marked. A
+    /// smaller fall is rounding and leaves the level as it is.
     fn fall(&mut self, t: f64, value: f64, at: [f64; 2]) {
-        if value >= self.f {
+        let before = self.f;
+        if !self.rule.is_contact(value, before) {
             return;
         }
         let p = self.sf.pitch;
         let s = t * p / STEPS_PER_PITCH;
-        let before = self.f;
-        if self.rule.is_contact(value, before) {
-            let earlier = self.history.earlier(s, self.rule.window);
-            if self.rule.window_strikes(value, earlier) {
-                self.out.strikes.push((nearest(at), s));
-                self.ties(t, s, value, at);
-            }
-            self.witness = at;
+        let earlier = self.history.earlier(s, self.rule.window);
+        if self.rule.window_strikes(value, earlier) {
+            self.out.strikes.push((nearest(at), s));
+            self.ties(t, s, value, at);
         }
+        self.witness = at;
         self.f = value;
         self.history.push(s, value);
         self.out.levels.push((s, value));
@@ -492,7 +497,7 @@ impl Slide<'_, '_> {
             return;
         }
         let mid = (lo + hi) / 2.0;
-        let lowest = self.lowest_below(mid, f0);
+        let lowest = self.lowest_below(mid, f0 - self.rule.e0);
         let w_mid = lowest.0.map_or(w_lo, |p| p.at);
         self.bisect((lo, mid), (w_lo, w_mid), f0, depth + 1);
         if let Some(point) = lowest.0 {
@@ -521,22 +526,31 @@ pub(crate) fn trace(
         let at = [u0 + du, w0 + dw];
         push.take(sg.at(at[0], at[1]), at);
     }
-    // Per row on the grid: its row, the column of its first node in
-    // front, its d0.
-    let mut rows: Vec<(usize, i64, f64)> = Vec::with_capacity(sf.rows.len());
-    for &(dj, klo, khi, kf, d0) in &sf.rows {
+    // Per row on the grid, in the slide's order: its row and the column
+    // of its first node in front, its d0.
+    let push_rows = sf.rows.iter().filter_map(|&(dj, klo, khi, _, _)| {
         let j = j0 as i64 + i64::from(dj);
-        if !(0..nz).contains(&j) {
-            continue;
-        }
+        (0..nz).contains(&j).then_some((j as usize, klo, khi))
+    });
+    for (j, klo, khi) in push_rows {
         for k in klo..=khi {
             let i = i0 as i64 + i64::from(k);
             if (0..nx).contains(&i) {
-                push.take(grid.at(i as usize, j as usize), [i as f64, j as f64]);
+                push.take(grid.at(i as usize, j), [i as f64, j as f64]);
             }
         }
-        rows.push((j as usize, i0 as i64 + i64::from(kf), d0));
     }
+    let rows: Vec<(usize, i64, f64)> = sf
+        .slide_order
+        .iter()
+        .map(|&r| sf.rows[r as usize])
+        .filter_map(|(dj, _, _, kf, d0)| {
+            let j = j0 as i64 + i64::from(dj);
+            (0..nz)
+                .contains(&j)
+                .then_some((j as usize, i0 as i64 + i64::from(kf), d0))
+        })
+        .collect();
     let Some(pushed) = push.0 else {
         return SurfaceTrace {
             yr: f64::INFINITY,
@@ -558,10 +572,14 @@ pub(crate) fn trace(
         },
         cached: vec![(i64::MIN, 0.0); sf.blocks.len()],
     };
-    // Nodes met so far per row.
-    let mut met = vec![0i64; rows.len()];
+    // The nodes in front as one stream by distance: layer `layer` (the
+    // `layer`-th node in front of each row), rows in the slide's order;
+    // `next` the next row of the layer.
+    let (mut layer, mut next) = (0i64, 0usize);
+    let first_most = rows.iter().map(|r| r.1).max().unwrap_or(-1);
     let (du_max, dw_lo, dw_hi) = sf.extent;
     let rows_span = (w0 + dw_lo, w0 + dw_hi);
+    let mut met: Vec<(usize, f64, [f64; 2])> = Vec::new();
     let mut k = 0u64;
     loop {
         k += 1;
@@ -569,30 +587,35 @@ pub(crate) fn trace(
         let s = t * p / STEPS_PER_PITCH;
         // The furthest column anything still ahead can read.
         let outline_at = u0 - t / STEPS_PER_PITCH + du_max;
-        let node_at = rows
-            .iter()
-            .zip(&met)
-            .map(|(r, m)| r.1 - m)
-            .max()
-            .unwrap_or(-1);
+        let node_at = first_most - layer;
         if outline_at < 0.0 && node_at < 0 {
             break;
         }
-        if sg.bound_before(outline_at.max(node_at as f64), rows_span) >= slide.f {
+        let floor = slide.f - rule.e0;
+        if sg.bound_before(outline_at.max(node_at as f64), rows_span) >= floor {
             break;
         }
-        let mut step = slide.lowest_below(t, slide.f);
-        for ((j, first, d0), m) in rows.iter().zip(&mut met) {
-            loop {
-                let i = first - *m;
-                if i < 0 || d0 + *m as f64 * p > s + NODE_TOL {
-                    break;
-                }
-                if i < nx {
-                    step.take(grid.at(i as usize, *j), [i as f64, *j as f64]);
-                }
-                *m += 1;
+        let mut step = slide.lowest_below(t, floor);
+        // The nodes met by this step, rows by j (one per row at most: a
+        // step is shorter than a pitch).
+        met.clear();
+        while first_most - layer >= 0 && !rows.is_empty() {
+            let (j, first, d0) = rows[next];
+            if d0 + layer as f64 * p > s + NODE_TOL {
+                break;
             }
+            let i = first - layer;
+            if (0..nx).contains(&i) {
+                met.push((j, grid.at(i as usize, j), [i as f64, j as f64]));
+            }
+            next += 1;
+            if next == rows.len() {
+                (next, layer) = (0, layer + 1);
+            }
+        }
+        met.sort_by_key(|m| m.0);
+        for &(_, value, at) in &met {
+            step.take(value, at);
         }
         let Some(point) = step.0 else { continue };
         if rule.is_contact(point.value, slide.f) && apart(slide.witness, point.at) {

@@ -75,3 +75,85 @@ fn the_surface_level_equals_brute_force_on_rough_grids() {
 fn the_surface_level_equals_brute_force_on_gentle_grids() {
     check(0.7, 0.001);
 }
+
+/// `--level surface` end to end: `analyze` and `verify` record the level
+/// they ran (`node` by default) and the surface level strikes otherwise
+/// than the node level on the bump; asked with what it has no form for
+/// (`--rate x-slope`, `--algorithm paper`, `--approach direct`) it is
+/// refused in one line naming `--level`.
+#[test]
+fn the_level_is_a_flag_recorded_by_every_run_and_refused_where_it_has_no_form() {
+    let dir = crate::util::scratch_dir("surface-level-cli");
+    let bump = crate::util::scenario("bump");
+    let small = [
+        "--pitch",
+        "4",
+        "--angles=-10,0",
+        "--triangle-side",
+        "40",
+        "--radius",
+        "12",
+    ];
+    let out = |name: &str| dir.join(name).display().to_string();
+    let analyze = |level: &str| {
+        let o = out(&format!("analyze-{level}"));
+        let mut args = vec![
+            "analyze",
+            bump.as_str(),
+            "--out",
+            o.as_str(),
+            "--level",
+            level,
+        ];
+        args.extend(small);
+        crate::util::ok(crate::cli::kneeform(&args), "analyze");
+        let text = std::fs::read_to_string(dir.join(format!("analyze-{level}/summary.json")))
+            .expect("summary.json");
+        serde_json::from_str::<serde_json::Value>(&text).expect("JSON")
+    };
+    let (node, surface) = (analyze("node"), analyze("surface"));
+    assert_eq!(node["level"], "node");
+    assert_eq!(surface["level"], "surface");
+    assert_ne!(
+        node["per_angle"], surface["per_angle"],
+        "the level changed no strike"
+    );
+    let v = out("verify");
+    let mut args = vec![
+        "verify",
+        bump.as_str(),
+        "--out",
+        v.as_str(),
+        "--level",
+        "surface",
+        "--starts",
+        "6",
+        "--tolerance",
+        "10",
+    ];
+    args.extend(small);
+    let verify = crate::cli::kneeform(&args);
+    assert!(
+        matches!(verify.status.code(), Some(0 | 1)),
+        "{}",
+        String::from_utf8_lossy(&verify.stderr)
+    );
+    let text = std::fs::read_to_string(dir.join("verify/verify.json")).expect("verify.json");
+    let json: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+    assert_eq!(json["level"], "surface", "{text}");
+    for (flag, value) in [
+        ("--rate", "x-slope"),
+        ("--algorithm", "paper"),
+        ("--approach", "direct"),
+    ] {
+        let o = out("refused");
+        let mut args = vec!["analyze", bump.as_str(), "--out", o.as_str()];
+        args.extend(small);
+        args.extend(["--level", "surface", flag, value]);
+        let run = crate::cli::kneeform(&args);
+        crate::cli::assert_clean_failure(&run, &dir.join("refused"), flag);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(stderr.contains("--level"), "{flag}: {stderr}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

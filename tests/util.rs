@@ -653,7 +653,8 @@ pub fn surface_outline(knee: &KneeForm, angle_deg: f64, p: f64) -> [Vec<[f64; 2]
 
 /// SPEC v4's surface level, per start, evaluating everything (no bound,
 /// no early end): the push over the whole outline and the nodes inside;
-/// steps of `p / 8` over the leading outline and the nodes met; the
+/// steps of `p / 8` over the leading outline and the nodes met (a fall
+/// of more than `e0` a contact, a smaller one leaving the level); the
 /// bisection between witnesses more than `p / 2` apart; the tie set; the
 /// window rule on the level curve; the node nearest each struck witness.
 /// The readings where SPEC leaves a choice are `kneeform`'s
@@ -744,26 +745,26 @@ pub fn brute_force_surface(
                             points: &[Sample],
                             f: &mut f64,
                             witness: &mut [f64; 2]| {
-                if value >= *f {
+                // Only a contact moves the level: a fall of at most e0
+                // is rounding.
+                if value >= *f - e0 {
                     return;
                 }
                 let s = t * p / 8.0;
-                if value < *f - e0 {
-                    let back = after
-                        .iter()
-                        .rev()
-                        .find(|&&(u, _)| u <= s - window + TOL)
-                        .map_or(yr, |&(_, level)| level);
-                    if back - value > sigma * window {
-                        mask[nearest(at)] = 1;
-                        for &(pv, pat) in points {
-                            if pv <= value + surface_tau(grid, pat[0], pat[1]) {
-                                mask[nearest(pat)] = 1;
-                            }
+                let back = after
+                    .iter()
+                    .rev()
+                    .find(|&&(u, _)| u <= s - window + TOL)
+                    .map_or(yr, |&(_, level)| level);
+                if back - value > sigma * window {
+                    mask[nearest(at)] = 1;
+                    for &(pv, pat) in points {
+                        if pv <= value + surface_tau(grid, pat[0], pat[1]) {
+                            mask[nearest(pat)] = 1;
                         }
                     }
-                    *witness = at;
                 }
+                *witness = at;
                 *f = value;
                 after.push((s, value));
             };
@@ -815,7 +816,7 @@ pub fn brute_force_surface(
                     }
                     let mut eval = |mid: f64| {
                         let points = outline_at(mid, i0, j0);
-                        let low = lowest(&mut points.clone().into_iter(), f0);
+                        let low = lowest(&mut points.clone().into_iter(), f0 - e0);
                         (points, low)
                     };
                     let mut apply = |mid: f64, (value, at): Sample, pts: &[Sample]| {

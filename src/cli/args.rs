@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, ensure};
 use clap::{Args, Parser, Subcommand};
-use kneeform::strike::RateEstimate;
+use kneeform::strike::{Level, RateEstimate};
 use kneeform::{
     Algorithm, Approach, Frame, GridPlacement, KneeForm, PartSource, Placement, Setup, SetupError,
     Side, StrikeRule,
@@ -198,6 +198,20 @@ pub struct SetupArgs {
     /// is measured. A fixed length, independent of the pitch.
     #[arg(long, default_value_t = StrikeRule::DEFAULT_WINDOW_MM, value_name = "MM")]
     pub window: f64,
+    /// Which level the knee-form's face follows as it slides (SPEC v4):
+    /// `node` (default: the level drops only at the grid's nodes, so
+    /// between them it rides too deep) or `surface` (the grid's
+    /// piecewise-linear surface between the nodes; each strike at the node
+    /// nearest where it touched). `surface` takes `--rate window`,
+    /// `--algorithm fast` and `--approach slide` only, and has no streaming
+    /// form yet: an analysis takes minutes per angle on a console.
+    #[arg(
+        long,
+        default_value = "node",
+        value_name = "LEVEL",
+        value_parser = one_of(&Level::ALL, Level::name)
+    )]
+    pub level: Level,
     /// Grid origin X,Z (mm), snapped to multiples of the pitch. Default: the
     /// part's xz bounding box grown by the knee-form's extent.
     #[arg(
@@ -679,7 +693,8 @@ impl SetupArgs {
             angles: parse_angles(&self.angles.angles)?,
             rule: StrikeRule::new(self.deflection, self.e0)
                 .with_rate(self.rate)
-                .with_window(self.window),
+                .with_window(self.window)
+                .with_level(self.level),
             grid,
             algorithm: self.algorithm,
             max_memory_bytes: self.max_memory * f64::from(1u32 << 30),

@@ -142,6 +142,9 @@ pub struct ConvergeSummary {
     pub sigma: f64,
     /// `window` or `x-slope` (`summary.json`'s `rate`).
     pub rate: String,
+    /// The level the grid's knee-form follows (`summary.json`'s `level`).
+    #[serde(default)]
+    pub level: crate::strike::Level,
     /// The deflection window (mm) of the `window` rule (`summary.json`'s
     /// `window_mm`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -537,6 +540,7 @@ impl ConvergeSummary {
             ],
             sigma: setup.rule.sigma,
             rate: setup.rule.rate.name().into(),
+            level: setup.rule.level,
             window_mm: setup.rule.window_mm(),
             pitches_mm: options.pitches.clone(),
             fits: Default::default(),

@@ -512,6 +512,53 @@ mod tests {
         }
     }
 
+    /// Under the surface level too, the union of the per-start traces is
+    /// the engine's mask, and it is not the node level's.
+    #[test]
+    fn union_of_surface_start_traces_is_the_engine_mask() {
+        let spec = GridSpec {
+            pitch: 2.0,
+            i_origin: -10,
+            j_origin: -5,
+            nx: 50,
+            nz: 24,
+        };
+        let grid = HeightGrid::from_fn(spec, |x, z| {
+            0.15 * x + 4.0 * (0.11 * x).sin() * (0.07 * z).cos()
+        });
+        let knee = KneeForm {
+            triangle_side: 20.0,
+            radius: 6.0,
+            thickness: 100.0,
+        };
+        let rule = StrikeRule::default().with_level(Level::Surface);
+        for angle in [-30.0, 12.0] {
+            let fp = GridFootprint::new(&knee, angle, &spec);
+            let mut union = vec![0u8; spec.len()];
+            for j0 in 0..spec.nz {
+                for i0 in 0..spec.nx {
+                    for c in grid_trace(&grid, &fp, i0, j0, &rule, None).colliding {
+                        union[c.node.1 * spec.nx + c.node.0] = 1;
+                    }
+                }
+            }
+            let options = EngineOptions {
+                rule,
+                ..EngineOptions::default()
+            };
+            let masks = colliding_masks(&grid, std::slice::from_ref(&fp), &options, &|| {});
+            assert_eq!(masks[0].mask, union, "angle {angle}");
+            assert!(masks[0].colliding > 0);
+            let node = colliding_masks(
+                &grid,
+                std::slice::from_ref(&fp),
+                &EngineOptions::default(),
+                &|| {},
+            );
+            assert_ne!(node[0].mask, union, "angle {angle}");
+        }
+    }
+
     /// A start's trace joined to its -x neighbour's is its trace alone, to
     /// the bit: every start of every row, at angles and pitches where the
     /// level curves join at once, late and never, both rate rules.

@@ -323,6 +323,7 @@ impl VerifySummary {
             sigma: setup.rule.sigma,
             e0_mm: setup.rule.e0,
             rate: setup.rule.rate.name().into(),
+            level: setup.rule.level,
             window_mm: setup.rule.window_mm(),
             tie_band: comparison.band,
             tie_band_rule: tie_band_rule(options.tie_band_per_mm, setup.rule.window_mm()),
@@ -599,6 +600,10 @@ pub struct VerifySummary {
     pub e0_mm: f64,
     /// How the grid's deflection is measured (`window` or `x-slope`).
     pub rate: String,
+    /// The level the grid's knee-form follows: `node` or `surface`
+    /// (SPEC v4); `node` in files of earlier versions.
+    #[serde(default)]
+    pub level: crate::strike::Level,
     /// The deflection window (mm) of the `window` rule.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub window_mm: Option<f64>,

@@ -131,12 +131,13 @@ impl Verification {
 /// `converge.json` alike: today's contact tolerance and the deflection
 /// rule's parameters. A key present in one file must be in the other, with
 /// the same value.
-pub const STRIKE_RULE_KEYS: [&str; 6] = [
+pub const STRIKE_RULE_KEYS: [&str; 7] = [
     "eps_mm",
     "deflection_deg",
     "sigma",
     "e0_mm",
     "rate",
+    "level",
     "window_mm",
 ];
 
