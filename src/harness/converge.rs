@@ -550,7 +550,11 @@ impl ConvergeSummary {
             angles_deg: setup.angles.clone(),
             deflection_deg: setup.rule.deflection_deg(),
             e0_mm: setup.rule.e0,
-            tie_band_rule: tie_band_rule(options.tie_band_per_mm, setup.rule.window_mm()),
+            tie_band_rule: tie_band_rule(
+                options.tie_band_per_mm,
+                setup.rule.window_mm(),
+                setup.rule.level,
+            ),
             starts,
             seconds: Vec::new(),
             verdicts: Vec::new(),

@@ -201,9 +201,21 @@ pub(crate) enum ExactRule {
     /// short by more than that error plus the bound of the grid's level
     /// error `W` back (SPEC, "Ties at the threshold"). Both terms come from
     /// the grid's cells ([`LevelErrorBound`]) and shrink with the pitch.
+    ///
+    /// **Under the surface level** (SPEC v4) the grid's level error goes
+    /// both ways: the surface cuts above a convex crease between nodes (the
+    /// level too deep, as the node level's) and may lie below the part
+    /// elsewhere, and the grid judges the surface near the touched point,
+    /// not a node. So the band is two-sided (`two_sided`): each side is
+    /// widened by both terms, the lowest near node's rise and the level
+    /// error's bound `W` back. Both terms are the node level's measured
+    /// bounds from the mesh's cells; a bound of the surface lying below a
+    /// concave part between nodes is not measured yet.
     Window {
         /// `W` (mm).
         window: f64,
+        /// Whether the grid's error goes both ways (the surface level).
+        two_sided: bool,
     },
 }
 
@@ -211,7 +223,10 @@ impl ExactRule {
     /// The exact side of `rule`.
     pub fn of(rule: &crate::strike::StrikeRule) -> ExactRule {
         match rule.window_mm() {
-            Some(window) => ExactRule::Window { window },
+            Some(window) => ExactRule::Window {
+                window,
+                two_sided: rule.level == crate::strike::Level::Surface,
+            },
             None => ExactRule::Rate,
         }
     }
@@ -234,6 +249,32 @@ pub(crate) struct ExactStrike {
     pub decision: Decision,
 }
 
+/// The window rule's decision of an exact contact whose `drop` is known
+/// to within `error`, against `threshold` (`sigma W`), the grid's drop
+/// short of the exact one by up to `node` (the lowest near node's rise)
+/// and beyond it by up to `grid` (the level error's bound `W` back); under
+/// the surface level (`two_sided`) either error may move it either way,
+/// so each side takes both ([`ExactRule::Window`]).
+fn decide_drop(
+    (drop, error): (f64, f64),
+    threshold: f64,
+    (node, grid): (f64, f64),
+    two_sided: bool,
+) -> Decision {
+    let (short, beyond) = if two_sided {
+        (node + grid, node + grid)
+    } else {
+        (node, grid)
+    };
+    if drop - error - short > threshold {
+        Decision::Strike
+    } else if drop + error + beyond < threshold {
+        Decision::NoStrike
+    } else {
+        Decision::Undecided
+    }
+}
+
 /// The exact contacts of a placed start with their standing by `rule`,
 /// against the grid's level error `bound` along it.
 fn classify(
@@ -253,7 +294,7 @@ fn classify(
                 strike: c.rate > band.sigma,
                 decision: band.decide(c.rate, c.rate_error),
             },
-            ExactRule::Window { window, .. } => {
+            ExactRule::Window { window, two_sided } => {
                 let drop = curve.drop_at(k, window, JUMP_TOLERANCE);
                 let grid = bound.at(c.travel - window);
                 // The grid judges the nodes near the touched point, the
@@ -264,13 +305,12 @@ fn classify(
                 ExactStrike {
                     contact: c,
                     strike: drop.drop > threshold,
-                    decision: if drop.drop - drop.error - node > threshold {
-                        Decision::Strike
-                    } else if drop.drop + drop.error + grid < threshold {
-                        Decision::NoStrike
-                    } else {
-                        Decision::Undecided
-                    },
+                    decision: decide_drop(
+                        (drop.drop, drop.error),
+                        threshold,
+                        (node, grid),
+                        two_sided,
+                    ),
                 }
             }
         })
@@ -959,6 +999,24 @@ pub(crate) fn compare(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_surface_levels_band_is_two_sided() {
+        // Threshold 0.044, error 0.001, near node's rise 0.002, level
+        // error W back 0.02.
+        let decide = |drop, two_sided| decide_drop((drop, 0.001), 0.044, (0.002, 0.02), two_sided);
+        // Beyond the threshold by more than error + rise, within the
+        // level error: decided under the node level (its level is only
+        // ever too deep), not under the surface level.
+        assert_eq!(decide(0.05, false), Decision::Strike);
+        assert_eq!(decide(0.05, true), Decision::Undecided);
+        assert_eq!(decide(0.07, true), Decision::Strike);
+        // Short of it by more than error + level error but less than that
+        // plus the rise: the same, mirrored.
+        assert_eq!(decide(0.0215, false), Decision::NoStrike);
+        assert_eq!(decide(0.0215, true), Decision::Undecided);
+        assert_eq!(decide(0.01, true), Decision::NoStrike);
+    }
 
     #[test]
     fn stats_use_absolute_values_and_nearest_rank() {

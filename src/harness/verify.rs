@@ -20,6 +20,7 @@ use crate::input::PartFile;
 use crate::kneeform::{GridFootprint, KneeForm};
 use crate::mesh::Triangle;
 use crate::setup::{GIB, Setup};
+use crate::strike::Level;
 use crate::summary::Outcome;
 
 /// How to verify, beside the analysis [`Setup`].
@@ -126,10 +127,16 @@ pub fn sampling_tolerance(pitch: f64) -> f64 {
 /// The tie band's rule in words, for the summaries: under the window rule
 /// (`window_mm`) the drop's band ([`super::metrics::ExactRule::Window`]),
 /// under x-slope the rate's ([`TieBand`]).
-pub(crate) fn tie_band_rule(per_mm: f64, window_mm: Option<f64>) -> String {
+pub(crate) fn tie_band_rule(per_mm: f64, window_mm: Option<f64>, level: Level) -> String {
+    let both = match level {
+        Level::Node => "",
+        Level::Surface => {
+            "; under --level surface the grid's error goes both ways, so each side of the band is widened by both terms (the near node's rise and the level error's bound) (a bound of the surface lying below a concave part between nodes is not measured yet)"
+        }
+    };
     match window_mm {
         Some(w) => format!(
-            "an exact contact is a decided strike when its drop over the last {w} mm exceeds sigma x {w} mm by more than its stated error plus how far the lowest node within sqrt 2 pitches of the touched point that the slide met by sqrt 2 pitches more of travel lies above it (the grid judges those nodes; none: undecided), a decided non-strike when it falls short by more than its error plus the bound of the grid's level error {w} mm back (the exact level's fall over the pitch before that travel plus the rise of the surface within sqrt 2 pitches of the exact contacts in force, unbounded where the slide met no node that near: the grid's level is deeper by at most that, which only ever adds strikes), undecided otherwise; a grid strike whose node lies within that bound of touching the exact knee-form, and whose drop the bound can explain, is the level error's (a false alarm on the safe side); disagreements from the exact knee-form's first touch of a flagged blind spot on are blind"
+            "an exact contact is a decided strike when its drop over the last {w} mm exceeds sigma x {w} mm by more than its stated error plus how far the lowest node within sqrt 2 pitches of the touched point that the slide met by sqrt 2 pitches more of travel lies above it (the grid judges those nodes; none: undecided), a decided non-strike when it falls short by more than its error plus the bound of the grid's level error {w} mm back (the exact level's fall over the pitch before that travel plus the rise of the surface within sqrt 2 pitches of the exact contacts in force, unbounded where the slide met no node that near: the grid's level is deeper by at most that, which only ever adds strikes), undecided otherwise; a grid strike whose node lies within that bound of touching the exact knee-form, and whose drop the bound can explain, is the level error's (a false alarm on the safe side); disagreements from the exact knee-form's first touch of a flagged blind spot on are blind{both}"
         ),
         None => format!(
             "an exact contact is undecided when its deflection rate, widened by its rate_error, overlaps [sigma / (1 + m), sigma * (1 + m)] with m = {per_mm} x pitch (mm)"
@@ -326,7 +333,11 @@ impl VerifySummary {
             level: setup.rule.level,
             window_mm: setup.rule.window_mm(),
             tie_band: comparison.band,
-            tie_band_rule: tie_band_rule(options.tie_band_per_mm, setup.rule.window_mm()),
+            tie_band_rule: tie_band_rule(
+                options.tie_band_per_mm,
+                setup.rule.window_mm(),
+                setup.rule.level,
+            ),
             area_distance_decided_mm: None,
             area_distance_mm: None,
             area_miss_decided_mm: None,
