@@ -33,12 +33,16 @@
 //!   between the step before and this one is bisected, at most 5 levels:
 //!   a midpoint evaluates the leading outline only; its witness is its
 //!   first lowest point more than `e0` below the level `f0` held before
-//!   the step (the left end's witness where none is); a half is bisected only
-//!   while its end witnesses are more than `p / 2` apart; midpoints are
+//!   the step (the left end's witness where none is); a half is bisected
+//!   only while its end witnesses are more than `p / 2` apart; midpoints are
 //!   applied in travel order, each fall of more than `e0` a contact;
 //! * **ties**: a contact that strikes marks, beside its witness, every
 //!   outline point of the same travel whose value is within `tau` of the
-//!   new level, `tau` read at that point's own cell ([`SurfaceGrid::tau`]);
+//!   new level, `tau` read at that point's own cell ([`SurfaceGrid::tau`]:
+//!   a quarter of the largest second difference there, at most `p / 4`).
+//!   SPEC reads `tau` at the witness's cell; read there, a crease's `tau`
+//!   would tie every point of a flat plate beside it within that much of
+//!   the level (a SPEC change proposed);
 //! * **strike**: SPEC's window rule on this level curve, through
 //!   [`StrikeRule::window_strikes`] with the new level as `h` (whatever the
 //!   rule's rate: the surface level has the window rule only);
