@@ -204,7 +204,7 @@ pub struct SetupArgs {
     /// piecewise-linear surface between the nodes; each strike at the node
     /// nearest where it touched). `surface` takes `--rate window`,
     /// `--algorithm fast` and `--approach slide` only, and has no streaming
-    /// form yet: an analysis takes minutes per angle on a console.
+    /// form yet: an analysis takes minutes or more per angle on a console.
     #[arg(
         long,
         default_value = "node",
