@@ -133,8 +133,9 @@ fn the_level_is_a_flag_recorded_by_every_run_and_refused_where_it_has_no_form() 
     ];
     args.extend(small);
     let verify = crate::cli::kneeform(&args);
+    // A study written: PASS, FAIL or INCONCLUSIVE (scattered starts are).
     assert!(
-        matches!(verify.status.code(), Some(0 | 1)),
+        matches!(verify.status.code(), Some(0 | 1 | 3)),
         "{}",
         String::from_utf8_lossy(&verify.stderr)
     );
