@@ -167,7 +167,7 @@ pub struct GridFootprint {
     /// harness refuse a footprint of another grid.
     pub pitch: f64,
     /// The cross-section itself, whose outline the surface level samples
-    /// ([`crate::surface`]).
+    /// (the crate's `surface` module).
     pub shape: Footprint,
     /// Rows sorted by `dj`.
     pub rows: Vec<FootprintRow>,

@@ -75,7 +75,7 @@ pub enum Level {
     #[default]
     Node,
     /// The minimum of the grid's surface `S` over the swept footprint,
-    /// evaluated as SPEC v4 says ([`crate::surface`]); window rule only,
+    /// evaluated as SPEC v4 says (the crate's `surface` module); window rule only,
     /// fast algorithm and the slide approach only.
     Surface,
 }
