@@ -5,7 +5,7 @@
 //! **One grid, A's.** The two runs may differ in part, pitch or extent, so
 //! B is mapped onto A's grid: each node of A takes the largest composite
 //! count of B's nodes whose cell (half B's pitch either way in x and z)
-//! holds it, the report's painting rule ([`NodeCounts::at`]). A node of A
+//! holds it, the report's painting rule (`NodeCounts::at`). A node of A
 //! outside B's grid is not struck by B. Where B is finer, a node of A is
 //! struck by B when any B node of its cell is; where B is coarser, each
 //! B node stands for its whole cell. The runs must agree on what was
@@ -27,7 +27,7 @@ use crate::grid::GridSpec;
 use crate::summary::Summary;
 
 use super::error::ReportError;
-use super::run::{GridAxes, NodeCounts, read_composite, run_frame};
+use super::run::RunTables;
 
 /// The `summary.json` keys two compared runs must agree on: what the
 /// knee-form is, how a strike is decided, where the part is and which
@@ -136,8 +136,18 @@ impl RevisionDiff {
 /// Reads the runs in `a_dir` and `b_dir` (`analyze` output directories:
 /// `summary.json`, `composite.csv`) and compares them on A's grid.
 pub fn diff_runs(a_dir: &Path, b_dir: &Path) -> Result<RevisionDiff, ReportError> {
-    let (a, a_json, a_counts) = read_run(a_dir)?;
-    let (b, b_json, b_counts) = read_run(b_dir)?;
+    let RunTables {
+        summary: a,
+        json: a_json,
+        composite: a_counts,
+        ..
+    } = RunTables::read(a_dir)?;
+    let RunTables {
+        summary: b,
+        json: b_json,
+        composite: b_counts,
+        ..
+    } = RunTables::read(b_dir)?;
     for key in SAME_KEYS {
         if a_json.get(key) != b_json.get(key) {
             return Err(ReportError::Inconsistent {
@@ -190,35 +200,6 @@ pub fn diff_runs(a_dir: &Path, b_dir: &Path) -> Result<RevisionDiff, ReportError
 /// A JSON value as a message shows it ("absent" for none).
 fn shown(v: Option<&serde_json::Value>) -> String {
     v.map_or_else(|| "absent".into(), ToString::to_string)
-}
-
-/// A run's summary (typed and as written) and composite counts.
-fn read_run(dir: &Path) -> Result<(Summary, serde_json::Value, NodeCounts), ReportError> {
-    let path = dir.join(crate::output::SUMMARY_JSON);
-    let text = crate::limits::read_text_bounded(&path).map_err(|source| ReportError::Io {
-        path: path.clone(),
-        source,
-    })?;
-    let json: serde_json::Value =
-        serde_json::from_str(&text).map_err(|source| ReportError::Json {
-            path: path.clone(),
-            source,
-        })?;
-    let summary = Summary::from_json(&text).map_err(|e| ReportError::Inconsistent {
-        path: path.clone(),
-        reason: e.to_string(),
-    })?;
-    let spec = super::run::grid_spec(&summary).ok_or_else(|| ReportError::Inconsistent {
-        path: path.clone(),
-        reason: "its grid origin, size and pitch do not describe a grid".into(),
-    })?;
-    let frame = run_frame(&summary, &path)?;
-    let axes = GridAxes {
-        approach: summary.approach,
-        side: summary.side,
-    };
-    let counts = read_composite(&dir.join("composite.csv"), spec, &frame, axes)?;
-    Ok((summary, json, counts))
 }
 
 /// The zone groups of `a` and `b` (counts on one grid, `spec`).
@@ -433,19 +414,12 @@ pub fn write_diff(dir: &Path, diff: &RevisionDiff) -> Result<(), ReportError> {
     .map_err(|e| io(path.clone())(e.into()))?;
 
     let path = dir.join(DIFF_FILES[3]);
-    let (width, height, rgb) = picture(diff);
-    let file = std::fs::File::create(&path).map_err(io(path.clone()))?;
-    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), width, height);
-    encoder.set_color(png::ColorType::Rgb);
-    encoder.set_depth(png::BitDepth::Eight);
-    encoder
-        .write_header()
-        .and_then(|mut w| w.write_image_data(&rgb))
-        .map_err(|e| io(path.clone())(std::io::Error::other(e)))?;
+    std::fs::write(&path, picture_png(diff)?).map_err(io(path.clone()))?;
     Ok(())
 }
 
-/// [`write_diff`]'s picture as PNG bytes (for the report's page).
+/// [`write_diff`]'s picture as PNG bytes (`diff.png`, and the report's
+/// page).
 pub(super) fn picture_png(diff: &RevisionDiff) -> Result<Vec<u8>, ReportError> {
     let (width, height, rgb) = picture(diff);
     let mut bytes = Vec::new();

@@ -609,6 +609,18 @@ fn image_tag(figure: &Figure, png: &[u8], id: &str, class: &str, mapping: bool) 
     }
 }
 
+/// The sign of the face-on view's horizontal axis: the picture's column
+/// coordinate grows with `sign` times the horizontal coordinate (x for
+/// push-and-slide, y for the direct approach), mirrored when the camera
+/// looks from the other side.
+fn horizontal_sign(view: &super::render::View) -> f64 {
+    if view.camera.right[0] + view.camera.right[1] < 0.0 {
+        -1.0
+    } else {
+        1.0
+    }
+}
+
 /// The main image's axes: mm ticks on its lower and left edges, drawn
 /// over the image (an SVG of the image's pixel size laid on it; its
 /// labels reach out into the wrapper's margin), so they scale with it.
@@ -617,11 +629,7 @@ fn image_tag(figure: &Figure, png: &[u8], id: &str, class: &str, mapping: bool) 
 /// x runs leftwards).
 fn axes_svg(view: &super::render::View, horizontal: &str) -> Markup {
     let (w, h) = (view.width as f64, view.height as f64);
-    let sign = if view.camera.right[0] + view.camera.right[1] < 0.0 {
-        -1.0
-    } else {
-        1.0
-    };
+    let sign = horizontal_sign(view);
     let mm = view.mm_per_px;
     // The horizontal coordinate at pixel edge `c` is `sign * (u_left + c mm)`.
     let h_at = |c: f64| sign * (view.u_left + c * mm);
@@ -1661,11 +1669,7 @@ const TABLED_ZONES: usize = 15;
 /// specks are left out (the table names them).
 fn zone_labels_svg(run: &super::run::Run, view: &super::render::View) -> Markup {
     let (w, h) = (view.width as f64, view.height as f64);
-    let sign = if view.camera.right[0] + view.camera.right[1] < 0.0 {
-        -1.0
-    } else {
-        1.0
-    };
+    let sign = horizontal_sign(view);
     let direct = run.summary.approach == Approach::Direct;
     let labels: Vec<(usize, f64, f64)> = run
         .summary

@@ -184,16 +184,7 @@ fn build_report(options: &ReportOptions) -> Result<(String, Report), ReportError
 /// Whether the run in `dir` has `run`'s approach (another revision of the
 /// part, for `--compare`), from its `summary.json`.
 fn same_approach(dir: &Path, run: &Run) -> Result<bool, ReportError> {
-    let path = dir.join(crate::output::SUMMARY_JSON);
-    let text = crate::limits::read_text_bounded(&path).map_err(|source| ReportError::Io {
-        path: path.clone(),
-        source,
-    })?;
-    let other =
-        crate::summary::Summary::from_json(&text).map_err(|e| ReportError::Inconsistent {
-            path: path.clone(),
-            reason: e.to_string(),
-        })?;
+    let (_, _, other) = run::read_summary(&dir.join(crate::output::SUMMARY_JSON))?;
     Ok(other.approach == run.summary.approach)
 }
 

@@ -97,6 +97,83 @@ pub(crate) struct AngleBits {
     pub bits: Vec<u8>,
 }
 
+/// What every reader of a run directory needs first: its `summary.json`
+/// (as written, parsed and typed, every field checked), the grid, frame
+/// and axes it states, and `composite.csv` on that grid, checked against
+/// the summary's counts. [`Run::read`] adds the part and the blind spots;
+/// a comparison of revisions ([`super::diff`]) needs no more.
+pub(super) struct RunTables {
+    /// `summary.json`'s text.
+    pub text: String,
+    /// `summary.json`, as written.
+    pub json: serde_json::Value,
+    /// `summary.json`, typed.
+    pub summary: Summary,
+    /// The run's grid.
+    pub spec: GridSpec,
+    /// The run's `--frame`.
+    pub frame: Frame,
+    /// How drawn points map to the grid.
+    pub axes: GridAxes,
+    /// `composite.csv`.
+    pub composite: NodeCounts,
+}
+
+impl RunTables {
+    /// Reads `dir`'s `summary.json` and `composite.csv`.
+    pub fn read(dir: &Path) -> Result<RunTables, ReportError> {
+        let summary_path = dir.join(crate::output::SUMMARY_JSON);
+        let (text, json, summary) = read_summary(&summary_path)?;
+        let spec = grid_spec(&summary).ok_or_else(|| ReportError::Inconsistent {
+            path: summary_path.clone(),
+            reason: format!(
+                "grid origin {:?}, size {:?} and pitch {} do not describe a grid",
+                summary.grid_origin, summary.grid_size, summary.pitch_mm
+            ),
+        })?;
+        let frame = run_frame(&summary, &summary_path)?;
+        let axes = GridAxes {
+            approach: summary.approach,
+            side: summary.side,
+        };
+        let composite = read_composite(&dir.join("composite.csv"), spec, &frame, axes)?;
+        check_counts(&summary, &composite).map_err(|reason| ReportError::Inconsistent {
+            path: summary_path.clone(),
+            reason,
+        })?;
+        Ok(RunTables {
+            text,
+            json,
+            summary,
+            spec,
+            frame,
+            axes,
+            composite,
+        })
+    }
+}
+
+/// A `summary.json` at `path`: its text, its JSON and the typed summary,
+/// every field checked ([`Summary::from_json`]).
+pub(super) fn read_summary(
+    path: &Path,
+) -> Result<(String, serde_json::Value, Summary), ReportError> {
+    let text = read_text(path)?;
+    let json = |source| ReportError::Json {
+        path: path.to_path_buf(),
+        source,
+    };
+    let value: serde_json::Value = serde_json::from_str(&text).map_err(json)?;
+    let summary = Summary::from_json(&text).map_err(|e| match e {
+        SummaryError::Json(source) => json(source),
+        e @ SummaryError::Field { .. } => ReportError::Inconsistent {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        },
+    })?;
+    Ok((text, value, summary))
+}
+
 /// A run directory, read.
 #[derive(Debug)]
 pub(crate) struct Run {
@@ -184,32 +261,15 @@ impl Run {
         // beside another's pictures: the directory read is the one there
         // before and after, or the report refuses.
         let identity_before = dir_identity(dir);
-        let text = read_text(&summary_path)?;
-        let json = |source| ReportError::Json {
-            path: summary_path.clone(),
-            source,
-        };
-        let summary_json: serde_json::Value = serde_json::from_str(&text).map_err(json)?;
-        let summary = Summary::from_json(&text).map_err(|e| match e {
-            SummaryError::Json(source) => json(source),
-            e @ SummaryError::Field { .. } => ReportError::Inconsistent {
-                path: summary_path.clone(),
-                reason: e.to_string(),
-            },
-        })?;
-        let spec = grid_spec(&summary).ok_or_else(|| ReportError::Inconsistent {
-            path: summary_path.clone(),
-            reason: format!(
-                "grid origin {:?}, size {:?} and pitch {} do not describe a grid",
-                summary.grid_origin, summary.grid_size, summary.pitch_mm
-            ),
-        })?;
-        let frame = run_frame(&summary, &summary_path)?;
-        let axes = GridAxes {
-            approach: summary.approach,
-            side: summary.side,
-        };
-        let composite = read_composite(&dir.join("composite.csv"), spec, &frame, axes)?;
+        let RunTables {
+            text,
+            json: summary_json,
+            summary,
+            spec,
+            frame,
+            axes,
+            composite,
+        } = RunTables::read(dir)?;
         let (part_path, mut part) = find_parts(dir, part, &summary)?;
         // With a frame, the part is drawn where the analysis put it: in
         // vehicle coordinates (the side's mirror aside, as ever).
@@ -224,10 +284,6 @@ impl Run {
         } else {
             Vec::new()
         };
-        check_counts(&summary, &composite).map_err(|reason| ReportError::Inconsistent {
-            path: summary_path.clone(),
-            reason,
-        })?;
         if dir_identity(dir) != identity_before || read_text(&summary_path).ok() != Some(text) {
             return Err(ReportError::Inconsistent {
                 path: dir.to_path_buf(),
@@ -478,7 +534,7 @@ fn check_counts(summary: &Summary, composite: &NodeCounts) -> Result<(), String>
     Ok(())
 }
 
-pub(super) fn read_composite(
+fn read_composite(
     path: &Path,
     spec: GridSpec,
     frame: &Frame,
@@ -495,7 +551,7 @@ pub(super) fn read_composite(
 }
 
 /// The run's `--frame`, checked as `analyze` checked it.
-pub(super) fn run_frame(summary: &Summary, path: &Path) -> Result<Frame, ReportError> {
+fn run_frame(summary: &Summary, path: &Path) -> Result<Frame, ReportError> {
     summary
         .frame
         .as_ref()
