@@ -63,8 +63,25 @@ fn files_over(root: &Path, limit: u64) -> Vec<(PathBuf, u64)> {
         .collect()
 }
 
+/// The bytes of the tracked files of `root` under its folder `folder`.
+fn tracked_bytes_under(root: &Path, folder: &str) -> u64 {
+    let Some(files) = tracked_files(root) else {
+        return 0;
+    };
+    files
+        .into_iter()
+        .filter(|f| f.starts_with(folder))
+        .filter_map(|f| std::fs::metadata(root.join(f)).ok())
+        .map(|m| m.len())
+        .sum()
+}
+
 /// Five megabytes: the largest file a clone should carry (issue 40).
 const MAX_TRACKED_BYTES: u64 = 5_000_000;
+/// Twenty megabytes: the most the committed evidence, `results/`, may
+/// hold (issue 40); the per-pair CSVs that `results/regenerate.sh` makes
+/// again are not committed.
+const MAX_RESULTS_BYTES: u64 = 20_000_000;
 
 // The parent folder's name, spelled in two pieces so that this file does
 // not name it itself.
@@ -88,8 +105,19 @@ fn no_tracked_file_is_over_five_megabytes() {
     assert!(found.is_empty(), "tracked files over 5 MB: {found:?}");
 }
 
-/// The two checks find what they look for: a scratch repository with a
-/// file naming the folder beside it and a 6 MB file fails both.
+#[test]
+fn the_committed_evidence_is_at_most_twenty_megabytes() {
+    let bytes = tracked_bytes_under(repo(), "results");
+    assert!(
+        bytes <= MAX_RESULTS_BYTES,
+        "results/ holds {bytes} bytes of tracked files, over {MAX_RESULTS_BYTES}"
+    );
+}
+
+/// The three checks find what they look for: a scratch repository with a
+/// file naming the folder beside it, a 6 MB file, and a `results/` of
+/// five 4.5 MB files (each under the file limit, 22.5 MB together) fails
+/// them.
 #[test]
 fn the_checks_find_a_reference_and_a_large_file() {
     let dir = std::env::temp_dir().join(format!("kneeform-standalone-{}", std::process::id()));
@@ -109,12 +137,24 @@ fn the_checks_find_a_reference_and_a_large_file() {
     std::fs::write(dir.join("CHANGELOG.md"), outside()).unwrap();
     std::fs::write(dir.join("big.csv"), vec![b'0'; 6_000_000]).unwrap();
     std::fs::write(dir.join("small.csv"), b"0\n").unwrap();
+    std::fs::create_dir_all(dir.join("results")).unwrap();
+    for k in 0..5 {
+        std::fs::write(
+            dir.join(format!("results/part_{k}.csv")),
+            vec![b'0'; 4_500_000],
+        )
+        .unwrap();
+    }
     git(&["add", "."]);
     assert_eq!(files_naming(&dir, &outside()), vec![PathBuf::from("a.md")]);
     assert_eq!(
         files_over(&dir, MAX_TRACKED_BYTES),
         vec![(PathBuf::from("big.csv"), 6_000_000)]
     );
+    assert_eq!(tracked_bytes_under(&dir, "results"), 22_500_000);
+    assert!(tracked_bytes_under(&dir, "results") > MAX_RESULTS_BYTES);
+    // Files beside `results/` do not count towards it.
+    assert_eq!(tracked_bytes_under(&dir, "result"), 0);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
