@@ -53,6 +53,10 @@ pub(crate) const BYTES_PER_TRIANGLE: f64 = 72.0;
 /// peak of `analyze` with and without its sample check, 2 mm, 2 threads).
 pub(crate) const ORACLE_BYTES_PER_TRIANGLE: f64 = 143.0;
 
+/// Bytes a study holds per node of each pitch's grid: the heights and
+/// the comparison's copy of them with the blind spots (`Cells`), about 20.
+pub(crate) const STUDY_GRID_BYTES_PER_NODE: f64 = 20.0;
+
 const MIB: f64 = 1024.0 * 1024.0;
 
 /// An estimate of an analysis's peak working memory, by item.

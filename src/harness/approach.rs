@@ -120,6 +120,12 @@ pub(crate) trait StudyApproach: Sync {
     /// `shard.json`'s word for this approach's study `kind` (`verify`,
     /// `converge-direct`, ...), unique over the approaches.
     fn kind_word(&self, kind: StudyKind) -> &'static str;
+    /// The most a comparison on the grid `spec` holds at once in finer
+    /// grids sampled to refine a miss (bytes), on `threads` threads; none
+    /// by default.
+    fn refinement_bytes(&self, _setup: &Setup, _spec: &GridSpec, _threads: usize) -> f64 {
+        0.0
+    }
     /// The approach, its study `kind` and the study's word
     /// ([`StudyApproach::kind_word`]): what names a summary of it.
     fn named(&self, kind: StudyKind) -> (Approach, StudyKind, &'static str) {

@@ -937,6 +937,37 @@ fn inside_miss_refined(
     (miss, g)
 }
 
+/// The most the finer bands of a comparison on `spec` at `angles_deg`
+/// hold at once (bytes), on `threads` threads: the bands kept
+/// ([`KEPT_BANDS`]) and one in use on each thread, each as wide as the
+/// grid at a quarter of its pitch (16 times the nodes of a band of the
+/// grid's own) and as tall as the knee-form's footprint there, at
+/// [`crate::memory::STUDY_GRID_BYTES_PER_NODE`] per node. A wide grid's
+/// bands outweigh its traces (issue 41: `--grid-size 8000,777` held
+/// 1.58 GiB where the traces predicted 1.0).
+pub(crate) fn refinement_bytes(
+    spec: GridSpec,
+    knee: &KneeForm,
+    angles_deg: &[f64],
+    threads: usize,
+) -> f64 {
+    let whole = finer(spec, 2);
+    let rows = angles_deg
+        .iter()
+        .map(|&a| {
+            let fp = GridFootprint::new(knee, a, &whole);
+            let (lo, hi) = fp.rows.iter().fold((0i64, 0i64), |(lo, hi), r| {
+                (lo.min(i64::from(r.dj)), hi.max(i64::from(r.dj)))
+            });
+            (hi - lo + 1) as usize
+        })
+        .max()
+        .unwrap_or(0)
+        .min(whole.nz);
+    let bands = (KEPT_BANDS + threads) as f64;
+    bands * crate::memory::STUDY_GRID_BYTES_PER_NODE * whole.nx as f64 * rows as f64
+}
+
 /// The grid `spec` with its pitch halved `halvings` times: its nodes and
 /// those between them, over the same extent.
 fn finer(spec: GridSpec, halvings: u32) -> GridSpec {

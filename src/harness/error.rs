@@ -122,18 +122,22 @@ pub enum HarnessError {
         /// Shards that would each fit the budget.
         shards: usize,
     },
-    /// A study's exact traces and comparisons would not fit in memory.
+    /// A study would not fit in memory.
     #[error(
-        "the exact traces and their comparison would hold about {need_gib:.1} GiB for {pairs} start-angle pairs (predicted from a sample), beyond the {limit_gib:.1} GiB allowed (--max-memory, or this machine's memory): fan it out with --shard K/{shards} (K = 1..{shards}, then `kneeform merge`), or compare fewer angles or starts"
+        "the study would hold about {need_gib:.1} GiB ({held_gib:.1} GiB whatever its starts: the part and the oracle's copy of it, the grids and the finer grids that refine a miss; the rest the exact traces and their comparison for {pairs} start-angle pairs, predicted from a sample), beyond the {limit_gib:.1} GiB allowed (--max-memory, or this machine's memory): {}",
+        fan_out_words(*shards)
     )]
     StudyMemory {
         /// The predicted memory (GiB).
         need_gib: f64,
+        /// Of it, what every shard holds whatever its starts (GiB).
+        held_gib: f64,
         /// The memory allowed (GiB).
         limit_gib: f64,
         /// Start-angle pairs to trace.
         pairs: usize,
-        /// Shards that would each fit.
+        /// Shards that would each fit; 0 where none would (what every
+        /// shard holds is beyond the limit).
         shards: usize,
     },
     /// The exact traces of a pitch study would take longer than its
@@ -194,4 +198,16 @@ pub enum HarnessError {
     /// A strip of start rows whose bounds are not finite and ordered.
     #[error("a strip of starts needs finite z bounds Z0 <= Z1 (mm), got {0:?}")]
     Strip([f64; 2]),
+}
+
+/// What to do about a study beyond its memory that `shards` shards would
+/// each fit (0: none would).
+fn fan_out_words(shards: usize) -> String {
+    if shards == 0 {
+        "sharding does not help, since every shard holds the grids: use a coarser --pitch or a smaller --grid-size, or allow more with --max-memory".into()
+    } else {
+        format!(
+            "fan it out with --shard K/{shards} (K = 1..{shards}, then `kneeform merge`), or compare fewer angles or starts"
+        )
+    }
 }

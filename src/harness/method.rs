@@ -36,6 +36,11 @@ pub(crate) struct MemoryLimit {
     pub bytes: f64,
     /// Pitches whose comparisons the study holds at once.
     pub pitches: usize,
+    /// What the study holds besides its traces and comparisons, whatever
+    /// the share of starts (bytes): the program, the part and the
+    /// oracle's copy of it, each pitch's grid and the refinement's finer
+    /// bands ([`super::approach::StudyApproach::refinement_bytes`]).
+    pub held_bytes: f64,
 }
 
 /// One pitch of a study, as [`Method::pitch`] compares it.

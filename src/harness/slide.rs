@@ -46,6 +46,10 @@ impl StudyApproach for Slide {
         }
     }
 
+    fn refinement_bytes(&self, setup: &Setup, spec: &crate::grid::GridSpec, threads: usize) -> f64 {
+        super::compare::refinement_bytes(*spec, &setup.knee, &setup.angles, threads)
+    }
+
     fn shard_words(&self, kind: StudyKind) -> &'static str {
         match kind {
             StudyKind::Verify => "a verification (verify --shard)",

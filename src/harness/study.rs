@@ -30,6 +30,34 @@ use crate::input::PartFile;
 use crate::partition::Shard;
 use crate::setup::Setup;
 
+/// What a study of a part of `triangles` triangles holds besides its
+/// traces and comparisons (bytes): the program, the part and the oracle's
+/// copy of it, the grid of each of `pitches` (laid from `coarse`), and the
+/// finer bands that refine the finest pitch's misses.
+fn held_bytes(
+    approach: &dyn super::approach::StudyApproach,
+    setup: &Setup,
+    triangles: usize,
+    coarse: &crate::grid::GridSpec,
+    pitches: &[f64],
+) -> f64 {
+    use crate::memory::{
+        BASE_BYTES, BYTES_PER_TRIANGLE, ORACLE_BYTES_PER_TRIANGLE, STUDY_GRID_BYTES_PER_NODE,
+    };
+    let grids: f64 = pitches
+        .iter()
+        .map(|&p| {
+            let s = spec_at(coarse, p);
+            STUDY_GRID_BYTES_PER_NODE * s.nx as f64 * s.nz as f64
+        })
+        .sum();
+    let finest = spec_at(coarse, pitches[pitches.len() - 1]);
+    BASE_BYTES
+        + (BYTES_PER_TRIANGLE + ORACLE_BYTES_PER_TRIANGLE) * triangles as f64
+        + grids
+        + approach.refinement_bytes(setup, &finest, rayon::current_num_threads())
+}
+
 /// The study `options` of `shard`'s share of the starts (the starts `s`,
 /// 0-based in the study's order, with `s % N == K - 1`) on `setup`'s
 /// approach: the oracle on the share alone, every pitch compared on it.
@@ -91,6 +119,13 @@ fn run(
             setup.check_memory(&spec_at(&coarse, p), input.part.triangles.len())?;
         }
     }
+    let held_bytes = held_bytes(
+        approach,
+        setup,
+        input.part.triangles.len(),
+        &coarse,
+        &pitches,
+    );
     let tracing = Tracing {
         share: share(&method.laid().starts, shard)?,
         finest: pitches[pitches.len() - 1],
@@ -99,6 +134,7 @@ fn run(
         memory: Some(MemoryLimit {
             bytes: setup.max_memory_bytes,
             pitches: pitches.len(),
+            held_bytes,
         }),
     };
     let oracle_s = method.trace(tracing, progress)?;

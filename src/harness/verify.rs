@@ -251,18 +251,28 @@ pub(super) fn run_oracle(
         }
         if let Some(memory) = memory {
             let contacts: usize = sample.iter().map(|t| t.contacts.len()).sum();
-            let need = BYTES_PER_CONTACT * memory.pitches as f64 * contacts as f64 * pairs as f64
+            let traces = BYTES_PER_CONTACT * memory.pitches as f64 * contacts as f64 * pairs as f64
                 / first.len().max(1) as f64;
+            let need = traces + memory.held_bytes;
             let limit = match crate::memory::limit_bytes() {
                 Some((machine, _)) => memory.bytes.min(machine),
                 None => memory.bytes,
             };
             if need > limit {
+                // Shards divide the traces; what every shard holds
+                // whatever its starts (the part, the grids, the finer
+                // bands) they do not.
+                let room = limit - memory.held_bytes;
                 return Err(HarnessError::StudyMemory {
                     need_gib: need / GIB,
+                    held_gib: memory.held_bytes / GIB,
                     limit_gib: limit / GIB,
                     pairs,
-                    shards: ((need / limit).ceil() as usize).clamp(2, starts.len().max(2)),
+                    shards: if room > 0.0 {
+                        ((traces / room).ceil() as usize).clamp(2, starts.len().max(2))
+                    } else {
+                        0
+                    },
                 });
             }
         }
@@ -716,7 +726,11 @@ mod tests {
         let starts = [[0.0, 0.0], [20.0, 10.0]];
         let options = oracle_options(&KneeForm::default(), 4.0, -150.0);
         let run = |bytes: f64| {
-            let memory = MemoryLimit { bytes, pitches: 1 };
+            let memory = MemoryLimit {
+                bytes,
+                pitches: 1,
+                held_bytes: 0.0,
+            };
             run_oracle(&tris, &starts, &[0.0], &options, (None, Some(memory)), &())
         };
         match run(1.0) {
