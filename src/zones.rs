@@ -17,6 +17,11 @@
 //! nearest zone that is not one (its neighbour), so a reader sees a stray
 //! node beside the area it belongs to rather than as a place of its own.
 //!
+//! A verification of the same part and grid says where the grid's boundary
+//! is undecided (`verify.json`'s `undecided_nodes`, a [`NodeRuns`]): a
+//! zone is **touched** by it when one of its nodes is on or 8-adjacent to
+//! an undecided node ([`touched_by`]), as the report's zone table says.
+//!
 //! **Invariant:** zones partition the composite's colliding nodes; their
 //! ids follow their order, largest area first (ties: the smaller first node
 //! index, row-major), so the same mask gives the same ids on every run.
@@ -135,6 +140,101 @@ pub fn zones(
         }
     }
     out
+}
+
+/// A set of grid nodes written compactly: runs of adjacent nodes along a
+/// row, in the lattice's own indices (node column `c` at `x = c p`, row
+/// `r` at `z = r p`, mm, analysis frame), so that the set reads the same
+/// on any grid of the same pitch whatever its origin. `verify.json` holds
+/// its undecided nodes this way.
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct NodeRuns {
+    /// The pitch `p` of the grid whose nodes these are (mm).
+    pub pitch_mm: f64,
+    /// How many nodes the runs hold.
+    pub nodes: usize,
+    /// `[row, first column, last column]` (lattice indices, both columns
+    /// included), ascending by row then column, never overlapping or
+    /// adjacent.
+    pub runs: Vec<[i64; 3]>,
+}
+
+impl NodeRuns {
+    /// The nodes `(i, j)` of the grid `spec` (each once, in any order) as
+    /// runs.
+    pub fn of(nodes: &[(usize, usize)], spec: &crate::grid::GridSpec) -> NodeRuns {
+        let mut lattice: Vec<(i64, i64)> = nodes
+            .iter()
+            .map(|&(i, j)| (spec.j_origin + j as i64, spec.i_origin + i as i64))
+            .collect();
+        lattice.sort_unstable();
+        lattice.dedup();
+        let mut runs: Vec<[i64; 3]> = Vec::new();
+        for &(row, column) in &lattice {
+            match runs.last_mut() {
+                Some(run) if run[0] == row && run[2] + 1 == column => run[2] = column,
+                _ => runs.push([row, column, column]),
+            }
+        }
+        NodeRuns {
+            pitch_mm: spec.pitch,
+            nodes: lattice.len(),
+            runs,
+        }
+    }
+
+    /// Their area (mm^2): each node stands for its cell of `p x p`, as a
+    /// zone's does; rounded to 1e-6 mm^2, so that it prints as its decimal.
+    pub fn area_mm2(&self) -> f64 {
+        (self.nodes as f64 * self.pitch_mm * self.pitch_mm * 1e6).round() / 1e6
+    }
+
+    /// Every node as `(column, row)` lattice indices, row-major.
+    pub fn lattice_nodes(&self) -> impl Iterator<Item = (i64, i64)> + '_ {
+        self.runs
+            .iter()
+            .flat_map(|&[row, first, last]| (first..=last).map(move |c| (c, row)))
+    }
+
+    /// On the grid `spec` (of the same pitch), per node (row-major by z)
+    /// whether it is one of these; `None` when the pitches differ (the
+    /// sets are of different grids). Nodes off `spec` are left out.
+    pub fn mask_on(&self, spec: &crate::grid::GridSpec) -> Option<Vec<bool>> {
+        let same = (self.pitch_mm - spec.pitch).abs() <= 1e-9 * spec.pitch;
+        if !same {
+            return None;
+        }
+        let mut mask = vec![false; spec.len()];
+        for (c, r) in self.lattice_nodes() {
+            let (i, j) = (c - spec.i_origin, r - spec.j_origin);
+            if (0..spec.nx as i64).contains(&i) && (0..spec.nz as i64).contains(&j) {
+                mask[j as usize * spec.nx + i as usize] = true;
+            }
+        }
+        Some(mask)
+    }
+}
+
+/// For each zone (`members`, as [`components`] gives them, on an
+/// `nx x nz` grid), whether one of its nodes is on or 8-adjacent to a
+/// node marked in `marked` (row-major by z): an undecided boundary
+/// touches it.
+pub fn touched_by(members: &[Vec<usize>], nx: usize, nz: usize, marked: &[bool]) -> Vec<bool> {
+    let near = |n: usize| {
+        let (i, j) = ((n % nx) as isize, (n / nx) as isize);
+        std::iter::once((0, 0)).chain(NEIGHBOURS).any(|(di, dj)| {
+            let (a, b) = (i + di, j + dj);
+            a >= 0
+                && b >= 0
+                && a < nx as isize
+                && b < nz as isize
+                && marked.get(b as usize * nx + a as usize) == Some(&true)
+        })
+    };
+    members
+        .iter()
+        .map(|nodes| nodes.iter().any(|&n| near(n)))
+        .collect()
 }
 
 /// The 8-connected components of the nodes of an `nx x nz` grid
@@ -347,5 +447,50 @@ mod tests {
         assert!(near[0].touches_blind_spot);
         let far = zones(&g, &composite, &masks, &[spot(4, 2)], &placement());
         assert!(!far[0].touches_blind_spot);
+    }
+
+    #[test]
+    fn node_runs_join_adjacent_columns_and_read_back_on_a_shifted_grid() {
+        // A 6 x 4 grid at 2 mm whose node (0, 0) is lattice node (3, -2).
+        let spec = GridSpec::explicit(6.0, -4.0, 6, 4, 2.0);
+        let nodes = [(4, 1), (0, 1), (1, 1), (5, 3), (1, 1), (3, 1)];
+        let runs = NodeRuns::of(&nodes, &spec);
+        // Row 1 is lattice row -1: columns 0-1 (lattice 3-4) and 3-4
+        // (lattice 6-7); row 3 is lattice row 1, column 5 (lattice 8).
+        assert_eq!(runs.runs, vec![[-1, 3, 4], [-1, 6, 7], [1, 8, 8]]);
+        assert_eq!(runs.nodes, 5);
+        assert_eq!(runs.area_mm2(), 5.0 * 4.0);
+        // On a grid one column further left, the same places.
+        let wider = GridSpec::explicit(4.0, -4.0, 7, 4, 2.0);
+        let mask = runs.mask_on(&wider).unwrap();
+        let on: Vec<usize> = (0..mask.len()).filter(|&n| mask[n]).collect();
+        assert_eq!(on, vec![8, 9, 11, 12, 27]);
+        // Another pitch is another grid.
+        assert!(
+            runs.mask_on(&GridSpec::explicit(6.0, -4.0, 6, 4, 1.0))
+                .is_none()
+        );
+    }
+
+    #[test]
+    fn a_zone_on_or_beside_a_marked_node_is_touched_and_a_distant_one_is_not() {
+        // Two zones on a 6 x 4 grid: columns 0-1 of rows 0-1, and node
+        // (5, 3). One marked node diagonal to the first zone's (1, 1).
+        let mut counts = vec![0u16; 24];
+        for n in [0, 1, 6, 7, 23] {
+            counts[n] = 1;
+        }
+        let members = components(&counts, 6, 4);
+        assert_eq!(members, vec![vec![0, 1, 6, 7], vec![23]]);
+        let mut marked = vec![false; 24];
+        marked[2 * 6 + 2] = true;
+        assert_eq!(touched_by(&members, 6, 4, &marked), vec![true, false]);
+        // On a zone's own node it touches too; two columns away it does not.
+        let mut marked = vec![false; 24];
+        marked[23] = true;
+        assert_eq!(touched_by(&members, 6, 4, &marked), vec![false, true]);
+        let mut marked = vec![false; 24];
+        marked[3] = true;
+        assert_eq!(touched_by(&members, 6, 4, &marked), vec![false, false]);
     }
 }

@@ -113,3 +113,78 @@ fn verify_help_names_the_figure_judged_and_the_three_outcomes() {
         assert!(out.contains(words), "{words}: {out}");
     }
 }
+
+/// Issue 39, "about 41% of the exact contacts are undecided, stated as a
+/// count with no area or location": `verify` stores where they are. A
+/// wall that rises towards the sliding knee-form (in -x) at exactly the
+/// deflection threshold, `y = sigma (x - X1)` between `X0` and `X1`, flat
+/// on either side: the exact level falls by exactly `sigma W` over every
+/// window on the ramp, so each exact contact there is in the tie band
+/// (either answer is right), and there is no contact on the flats, where
+/// the level does not fall. At angle 0 the knee-form's apex leads, so the
+/// contacts lie on the start rows. The undecided nodes are therefore on
+/// the strip's rows, between `X0` and `X1` (to the nearest node), and
+/// fill the ramp once the knee-form has slid a window onto it.
+#[test]
+fn the_undecided_nodes_lie_where_the_ramp_is_at_the_threshold() {
+    use kneeform::harness::{self, StartSelection, TieBand, VerifyOptions};
+    use kneeform::{Part, PartFile, Setup, Side};
+
+    use crate::util::{lattice_part, lines};
+
+    let (x0, x1, pitch) = (-150.0, 100.0, 5.0);
+    let setup = Setup {
+        pitch,
+        angles: vec![0.0],
+        ..Setup::default()
+    };
+    let sigma = setup.rule.sigma;
+    let window = setup.rule.window_mm().expect("the window rule is the default");
+    let verify = |slope: f64| {
+        let xs = lines(-300.0, 300.0, 10.0, &[x0, x1]);
+        let zs = lines(-150.0, 150.0, 10.0, &[]);
+        let tris = lattice_part(&xs, &zs, |x, _| slope * (x.clamp(x0, x1) - x1));
+        let part = Part::from_triangles("ramp", tris, 1.0, Side::Left).unwrap();
+        let options = VerifyOptions {
+            selection: StartSelection::Strip {
+                z: [-pitch, pitch],
+            },
+            tie_band_per_mm: TieBand::DEFAULT_PER_MM,
+            tolerance: 1.0,
+            budget_s: None,
+        };
+        harness::verify(&PartFile::in_memory("ramp", part), &setup, &options, &())
+            .unwrap()
+            .summary
+    };
+    let tie = verify(sigma);
+    let runs = tie.undecided_nodes.clone().expect("verify records them");
+    assert_eq!(runs.pitch_mm, pitch);
+    let nodes: Vec<(f64, f64)> = runs
+        .lattice_nodes()
+        .map(|(c, r)| (c as f64 * pitch, r as f64 * pitch))
+        .collect();
+    assert_eq!(nodes.len(), runs.nodes);
+    assert!(tie.counts.exact_undecided > 0, "{:?}", tie.counts);
+    // On the strip's rows, on the ramp to the nearest node.
+    for &(x, z) in &nodes {
+        assert!([-pitch, 0.0, pitch].contains(&z), "({x}, {z})");
+        assert!(
+            (x0 - pitch / 2.0..=x1 + pitch / 2.0).contains(&x),
+            "({x}, {z}) off the ramp [{x0}, {x1}]"
+        );
+    }
+    // Filling the ramp on every row once a window has been slid on it
+    // (with two pitches of room at each end).
+    let mut x = x0 + 2.0 * pitch;
+    while x <= x1 - window - 2.0 * pitch {
+        for z in [-pitch, 0.0, pitch] {
+            assert!(nodes.contains(&(x, z)), "({x}, {z}) is not undecided");
+        }
+        x += pitch;
+    }
+    // The area is the stored set's nodes times the pitch squared.
+    let area = tie.undecided_area_mm2.expect("verify records the area");
+    assert!((area - nodes.len() as f64 * pitch * pitch).abs() < 1e-6, "{area}");
+    assert!(tie.sentence().contains(&format!("({} mm^2)", kneeform::limits::short(area))));
+}

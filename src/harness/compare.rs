@@ -521,6 +521,11 @@ pub struct Comparison {
     /// The decided figures the level error can explain, over what it does
     /// not explain.
     pub unexplained: Unexplained,
+    /// The nodes nearest an undecided exact contact, over every pair and
+    /// angle compared (the union of [`PairResult::undecided`]), each once,
+    /// in row-major order (by row `j`, then column `i`): where the grid's
+    /// boundary is undecided at this pitch.
+    pub undecided_nodes: Vec<(usize, usize)>,
     /// Seconds spent on the grid side.
     pub grid_s: f64,
 }
@@ -634,6 +639,10 @@ pub struct PairResult {
     pub grid_nodes: Vec<(usize, usize)>,
     /// The exact strikes snapped to their nearest nodes `(i, j)`.
     pub snapped: Vec<(usize, usize)>,
+    /// The undecided exact contacts snapped to their nearest nodes
+    /// `(i, j)`, each node once, in row-major order: where the grid's
+    /// boundary is undecided in this pair.
+    pub undecided: Vec<(usize, usize)>,
 }
 
 /// The statuses of a row, in the order a shard's file numbers them.
@@ -852,10 +861,12 @@ pub(crate) fn pair_results(
             .iter()
             .filter_map(|p| node_of(p[0], p[1]))
             .collect();
+        let undecided = undecided_nodes(&cmp.points.undecided, &node_of);
         PairResult {
             row: row_of(i, j, fp.angle_deg, status, &cmp),
             grid_nodes: g.colliding.iter().map(|c| c.node).collect(),
             snapped,
+            undecided,
             cmp,
         }
     };
@@ -882,6 +893,20 @@ pub(crate) fn pair_results(
         })
         .collect();
     Ok(results.into_iter().flatten().collect())
+}
+
+/// The nodes nearest `points` (xz, mm) by `node_of`, each once, in
+/// row-major order (by row `j`, then column `i`); points nearest no node
+/// of the grid are left out.
+fn undecided_nodes(
+    points: &[[f64; 2]],
+    node_of: &dyn Fn(f64, f64) -> Option<(usize, usize)>,
+) -> Vec<(usize, usize)> {
+    let mut nodes: Vec<(usize, usize)> =
+        points.iter().filter_map(|p| node_of(p[0], p[1])).collect();
+    nodes.sort_by_key(|&(i, j)| (j, i));
+    nodes.dedup();
+    nodes
 }
 
 /// The most starts of a row whose grid traces [`pair_results`] joins one
@@ -1064,6 +1089,8 @@ pub(crate) fn assemble(
     let mut values: Vec<Vec<f64>> = vec![Vec::new(); METRICS.len()];
     let mut unexplained = Unexplained::default();
     let (mut grid_set, mut exact_set) = (HashSet::new(), HashSet::new());
+    // Row-major: the order `undecided_nodes` keeps, whatever the pairs'.
+    let mut undecided_set: std::collections::BTreeSet<(usize, usize)> = Default::default();
     let mut area_points: Vec<StartPoints> = vec![StartPoints::default(); angles_deg.len()];
     for (k, pair) in results.iter().enumerate() {
         let a = k / per_angle.max(1);
@@ -1072,6 +1099,7 @@ pub(crate) fn assemble(
             cmp,
             grid_nodes,
             snapped,
+            undecided,
         } = pair;
         match row.status.as_str() {
             "compared" => counts.compared += 1,
@@ -1198,6 +1226,7 @@ pub(crate) fn assemble(
         if row.status == "compared" || row.status == "grid_not_placed" {
             grid_set.extend(grid_nodes.iter().map(|&n| (a, n)));
             exact_set.extend(snapped.iter().map(|&n| (a, n)));
+            undecided_set.extend(undecided.iter().map(|&(i, j)| (j, i)));
             // (A count of pairs that is no multiple of the angles' is a
             // caller's mistake; its extra pairs join no angle's area.)
             if let Some(points) = area_points.get_mut(a) {
@@ -1249,6 +1278,7 @@ pub(crate) fn assemble(
         band,
         counts,
         unexplained,
+        undecided_nodes: undecided_set.into_iter().map(|(j, i)| (i, j)).collect(),
         grid_s,
     }
 }
@@ -1735,6 +1765,7 @@ mod tests {
                 band: TieBand::new(1.0, 1.0, 0.0),
                 counts: Counts::default(),
                 unexplained: Unexplained::default(),
+                undecided_nodes: Vec::new(),
                 grid_s: 0.0,
             };
             for (i, j) in choose_nodes(&spec, nodes.clone(), p) {
@@ -1863,6 +1894,7 @@ mod tests {
                 cmp,
                 grid_nodes: vec![(0, 0)],
                 snapped: vec![(3, 0)],
+                undecided: Vec::new(),
             };
             let c = assemble(vec![pair], &[0.0], TieBand::new(0.05, 1.0, 0.0), 0.0);
             c.failures(1.5)

@@ -458,6 +458,9 @@ pub struct StartPoints {
     pub decided_refined: Vec<[f64; 2]>,
     /// The exact contacts that are not decided non-strikes.
     pub possible: Vec<[f64; 2]>,
+    /// The undecided exact contacts (in the tie band: either answer is
+    /// right at this pitch): where the grid's boundary is undecided.
+    pub undecided: Vec<[f64; 2]>,
     /// The exact push contact, when placed: a point of the exact curve for
     /// false alarms (see [`compare`]).
     pub push: Vec<[f64; 2]>,
@@ -472,7 +475,7 @@ impl StartPoints {
     }
 
     /// Every set, in a fixed order (what a shard's file holds).
-    pub fn sets(&self) -> [&Vec<[f64; 2]>; 11] {
+    pub fn sets(&self) -> [&Vec<[f64; 2]>; 12] {
         [
             &self.grid,
             &self.grid_decided,
@@ -484,12 +487,13 @@ impl StartPoints {
             &self.decided_inside,
             &self.decided_refined,
             &self.possible,
+            &self.undecided,
             &self.push,
         ]
     }
 
     /// Every set, mutable, in the order of [`StartPoints::sets`].
-    pub fn sets_mut(&mut self) -> [&mut Vec<[f64; 2]>; 11] {
+    pub fn sets_mut(&mut self) -> [&mut Vec<[f64; 2]>; 12] {
         [
             &mut self.grid,
             &mut self.grid_decided,
@@ -501,6 +505,7 @@ impl StartPoints {
             &mut self.decided_inside,
             &mut self.decided_refined,
             &mut self.possible,
+            &mut self.undecided,
             &mut self.push,
         ]
     }
@@ -868,6 +873,7 @@ pub(crate) fn compare(
             .collect(),
         decided_refined: Vec::new(),
         possible: points(&|c| c.decision != Decision::NoStrike),
+        undecided: points(&|c| c.decision == Decision::Undecided),
         push,
     };
     let strikes_or_push = pts.with_push(&pts.strikes);
@@ -983,10 +989,7 @@ pub(crate) fn compare(
             _ => None,
         },
         exact_strikes: pts.strikes.len(),
-        undecided: classified
-            .iter()
-            .filter(|c| c.decision == Decision::Undecided)
-            .count(),
+        undecided: pts.undecided.len(),
         blind: blind_from.is_some(),
         blind_strikes: classified
             .iter()

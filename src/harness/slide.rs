@@ -127,6 +127,8 @@ impl StudyApproach for Slide {
                 "area_iou": 0.0,
                 "counts": super::compare::Counts::default(),
                 "worst_starts": [],
+                "undecided_area_mm2": null,
+                "undecided_nodes": null,
             }),
             StudyKind::Converge => serde_json::json!({
                 "fits": {},
@@ -349,7 +351,8 @@ fn plots(
 }
 
 /// A pair in `shard.bin`: status, node, then its comparison's values and
-/// points, the grid's nodes and the snapped exact strikes (the row is
+/// points, the grid's nodes, the snapped exact strikes and the nodes of
+/// the undecided contacts (the row is
 /// rebuilt from them by [`row_of`], as the comparison builds it;
 /// [`read_pair`] reads it back).
 impl Pair for PairResult {
@@ -404,6 +407,7 @@ impl Pair for PairResult {
         }
         put_nodes(out, &pair.grid_nodes);
         put_nodes(out, &pair.snapped);
+        put_nodes(out, &pair.undecided);
     }
 }
 
@@ -498,6 +502,7 @@ fn read_pair(r: &mut Reader, angle_deg: f64) -> Result<PairResult, String> {
         cmp,
         grid_nodes: r.nodes()?,
         snapped: r.nodes()?,
+        undecided: r.nodes()?,
     })
 }
 
@@ -826,6 +831,7 @@ mod tests {
                 decided_inside: Vec::new(),
                 decided_refined: vec![[0.5, 1.5]],
                 possible: Vec::new(),
+                undecided: vec![[2.0, 3.5]],
                 push: vec![[-7.5, 8.25]],
             },
         };
@@ -834,6 +840,7 @@ mod tests {
             cmp,
             grid_nodes: vec![(1, 2), (3, 4)],
             snapped: vec![(5, 6)],
+            undecided: vec![(2, 3)],
         }
     }
 

@@ -353,6 +353,8 @@ impl VerifySummary {
             area_miss_decided_mm: None,
             area_false_alarm_decided_mm: None,
             area_distance: Vec::new(),
+            undecided_area_mm2: None,
+            undecided_nodes: None,
             starts,
             seed,
             metrics: std::collections::BTreeMap::new(),
@@ -405,6 +407,9 @@ impl VerifySummary {
             let v = comparison.area.iter().map(f).fold(0.0, f64::max);
             v.is_finite().then_some(v)
         };
+        let undecided = crate::zones::NodeRuns::of(&comparison.undecided_nodes, spec);
+        self.undecided_area_mm2 = Some(undecided.area_mm2());
+        self.undecided_nodes = Some(undecided);
         self.area_miss_decided_mm = worst(|a| a.miss_decided);
         self.area_false_alarm_decided_mm = worst(|a| a.false_alarm_decided);
         self.metrics = comparison.stats.iter().cloned().collect();
@@ -468,7 +473,7 @@ impl VerifySummary {
             100.0 * c.exact_undecided as f64 / decided_and_undecided as f64
         };
         format!(
-            "{} at tolerance {} mm, pitch {} mm: {judged}; sample: {} start-angle pairs ({} starts), {} decided exact strikes; undecided: {} exact contacts ({share:.0}% of the decided strikes and undecided contacts), which may move the area's boundary by up to {} (the all-strikes area distance); cost: the grid's area reaches {} beyond the exact one (decided area false-alarm distance); blind spots: {} pairs touched one ({} exact strikes judged apart); knee-form L = {} mm{}",
+            "{} at tolerance {} mm, pitch {} mm: {judged}; sample: {} start-angle pairs ({} starts), {} decided exact strikes; undecided: {} exact contacts ({share:.0}% of the decided strikes and undecided contacts) at {} of the grid's nodes ({} mm^2), which may move the area's boundary by up to {} (the all-strikes area distance); cost: the grid's area reaches {} beyond the exact one (decided area false-alarm distance); blind spots: {} pairs touched one ({} exact strikes judged apart); knee-form L = {} mm{}",
             self.outcome.word(),
             short(self.tolerance_mm),
             short(self.pitch_mm),
@@ -476,6 +481,8 @@ impl VerifySummary {
             self.starts,
             c.exact_strikes_decided,
             c.exact_undecided,
+            self.undecided_nodes.as_ref().map_or(0, |n| n.nodes),
+            self.undecided_area_mm2.map_or("unknown".to_string(), short),
             mm(self.area_distance_mm),
             mm(self.area_false_alarm_decided_mm),
             c.blind_pairs,
@@ -649,6 +656,17 @@ pub struct VerifySummary {
     pub area_false_alarm_decided_mm: Option<f64>,
     /// The area distance per angle.
     pub area_distance: Vec<AreaDistance>,
+    /// Where the grid's boundary is undecided, as an area (mm^2): the
+    /// nodes of `undecided_nodes` times the pitch squared (`null` in files
+    /// of earlier versions).
+    #[serde(default)]
+    pub undecided_area_mm2: Option<f64>,
+    /// The nodes of the verified grid nearest an undecided exact contact,
+    /// over every pair and angle, as row runs in lattice indices
+    /// ([`crate::zones::NodeRuns`]: `x = column x pitch`,
+    /// `z = row x pitch`, mm, analysis frame).
+    #[serde(default)]
+    pub undecided_nodes: Option<crate::zones::NodeRuns>,
     /// `all`, or the sample size.
     pub starts: String,
     /// The sample's seed.

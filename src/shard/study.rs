@@ -47,7 +47,7 @@ use crate::output::{OutputDir, WriteError};
 pub struct StudyRecord {
     /// The format of the shard's files (`FORMAT`; 5: pairs carry their
     /// miss at half and at a quarter of the pitch and the points they set
-    /// apart).
+    /// apart; 6: and their undecided contacts, as points and as nodes).
     pub format: u32,
     /// Which shard of how many.
     pub shard: Shard,
@@ -75,9 +75,9 @@ pub struct StudyRecord {
 }
 
 /// The format [`write_study_shard`] writes and [`merge_study`] reads.
-pub(crate) const FORMAT: u32 = 5;
+pub(crate) const FORMAT: u32 = 6;
 
-const MAGIC: &[u8; 16] = b"kneeform study 5";
+const MAGIC: &[u8; 16] = b"kneeform study 6";
 
 /// The largest `shard.bin` read (bytes): far beyond a study's (a few
 /// hundred bytes per start and angle), short of exhausting memory.
