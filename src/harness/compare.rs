@@ -522,7 +522,7 @@ pub struct Comparison {
     /// not explain.
     pub unexplained: Unexplained,
     /// The nodes nearest an undecided exact contact, over every pair and
-    /// angle compared (the union of [`PairResult::undecided`]), each once,
+    /// angle compared (the union of each pair's), each once,
     /// in row-major order (by row `j`, then column `i`): where the grid's
     /// boundary is undecided at this pitch.
     pub undecided_nodes: Vec<(usize, usize)>,
