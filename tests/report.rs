@@ -1146,3 +1146,116 @@ fn a_long_converge_csv_shows_its_largest_rows() {
     assert!(table.contains(">metric_77<"), "{table}");
     assert!(!table.contains(">metric_0<"), "{table}");
 }
+
+/// The report with the verification `v` of `dir`'s run, as HTML.
+fn report_with(dir: &Path, v: &Path, name: &str) -> String {
+    let html_path = dir.join(format!("{name}.html"));
+    ok(
+        kneeform(
+            dir,
+            &[
+                "report",
+                "run",
+                v.to_str().unwrap(),
+                "--out",
+                html_path.to_str().unwrap(),
+            ],
+        ),
+        "report",
+    );
+    std::fs::read_to_string(&html_path).unwrap()
+}
+
+/// Issue 39 item 3 and issue 43 item 1: where a verification's grid
+/// boundary is undecided is on page one: its area in the verdict
+/// sentence, its cells hatched over the face-on picture (with a legend
+/// entry), and the zone table says whether it touches each zone. The step
+/// strikes node column x = -2 mm (lattice column -1) at every angle: one
+/// zone. Undecided nodes at x = 0 (the next column) touch it; at x = 20
+/// to 24 mm they do not.
+#[test]
+fn the_undecided_boundary_is_hatched_on_page_one_and_touches_the_zones_beside_it() {
+    let dir = step_run("report-undecided", "left");
+    let pitch: f64 = PITCH.parse().unwrap();
+    let with = |runs: Value, pitch: f64| {
+        let nodes: i64 = runs
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| r[2].as_i64().unwrap() - r[1].as_i64().unwrap() + 1)
+            .sum();
+        let mut v = console_like("PASS", 1.2);
+        v["pitch_mm"] = Value::from(pitch);
+        v["undecided_nodes"] = serde_json::json!({"pitch_mm": pitch, "nodes": nodes, "runs": runs});
+        v["undecided_area_mm2"] = Value::from(nodes as f64 * pitch * pitch);
+        v
+    };
+    let cases = [
+        ("beside", with(serde_json::json!([[0, 0, 0]]), pitch), "yes"),
+        ("far", with(serde_json::json!([[0, 10, 12]]), pitch), "no"),
+    ];
+    for (name, verify, touches) in cases {
+        let v = verification_of(&dir, name, verify, None);
+        let html = report_with(&dir, &v, name);
+        let json = read_json(&v.join("verify.json"));
+        // Page one's sentence: the area, cited, and where it is drawn.
+        let first = section_of(&html, "id=\"verdict-first-0\"");
+        let first = &first[..first.find("</p>").unwrap()];
+        let area = citations(first)
+            .into_iter()
+            .find(|(_, p, _)| p == "/undecided_area_mm2")
+            .unwrap_or_else(|| panic!("{name}: no undecided area on page one: {first}"));
+        assert!(shows(&json["undecided_area_mm2"], &area.2), "{area:?}");
+        assert!(first.contains("(hatched on the picture below)"), "{first}");
+        // The hatching over the main picture, and its legend entry.
+        let overlay = &html[html
+            .find("id=\"undecided-overlay\"")
+            .unwrap_or_else(|| panic!("{name}: no overlay"))..];
+        let overlay = &overlay[..overlay.find("</svg>").unwrap()];
+        let d = attr(&overlay[overlay.find("<path").unwrap()..], "d").unwrap();
+        assert_eq!(d.matches('M').count(), 1, "{d}");
+        assert!(html.contains("id=\"undecided-legend\""), "{name}");
+        // The hatched cell is where the JSON puts it: for "beside", the
+        // cell right of the struck column's, so its left edge is where the
+        // painted column ends in the picture, on the same rows.
+        if name == "beside" {
+            let numbers: Vec<f64> = d
+                .trim_start_matches('M')
+                .split(|c: char| c.is_ascii_alphabetic() || c == ' ')
+                .filter(|s| !s.is_empty())
+                .map(|s| s.parse().unwrap())
+                .collect();
+            let (left, top, width, height) = (numbers[0], numbers[1], numbers[2], numbers[3]);
+            let tag = img_by_id(&html, "main-view");
+            let mm: f64 = attr(tag, "data-mm-per-px").unwrap().parse().unwrap();
+            assert!((width - pitch / mm).abs() < 0.1 && (height - pitch / mm).abs() < 0.1);
+            let src = attr(tag, "src").unwrap();
+            let img = Image::decode(&unbase64(
+                src.strip_prefix("data:image/png;base64,").unwrap(),
+            ));
+            let row = (top + height / 2.0) as usize;
+            let painted: Vec<usize> = (0..img.width)
+                .filter(|&c| {
+                    let [r, g, b] = img.at(c, row);
+                    !(r == g && g == b)
+                })
+                .collect();
+            let end = *painted
+                .last()
+                .expect("the struck column is painted on the row") as f64
+                + 1.0;
+            assert!(
+                (left - end).abs() <= 1.0,
+                "hatched from {left}, painted to {end}"
+            );
+        }
+        // The zone table.
+        let table = &html[html.find("id=\"zones-table\"").unwrap()..];
+        let table = &table[..table.find("</table>").unwrap()];
+        assert!(table.contains("undecided boundary touches it"), "{table}");
+        assert!(
+            table.contains(&format!("<td class=\"undecided-touch\">{touches}</td>")),
+            "{name}: {table}"
+        );
+    }
+}

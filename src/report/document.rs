@@ -327,6 +327,8 @@ fn result_section(inputs: &Inputs) -> Markup {
     } else {
         "whose sliding knee-form strikes the point (the paper's Figure 13)"
     };
+    let undecided = super::undecided::Undecided::of(inputs.verifications, run.spec.pitch)
+        .filter(|u| !direct && u.runs.nodes > 0);
     html! {
         section id="result" {
             "\n"
@@ -334,7 +336,7 @@ fn result_section(inputs: &Inputs) -> Markup {
             "\n"
             @for (k, v) in inputs.verifications.iter().enumerate() {
                 @if let Some(json) = &v.verify {
-                    (verdict_first(k, json, v.verdict(), run.blind_spots.len()))
+                    (verdict_first(k, json, v.verdict(), (run.blind_spots.len(), undecided.as_ref().is_some_and(|u| u.k == k))))
                 }
                 @if let Some(json) = &v.converge {
                     (converge_first(k, json))
@@ -369,6 +371,9 @@ fn result_section(inputs: &Inputs) -> Markup {
                 div class="axes" {
                     (image_tag(&views.side, &inputs.pngs[0], "main-view", "view main", true))
                     (axes_svg(&views.side.view, if direct { "y" } else { "x" }))
+                    @if let Some(u) = &undecided {
+                        (u.overlay_svg(run, &views.side.view))
+                    }
                     (zone_labels_svg(run, &views.side.view))
                 }
                 "\n"
@@ -387,11 +392,14 @@ fn result_section(inputs: &Inputs) -> Markup {
                         " Boxed numbers: the largest struck zones' ids (the table below, "
                         code { "zones.csv" } ")."
                     }
+                    @if let Some(u) = &undecided {
+                        (u.legend())
+                    }
                 }
                 "\n"
             }
             "\n"
-            (zones_table(run))
+            (zones_table(run, undecided.as_ref()))
             "\n"
             figure {
                 "\n"
@@ -443,12 +451,19 @@ fn verdict_words(verdict: Verdict) -> (&'static str, &'static str) {
 /// The verdict of the `k`-th verification, first: its outcome and the
 /// sentence a regulator signs (SPEC, "The verdict"): the figure judged
 /// against the tolerance at the pitch, the sample, the undecided contacts
-/// and how far they may move the area's boundary, the cost side, the blind
-/// spots and the knee-form's L, assumed or given; then, on FAIL, the
+/// (with their area, and whether they are `hatched` on the picture) and
+/// how far they may move the area's boundary, the cost side, the blind
+/// spots (of `blind_cells` flagged) and the knee-form's L, assumed or
+/// given; then, on FAIL, the
 /// figures beyond the tolerance with their mechanism and the worst start
 /// (diagnostics). Section 5 has the tables. `blind_cells` is the run's
 /// flagged blind spots.
-fn verdict_first(k: usize, json: &Value, verdict: Verdict, blind_cells: usize) -> Markup {
+fn verdict_first(
+    k: usize,
+    json: &Value,
+    verdict: Verdict,
+    (blind_cells, hatched): (usize, bool),
+) -> Markup {
     let file = verify_label(k, "verify.json");
     let c = |p: &str| cite(&file, json, p);
     let (class, word) = verdict_words(verdict);
@@ -484,7 +499,15 @@ fn verdict_first(k: usize, json: &Value, verdict: Verdict, blind_cells: usize) -
             (json.get("angles_deg").and_then(Value::as_array).map_or(0, Vec::len))
             " angles) against the exact oracle, " (c("/counts/exact_strikes_decided"))
             " decided exact strikes. Undecided: " (c("/counts/exact_undecided"))
-            " exact contacts (either answer is right at this pitch), which may move the area's boundary by up to "
+            " exact contacts (either answer is right at this pitch)"
+            @if json.get("undecided_area_mm2").is_some_and(Value::is_number) {
+                " at " (c("/undecided_nodes/nodes")) " nodes of the verified grid, an area of "
+                (c("/undecided_area_mm2")) " mm" (SUP2)
+                @if hatched {
+                    " (hatched on the picture below)"
+                }
+            }
+            ", which may move the area's boundary by up to "
             (c("/area_distance_mm")) " mm (the all-strikes area distance). Cost: the grid's area reaches "
             (c("/area_false_alarm_decided_mm")) " mm beyond the exact one (the decided area false-alarm distance). Blind spots: "
             (c("/counts/blind_pairs")) " pairs touched one of the " (blind_cells)
@@ -613,7 +636,7 @@ fn image_tag(figure: &Figure, png: &[u8], id: &str, class: &str, mapping: bool) 
 /// coordinate grows with `sign` times the horizontal coordinate (x for
 /// push-and-slide, y for the direct approach), mirrored when the camera
 /// looks from the other side.
-fn horizontal_sign(view: &super::render::View) -> f64 {
+pub(crate) fn horizontal_sign(view: &super::render::View) -> f64 {
     if view.camera.right[0] + view.camera.right[1] < 0.0 {
         -1.0
     } else {
@@ -1702,10 +1725,11 @@ fn zone_labels_svg(run: &super::run::Run, view: &super::render::View) -> Markup 
 /// The struck zones' table (the largest [`TABLED_ZONES`], from
 /// `summary.json`'s `zones`); a run of an earlier version says it has
 /// none listed.
-fn zones_table(run: &super::run::Run) -> Markup {
+fn zones_table(run: &super::run::Run, undecided: Option<&super::undecided::Undecided>) -> Markup {
     let s = &run.summary;
     let j = &run.summary_json;
     let specks = s.zones.iter().filter(|z| z.speck).count();
+    let touched = undecided.and_then(|u| u.zones_touched(run));
     html! {
         @if s.zones.is_empty() {
             @if s.composite_nodes > 0 {
@@ -1716,10 +1740,19 @@ fn zones_table(run: &super::run::Run) -> Markup {
                 b { "Struck zones: " } (s.zones.len()) " connected areas of the composite (8-connected nodes), "
                 (specks) " of them specks under " (crate::zones::SPECK_NODES) " nodes, each listed beside the zone nearest it; the "
                 (s.zones.len().min(TABLED_ZONES)) " largest below, all in " code { "zones.csv" } ". Coordinates in mm, the part's own."
+                @if let (Some(u), Some(t)) = (undecided, &touched) {
+                    " An undecided boundary touches a zone when a node of the zone is on or next to (8-adjacent) one of verification "
+                    (u.k + 1) "'s undecided nodes (hatched above): "
+                    (t.iter().filter(|&&b| b).count()) " of the " (t.len()) " zones."
+                }
             }
             "\n"
             table class="compact" id="zones-table" {
-                tr { th { "zone" } th { "area (mm" (SUP2) ")" } th { "centroid x, y, z" } th { "angles striking it (degrees)" } th { "most angles at a node" } th { "blind spot touches it" } th { "speck beside zone" } }
+                tr {
+                    th { "zone" } th { "area (mm" (SUP2) ")" } th { "centroid x, y, z" } th { "angles striking it (degrees)" } th { "most angles at a node" } th { "blind spot touches it" }
+                    @if touched.is_some() { th { "undecided boundary touches it" } }
+                    th { "speck beside zone" }
+                }
                 @for (k, z) in s.zones.iter().enumerate().take(TABLED_ZONES) {
                     @let at = |field: &str| cite(SUMMARY, j, &format!("/zones/{k}/{field}"));
                     tr {
@@ -1729,6 +1762,9 @@ fn zones_table(run: &super::run::Run) -> Markup {
                         td { (at("angle_runs")) }
                         td { (at("max_count")) }
                         td { (at("touches_blind_spot")) }
+                        @if let Some(t) = &touched {
+                            td class="undecided-touch" { (if t[k] { "yes" } else { "no" }) }
+                        }
                         td { @if z.beside.is_some() { (at("beside")) } @else { "-" } }
                     }
                 }

@@ -11,7 +11,9 @@
 //! returns), `render` (the CPU renderer: orthographic, z-buffered, Lambert
 //! shading, and its pixel ↔ part mapping), `views` (the report's views of
 //! the part and how they are painted), `run` and `verify` (reading the run
-//! and verification files back), `document` (the page, a `maud` template)
+//! and verification files back), `undecided` (where a verification's
+//! grid boundary is undecided: hatched on the picture, and the zones it
+//! touches), `document` (the page, a `maud` template)
 //! and `html` (number formatting and citations).
 //!
 //! **Invariant:** every value the report shows from a run comes from the
@@ -27,6 +29,7 @@ mod error;
 mod html;
 mod render;
 mod run;
+mod undecided;
 mod verify;
 mod view3d;
 mod views;
