@@ -139,16 +139,17 @@ fn the_undecided_nodes_lie_where_the_ramp_is_at_the_threshold() {
         ..Setup::default()
     };
     let sigma = setup.rule.sigma;
-    let window = setup.rule.window_mm().expect("the window rule is the default");
+    let window = setup
+        .rule
+        .window_mm()
+        .expect("the window rule is the default");
     let verify = |slope: f64| {
         let xs = lines(-300.0, 300.0, 10.0, &[x0, x1]);
         let zs = lines(-150.0, 150.0, 10.0, &[]);
         let tris = lattice_part(&xs, &zs, |x, _| slope * (x.clamp(x0, x1) - x1));
         let part = Part::from_triangles("ramp", tris, 1.0, Side::Left).unwrap();
         let options = VerifyOptions {
-            selection: StartSelection::Strip {
-                z: [-pitch, pitch],
-            },
+            selection: StartSelection::Strip { z: [-pitch, pitch] },
             tie_band_per_mm: TieBand::DEFAULT_PER_MM,
             tolerance: 1.0,
             budget_s: None,
@@ -185,6 +186,12 @@ fn the_undecided_nodes_lie_where_the_ramp_is_at_the_threshold() {
     }
     // The area is the stored set's nodes times the pitch squared.
     let area = tie.undecided_area_mm2.expect("verify records the area");
-    assert!((area - nodes.len() as f64 * pitch * pitch).abs() < 1e-6, "{area}");
-    assert!(tie.sentence().contains(&format!("({} mm^2)", kneeform::limits::short(area))));
+    assert!(
+        (area - nodes.len() as f64 * pitch * pitch).abs() < 1e-6,
+        "{area}"
+    );
+    assert!(
+        tie.sentence()
+            .contains(&format!("({} mm^2)", kneeform::limits::short(area)))
+    );
 }
