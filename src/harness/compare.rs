@@ -861,7 +861,10 @@ pub(crate) fn pair_results(
             .iter()
             .filter_map(|p| node_of(p[0], p[1]))
             .collect();
-        let undecided = undecided_nodes(&cmp.points.undecided, &node_of);
+        // Kept as nodes only: a study holds every pair's points at once
+        // (`BYTES_PER_CONTACT`), and the undecided contacts were 41% of
+        // the console's.
+        let undecided = undecided_nodes(&std::mem::take(&mut cmp.points.undecided), &node_of);
         PairResult {
             row: row_of(i, j, fp.angle_deg, status, &cmp),
             grid_nodes: g.colliding.iter().map(|c| c.node).collect(),

@@ -459,7 +459,8 @@ pub struct StartPoints {
     /// The exact contacts that are not decided non-strikes.
     pub possible: Vec<[f64; 2]>,
     /// The undecided exact contacts (in the tie band: either answer is
-    /// right at this pitch): where the grid's boundary is undecided.
+    /// right at this pitch): where the grid's boundary is undecided. A
+    /// comparison takes them as their nearest nodes and keeps no point.
     pub undecided: Vec<[f64; 2]>,
     /// The exact push contact, when placed: a point of the exact curve for
     /// false alarms (see [`compare`]).
