@@ -33,7 +33,7 @@ use serde_json::Value;
 use super::compare::{BOTH, Comparison, DIRECT_ONLY, MATCH_PITCHES, SLIDE_ONLY};
 use super::html::{ASYMP, MIDDOT, NBSP, SUP2, TIMES, cite, fmt_num, png_uri, svg_empty, utc_date};
 use super::run::Run;
-use super::verify::{Verdict, Verification, escape_pointer, scalars};
+use super::verify::{Verdict, Verification, escape_pointer, scalars, verify_label};
 use super::views::{ANGLE_COLOUR, Figure, Views, composite_colour, ramp_len};
 
 /// The border colour of the main image: a blue no part shading or ramp
@@ -42,11 +42,6 @@ pub const MAIN_BORDER: [u8; 3] = [0, 90, 181];
 
 /// The file name the report cites the run's summary as.
 pub(crate) const SUMMARY: &str = crate::output::SUMMARY_JSON;
-
-/// The citation prefix of the `k`-th verification directory's files.
-pub(crate) fn verify_label(k: usize, file: &str) -> String {
-    format!("verify[{k}]/{file}")
-}
 
 /// Everything the page is made of.
 pub(crate) struct Inputs<'a> {
@@ -632,18 +627,6 @@ fn image_tag(figure: &Figure, png: &[u8], id: &str, class: &str, mapping: bool) 
     }
 }
 
-/// The sign of the face-on view's horizontal axis: the picture's column
-/// coordinate grows with `sign` times the horizontal coordinate (x for
-/// push-and-slide, y for the direct approach), mirrored when the camera
-/// looks from the other side.
-pub(crate) fn horizontal_sign(view: &super::render::View) -> f64 {
-    if view.camera.right[0] + view.camera.right[1] < 0.0 {
-        -1.0
-    } else {
-        1.0
-    }
-}
-
 /// The main image's axes: mm ticks on its lower and left edges, drawn
 /// over the image (an SVG of the image's pixel size laid on it; its
 /// labels reach out into the wrapper's margin), so they scale with it.
@@ -652,7 +635,7 @@ pub(crate) fn horizontal_sign(view: &super::render::View) -> f64 {
 /// x runs leftwards).
 fn axes_svg(view: &super::render::View, horizontal: &str) -> Markup {
     let (w, h) = (view.width as f64, view.height as f64);
-    let sign = horizontal_sign(view);
+    let sign = view.horizontal_sign();
     let mm = view.mm_per_px;
     // The horizontal coordinate at pixel edge `c` is `sign * (u_left + c mm)`.
     let h_at = |c: f64| sign * (view.u_left + c * mm);
@@ -1692,7 +1675,7 @@ const TABLED_ZONES: usize = 15;
 /// specks are left out (the table names them).
 fn zone_labels_svg(run: &super::run::Run, view: &super::render::View) -> Markup {
     let (w, h) = (view.width as f64, view.height as f64);
-    let sign = horizontal_sign(view);
+    let sign = view.horizontal_sign();
     let direct = run.summary.approach == Approach::Direct;
     let labels: Vec<(usize, f64, f64)> = run
         .summary

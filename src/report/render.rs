@@ -78,6 +78,18 @@ pub(crate) struct View {
 }
 
 impl View {
+    /// The sign of the face-on view's horizontal axis: the picture's
+    /// column coordinate grows with `sign` times the horizontal coordinate
+    /// (x for push-and-slide, y for the direct approach), mirrored when the
+    /// camera looks from the other side.
+    pub fn horizontal_sign(&self) -> f64 {
+        if self.camera.right[0] + self.camera.right[1] < 0.0 {
+            -1.0
+        } else {
+            1.0
+        }
+    }
+
     /// The view that fits `triangles` into `width` pixels (less `margin` on
     /// each side), as tall as the part needs plus the same margin.
     pub fn fit(camera: Camera, triangles: &[Triangle], width: usize, margin: usize) -> View {

@@ -51,7 +51,7 @@ impl<'a> Undecided<'a> {
 
     /// The file its figures are cited from.
     fn file(&self) -> String {
-        super::document::verify_label(self.k, "verify.json")
+        super::verify::verify_label(self.k, "verify.json")
     }
 
     /// For each of the run's zones (`summary.json`'s, in their order),
@@ -77,7 +77,7 @@ impl<'a> Undecided<'a> {
             return html! {};
         }
         let (w, h) = (view.width as f64, view.height as f64);
-        let sign = super::document::horizontal_sign(view);
+        let sign = view.horizontal_sign();
         let (p, mm) = (self.runs.pitch_mm, view.mm_per_px);
         let column = |x: f64| (sign * x - view.u_left) / mm;
         let mut path = String::new();

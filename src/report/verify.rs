@@ -34,6 +34,11 @@ pub struct Verification {
     pub figures: Vec<(String, Vec<u8>)>,
 }
 
+/// The citation prefix of the `k`-th verification directory's files.
+pub(crate) fn verify_label(k: usize, file: &str) -> String {
+    format!("verify[{k}]/{file}")
+}
+
 /// The verdict of a `verify` run against its tolerance.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Verdict {
