@@ -67,7 +67,67 @@ pub(crate) struct Cells {
     blind: Vec<((usize, usize), f64)>,
     /// The grid's heights (mm), row-major.
     heights: Vec<f64>,
+    /// Under the surface level: per cell `(i, j)` (row-major, `nx - 1`
+    /// cells a row), the largest `S - y` and `y - S` measured between the
+    /// grid's surface `S` and the mesh ([`Cells::with_surface_error`]).
+    surface_error: Option<Vec<SurfaceError>>,
 }
+
+/// How far the grid's surface `S` lies from the mesh on a cell, each way
+/// (mm, `>= 0`): `above` the largest `S - y` (the surface deeper than the
+/// part: cutting a convex crease between nodes, the grid's level too
+/// deep), `below` the largest `y - S` (the surface standing proud of the
+/// part, the grid's level too shallow).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct SurfaceError {
+    /// The largest `S - y` (mm).
+    pub above: f64,
+    /// The largest `y - S` (mm).
+    pub below: f64,
+}
+
+impl SurfaceError {
+    /// Both sides' largest of `self` and `other`.
+    pub fn max(self, other: SurfaceError) -> SurfaceError {
+        SurfaceError {
+            above: self.above.max(other.above),
+            below: self.below.max(other.below),
+        }
+    }
+
+    /// Unbounded both ways.
+    pub const UNBOUNDED: SurfaceError = SurfaceError {
+        above: f64::INFINITY,
+        below: f64::INFINITY,
+    };
+}
+
+/// The grid's surface `S` on cell `(i, j)` of the heights `h` (row-major,
+/// `nx` a row) at `(fx, fz)` in it (`0..=1` each): SPEC v4's two triangles
+/// split along the diagonal from `(i, j)` to `(i+1, j+1)`, as
+/// [`crate::surface::SurfaceGrid`] has them, read on the cell's own
+/// corners (a point on its edge too); `None` where a corner is off the
+/// part.
+fn cell_surface(h: &[f64], nx: usize, (i, j): (usize, usize), (fx, fz): (f64, f64)) -> Option<f64> {
+    let n = j * nx + i;
+    let (h00, h10, h01, h11) = (h[n], h[n + 1], h[n + nx], h[n + nx + 1]);
+    if !(h00.is_finite() && h10.is_finite() && h01.is_finite() && h11.is_finite()) {
+        return None;
+    }
+    Some(if fx >= fz {
+        h00 + fx * (h10 - h00) + fz * (h11 - h10)
+    } else {
+        h00 + fz * (h01 - h00) + fx * (h11 - h01)
+    })
+}
+
+/// Mesh samples per pitch (along x and z) that measure the surface's
+/// error in a cell ([`Cells::with_surface_error`]).
+pub(crate) const SURFACE_SAMPLES: usize = 8;
+
+/// Cell rows whose finer samples [`Cells::with_surface_error`] holds at
+/// once.
+const SURFACE_BAND_ROWS: usize = 16;
 
 impl Cells {
     /// The cells of `grid` (sampled from `triangles`), blind spots being
@@ -94,7 +154,158 @@ impl Cells {
             spec: grid.spec,
             blind,
             heights: grid.h.clone(),
+            surface_error: None,
         }
+    }
+
+    /// These cells with the surface level's error measured against the
+    /// mesh (`triangles`, from which `grid`, these cells' grid, was
+    /// sampled): per cell, the largest `S - y` and `y - S` over the mesh sampled at
+    /// [`SURFACE_SAMPLES`] points per pitch along x and z on the cell's
+    /// closed square (`y` the mesh's lowest height there, as the grid's
+    /// nodes sample it; `S` the grid's piecewise-linear surface, SPEC v4).
+    /// Where one of them has no height and the other has (a cell with a
+    /// node off the part over mesh, the part's edge between the last node
+    /// and the true edge; or a hole under a surface), `+inf`: the grid
+    /// cannot see what the exact knee-form rests on there.
+    ///
+    /// It is second order in the pitch on a smooth part (`p^2 |h''| / 8`),
+    /// first order across a crease (`p |delta g| / 4`) and at a riser; it
+    /// is measured, not assumed: a crease between two samples is seen at
+    /// most `p / 16` from its peak.
+    pub fn with_surface_error(mut self, triangles: &[Triangle], grid: &HeightGrid) -> Cells {
+        use rayon::prelude::*;
+        let spec = grid.spec;
+        let (nx, nz) = (spec.nx, spec.nz);
+        if nx < 2 || nz < 2 {
+            self.surface_error = Some(Vec::new());
+            return self;
+        }
+        let (cx, cz) = (nx - 1, nz - 1);
+        let k = SURFACE_SAMPLES;
+        let bands: Vec<Vec<SurfaceError>> = (0..cz)
+            .step_by(SURFACE_BAND_ROWS)
+            .collect::<Vec<_>>()
+            .into_par_iter()
+            .map(|j0| {
+                let j1 = (j0 + SURFACE_BAND_ROWS).min(cz);
+                let fine = GridSpec {
+                    pitch: spec.pitch / k as f64,
+                    i_origin: k as i64 * spec.i_origin,
+                    j_origin: k as i64 * (spec.j_origin + j0 as i64),
+                    nx: k * cx + 1,
+                    nz: k * (j1 - j0) + 1,
+                };
+                let mesh = HeightGrid::sample(triangles, fine);
+                let mut errors = vec![SurfaceError::default(); cx * (j1 - j0)];
+                for (b, row) in (j0..j1).enumerate() {
+                    for i in 0..cx {
+                        let mut worst = SurfaceError::default();
+                        for fb in 0..=k {
+                            for fa in 0..=k {
+                                let y = mesh.at(k * i + fa, k * b + fb);
+                                let (fx, fz) = (fa as f64 / k as f64, fb as f64 / k as f64);
+                                let s = cell_surface(&grid.h, nx, (i, row), (fx, fz))
+                                    .unwrap_or(f64::INFINITY);
+                                let e = match (s.is_finite(), y.is_finite()) {
+                                    (true, true) => SurfaceError {
+                                        above: (s - y).max(0.0),
+                                        below: (y - s).max(0.0),
+                                    },
+                                    (false, false) => SurfaceError::default(),
+                                    _ => SurfaceError::UNBOUNDED,
+                                };
+                                worst = worst.max(e);
+                            }
+                        }
+                        errors[b * cx + i] = worst;
+                    }
+                }
+                errors
+            })
+            .collect();
+        self.surface_error = Some(bands.concat());
+        self
+    }
+
+    /// Whether the surface level's error is measured here
+    /// ([`Cells::with_surface_error`]).
+    pub fn has_surface_error(&self) -> bool {
+        self.surface_error.is_some()
+    }
+
+    /// Under the surface level ([`Cells::with_surface_error`]), how far
+    /// the grid's surface lies from the mesh near the mesh point `p`
+    /// (`[x, y, z]`, mm) each way; `None` where it was not measured.
+    /// `above` is `S - y` at `p` itself (at least 0; `+inf` where the grid
+    /// has no surface there): the grid's level, the surface's minimum over
+    /// what the footprint swept, is at most that much deeper than the exact
+    /// knee-form's resting on `p`. `below` is the largest `y - S` measured
+    /// on the cells within half a pitch of `p` in xz (`+inf` where one of
+    /// them cannot see the mesh, or `p` lies off the grid): the grid's
+    /// minimum may lie beside `p`, where the surface stands proud of the
+    /// part.
+    pub fn surface_error_near(&self, p: [f64; 3]) -> Option<SurfaceError> {
+        let errors = self.surface_error.as_ref()?;
+        let spec = self.spec;
+        if spec.nx < 2 || spec.nz < 2 {
+            return Some(SurfaceError::UNBOUNDED);
+        }
+        let (cx, cz) = (spec.nx - 1, spec.nz - 1);
+        let reach = spec.pitch / 2.0 + CELL_TOL;
+        let span = |v: f64, origin: f64, cells: usize| {
+            let lo = ((v - reach - origin) / spec.pitch).floor().max(0.0);
+            let hi = ((v + reach - origin) / spec.pitch)
+                .floor()
+                .min(cells as f64 - 1.0);
+            (lo.is_finite() && hi.is_finite() && lo <= hi).then_some(lo as usize..=hi as usize)
+        };
+        let (Some(columns), Some(rows)) = (span(p[0], spec.x(0), cx), span(p[2], spec.z(0), cz))
+        else {
+            return Some(SurfaceError::UNBOUNDED);
+        };
+        let mut below = 0.0f64;
+        for j in rows {
+            for i in columns.clone() {
+                below = below.max(errors[j * cx + i].below);
+            }
+        }
+        let above = match self.surface_at(p[0], p[2]) {
+            Some(s) => (s - p[1]).max(0.0),
+            None => f64::INFINITY,
+        };
+        Some(SurfaceError { above, below })
+    }
+
+    /// The grid's surface `S` at `(x, z)` (mm; SPEC v4: each cell split
+    /// along its diagonal from `(i, j)` to `(i+1, j+1)`, as
+    /// [`crate::surface::SurfaceGrid`] has it), `None` off the grid or on a
+    /// cell with a node off the part.
+    fn surface_at(&self, x: f64, z: f64) -> Option<f64> {
+        let spec = self.spec;
+        let u = (x - spec.x(0)) / spec.pitch;
+        let w = (z - spec.z(0)) / spec.pitch;
+        let (nx, nz) = (spec.nx, spec.nz);
+        let tol = CELL_TOL / spec.pitch;
+        if !(u >= -tol && w >= -tol && u <= (nx - 1) as f64 + tol && w <= (nz - 1) as f64 + tol) {
+            return None;
+        }
+        // The cells whose closed square holds the point (within
+        // `CELL_TOL`): on an edge, the surface of either that has one.
+        let span = |v: f64, cells: usize| {
+            let lo = ((v - tol).floor().max(0.0) as usize).min(cells - 1);
+            let hi = ((v + tol).floor().max(0.0) as usize).min(cells - 1);
+            lo..=hi
+        };
+        let (columns, rows) = (span(u, nx - 1), span(w, nz - 1));
+        rows.flat_map(|j| columns.clone().map(move |i| (i, j)))
+            .find_map(|(i, j)| {
+                let (fx, fz) = (
+                    (u - i as f64).clamp(0.0, 1.0),
+                    (w - j as f64).clamp(0.0, 1.0),
+                );
+                cell_surface(&self.heights, nx, (i, j), (fx, fz))
+            })
     }
 
     /// The grid's pitch (mm).
@@ -465,6 +676,125 @@ mod tests {
         // A deeper threshold flags nothing.
         let deep = Cells::of(&triangles, &grid, 3.5);
         assert!(!deep.touches_blind_spot([21.0, -3.0, 7.0]));
+    }
+
+    /// A V-shaped ridge along z, `y = g |x - x_c|` (its crease the part's
+    /// point nearest the knee), at pitch 2 mm over [0, 40] x [0, 20].
+    fn ridge(g: f64, x_c: f64) -> (Vec<Triangle>, HeightGrid) {
+        let xs = [0.0, x_c, 40.0];
+        let zs = [0.0, 10.0, 20.0];
+        let triangles = tessellate(&xs, &zs, |i, _| g * (xs[i] - x_c).abs());
+        let spec = GridSpec {
+            pitch: 2.0,
+            i_origin: 0,
+            j_origin: 0,
+            nx: 21,
+            nz: 11,
+        };
+        let grid = HeightGrid::sample(&triangles, spec);
+        (triangles, grid)
+    }
+
+    #[test]
+    fn the_surface_lies_on_a_plane_and_cuts_a_crease_between_nodes_by_p_delta_g_over_4() {
+        // A plane: the surface is the part, no error either way.
+        let (plane, grid) = ridge(0.25, 0.0);
+        let cells = Cells::of(&plane, &grid, 10.0).with_surface_error(&plane, &grid);
+        let e = cells.surface_error_near([9.0, 0.25 * 9.0, 7.0]).unwrap();
+        assert!(e.above < 1e-9 && e.below < 1e-9, "{e:?}");
+        // Not measured: none.
+        assert_eq!(
+            Cells::of(&plane, &grid, 10.0).surface_error_near([9.0, 2.25, 7.0]),
+            None
+        );
+        // A ridge whose crease runs mid-cell (x = 21, between nodes at 20
+        // and 22): the nodes sit g p / 2 above the crease, the surface
+        // between them too (SPEC's `p |delta g| / 4` with delta g = 2 g).
+        let g = 0.3;
+        let (triangles, grid) = ridge(g, 21.0);
+        let cells = Cells::of(&triangles, &grid, 10.0).with_surface_error(&triangles, &grid);
+        let on_crease = cells.surface_error_near([21.0, 0.0, 7.0]).unwrap();
+        assert!(
+            (on_crease.above - g * 2.0 / 2.0).abs() < 1e-9,
+            "{on_crease:?}"
+        );
+        // The surface never stands proud of a convex ridge.
+        assert!(on_crease.below < 1e-9, "{on_crease:?}");
+        // Beside the crease, the same cell's surface is measured: `above`
+        // is read at the point itself, `S - y` there.
+        let beside = cells.surface_error_near([20.5, g * 0.5, 7.0]).unwrap();
+        // The nodes at 20 and 22 both lie g above the crease: S = g there.
+        let s_at = g;
+        assert!((beside.above - (s_at - g * 0.5)).abs() < 1e-9, "{beside:?}");
+        // Far from the crease, on a plane of the ridge: no error.
+        let far = cells.surface_error_near([9.0, g * 12.0, 7.0]).unwrap();
+        assert!(far.above < 1e-9 && far.below < 1e-9, "{far:?}");
+        // A crease on a node column: the nodes sample it, no error.
+        let (triangles, grid) = ridge(g, 20.0);
+        let cells = Cells::of(&triangles, &grid, 10.0).with_surface_error(&triangles, &grid);
+        let on_node = cells.surface_error_near([20.0, 0.0, 7.0]).unwrap();
+        assert!(on_node.above < 1e-9 && on_node.below < 1e-9, "{on_node:?}");
+    }
+
+    #[test]
+    fn the_surface_error_is_unbounded_where_the_grid_has_no_surface_over_the_mesh() {
+        // The part ends at x = 21, between node columns 20 and 22: the
+        // cell [20, 22] has a node off the part over mesh.
+        let xs = [0.0, 10.0, 21.0];
+        let zs = [0.0, 10.0, 20.0];
+        let triangles = tessellate(&xs, &zs, |_, _| 0.0);
+        let spec = GridSpec {
+            pitch: 2.0,
+            i_origin: 0,
+            j_origin: 0,
+            nx: 21,
+            nz: 11,
+        };
+        let grid = HeightGrid::sample(&triangles, spec);
+        let cells = Cells::of(&triangles, &grid, 10.0).with_surface_error(&triangles, &grid);
+        let edge = cells.surface_error_near([20.8, 0.0, 7.0]).unwrap();
+        assert_eq!(edge.above, f64::INFINITY);
+        assert_eq!(edge.below, f64::INFINITY);
+        // On the last node column on the part, the surface of the cell
+        // before it reads the part there: `above` is none, though the cell
+        // after it has no surface (its `below`, measured within half a
+        // pitch, is unbounded).
+        let column = cells.surface_error_near([20.0, 0.0, 7.0]).unwrap();
+        assert_eq!(column.above, 0.0);
+        assert_eq!(column.below, f64::INFINITY);
+        // Inside, more than half a pitch from that cell: measured, none.
+        let inside = cells.surface_error_near([18.5, 0.0, 7.0]).unwrap();
+        assert!(inside.above < 1e-9 && inside.below < 1e-9, "{inside:?}");
+    }
+
+    #[test]
+    fn the_cells_surface_is_the_surface_levels() {
+        let (_, grid) = ribbed(0.25);
+        let grid = HeightGrid {
+            h: grid
+                .h
+                .iter()
+                .enumerate()
+                .map(|(n, h)| h + 0.01 * ((n * 7919) % 13) as f64)
+                .collect(),
+            ..grid
+        };
+        let cells = Cells::of_blind_spots(&grid, &[]);
+        let surface = crate::surface::SurfaceGrid::new(&grid);
+        let mut rng = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..500 {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            let u = (rng % 20_000) as f64 / 1000.0;
+            let w = ((rng >> 20) % 10_000) as f64 / 1000.0;
+            let expected = surface.at(u, w);
+            let got = cells.surface_at(2.0 * u, 2.0 * w).unwrap();
+            assert!(
+                (got - expected).abs() < 1e-9,
+                "({u}, {w}): {got} against {expected}"
+            );
+        }
     }
 
     #[test]

@@ -20,7 +20,7 @@ use super::trace::{Fault, GridTrace, grid_trace, grid_trace_joining};
 use crate::grid::{GridSpec, HeightGrid};
 use crate::kneeform::{GridFootprint, KneeForm};
 use crate::mesh::Triangle;
-use crate::strike::StrikeRule;
+use crate::strike::{Level, StrikeRule};
 use crate::summary::{Evidence, Outcome};
 
 /// Starts per block of a row whose traces are chained
@@ -775,11 +775,23 @@ pub(crate) fn pair_results(
     }
     // The blind spots: the analysis's where it found them, else found
     // here.
+    // Under the surface level, with the surface's error measured against
+    // the mesh (the two-sided tie band's bound).
+    let surface = options.rule.level == Level::Surface;
     let owned;
     let cells = match cells {
-        Some(cells) => cells,
+        Some(cells) if !surface || cells.has_surface_error() => cells,
+        Some(cells) => {
+            owned = cells.clone().with_surface_error(triangles, grid);
+            &owned
+        }
         None => {
-            owned = Cells::of(triangles, grid, options.blind_depth);
+            let found = Cells::of(triangles, grid, options.blind_depth);
+            owned = if surface {
+                found.with_surface_error(triangles, grid)
+            } else {
+                found
+            };
             &owned
         }
     };
@@ -805,7 +817,7 @@ pub(crate) fn pair_results(
             }
         }
     }
-    let bands = FinerBands::new(triangles, options.blind_depth);
+    let bands = FinerBands::new(triangles, options.blind_depth, surface);
     // A pair's comparison, given its grid trace `g`; `finer_before` holds
     // the traces of the start one node to the -x on the finer grids where
     // it was refined (its pair came just before in the run), to join, and
@@ -1024,6 +1036,8 @@ struct FinerBands<'a> {
     triangles: &'a [Triangle],
     /// The blind-spot threshold of their cells (mm).
     blind_depth: f64,
+    /// Whether their cells measure the surface level's error.
+    surface: bool,
     recent: Mutex<Vec<(BandKey, Band)>>,
 }
 
@@ -1036,10 +1050,11 @@ type Band = Arc<OnceLock<(HeightGrid, Cells)>>;
 const KEPT_BANDS: usize = 4;
 
 impl<'a> FinerBands<'a> {
-    fn new(triangles: &'a [Triangle], blind_depth: f64) -> FinerBands<'a> {
+    fn new(triangles: &'a [Triangle], blind_depth: f64, surface: bool) -> FinerBands<'a> {
         FinerBands {
             triangles,
             blind_depth,
+            surface,
             recent: Mutex::new(Vec::new()),
         }
     }
@@ -1067,6 +1082,11 @@ impl<'a> FinerBands<'a> {
         cell.get_or_init(|| {
             let fine = HeightGrid::sample(self.triangles, spec);
             let cells = Cells::of(self.triangles, &fine, self.blind_depth);
+            let cells = if self.surface {
+                cells.with_surface_error(self.triangles, &fine)
+            } else {
+                cells
+            };
             (fine, cells)
         });
         cell
@@ -1824,7 +1844,7 @@ mod tests {
         let traces = exact_traces(&tris, &starts, &angles, &oracle).unwrap();
         // The bands kept across starts, angles and pitches, as the pairs
         // use them.
-        let bands = FinerBands::new(&tris, options.blind_depth);
+        let bands = FinerBands::new(&tris, options.blind_depth, false);
         for halvings in [1, 2] {
             let whole = finer(grid.spec, halvings);
             assert_eq!(whole.x(whole.nx - 1), grid.spec.x(grid.spec.nx - 1));

@@ -4,7 +4,7 @@
 use kneeform_oracle::{ContactPoint, FailureReason, LevelCurve, StartStatus, StartTrace};
 use serde::{Deserialize, Serialize};
 
-use super::causes::{Cells, RISE_REACH};
+use super::causes::{Cells, RISE_REACH, SurfaceError};
 use super::nearest::PointSet;
 use super::trace::GridTrace;
 
@@ -203,14 +203,17 @@ pub(crate) enum ExactRule {
     /// the grid's cells ([`LevelErrorBound`]) and shrink with the pitch.
     ///
     /// **Under the surface level** (SPEC v4) the grid's level error goes
-    /// both ways: the surface cuts above a convex crease between nodes (the
-    /// level too deep, as the node level's) and may lie below the part
-    /// elsewhere, and the grid judges the surface near the touched point,
-    /// not a node. So the band is two-sided (`two_sided`): each side is
-    /// widened by both terms, the lowest near node's rise and the level
-    /// error's bound `W` back. Both terms are the node level's measured
-    /// bounds from the mesh's cells; a bound of the surface lying below a
-    /// concave part between nodes is not measured yet.
+    /// both ways (`two_sided`): the surface cuts below a convex crease
+    /// between nodes (the level too deep, as the node level's) and may
+    /// stand proud of the part elsewhere (too shallow), and the grid judges
+    /// the surface near the touched point, not a node. The band is then the
+    /// surface's own error, measured against the mesh near each contact
+    /// ([`Cells::with_surface_error`], [`LevelErrorBound::surface_at`],
+    /// `surface_margins`): second order in the pitch on a smooth part,
+    /// first order across a crease and at a riser, unbounded where the
+    /// grid has no surface over the mesh (the part's edge between its last
+    /// node and the true edge). Where the cells do not measure it, each
+    /// side is widened by both of the node level's terms.
     Window {
         /// `W` (mm).
         window: f64,
@@ -275,6 +278,25 @@ fn decide_drop(
     }
 }
 
+/// Under the surface level, how far short of the exact drop over the
+/// window the grid's may fall and how far beyond it it may reach (mm),
+/// given the surface's error and the exact level's fall over a step at
+/// the contact (`now`) and one window back (`back`)
+/// ([`LevelErrorBound::surface_at`]). The grid's drop is its level `W`
+/// back less its level now, each judged at the grid's step at or after
+/// the exact contact's travel, within a step: short by at most the level
+/// back too shallow (`below`, and the exact level's fall over the step
+/// there) plus the level now too deep (`above`); beyond by at most the
+/// level back too deep plus the level now too shallow (and the fall over
+/// the step now).
+fn surface_margins(now: (SurfaceError, f64), back: (SurfaceError, f64)) -> (f64, f64) {
+    let ((now, fall_now), (back, fall_back)) = (now, back);
+    (
+        back.below + fall_back + now.above,
+        back.above + now.below + fall_now,
+    )
+}
+
 /// The exact contacts of a placed start with their standing by `rule`,
 /// against the grid's level error `bound` along it.
 fn classify(
@@ -302,15 +324,27 @@ fn classify(
                 // fall short by that.
                 let node = bound.lowest[k];
                 let threshold = band.sigma * window;
+                // Under the surface level, the surface's own measured
+                // error at both ends of the window, each way.
+                let surface = match (
+                    bound.surface_at(c.travel),
+                    bound.surface_at(c.travel - window),
+                ) {
+                    (Some(now), Some(back)) if two_sided => Some(surface_margins(now, back)),
+                    _ => None,
+                };
+                let decision = match surface {
+                    Some((short, beyond)) => {
+                        decide_drop((drop.drop, drop.error), threshold, (short, beyond), false)
+                    }
+                    None => {
+                        decide_drop((drop.drop, drop.error), threshold, (node, grid), two_sided)
+                    }
+                };
                 ExactStrike {
                     contact: c,
                     strike: drop.drop > threshold,
-                    decision: decide_drop(
-                        (drop.drop, drop.error),
-                        threshold,
-                        (node, grid),
-                        two_sided,
-                    ),
+                    decision,
                 }
             }
         })
@@ -609,6 +643,9 @@ pub(crate) struct LevelErrorBound<'a> {
     lowest: Vec<f64>,
     push_rise: f64,
     pitch: f64,
+    /// Under the surface level, the surface's measured error near each
+    /// contact and near the push contact ([`Cells::surface_error_near`]).
+    surface: Option<(Vec<SurfaceError>, SurfaceError)>,
 }
 
 impl<'a> LevelErrorBound<'a> {
@@ -639,6 +676,18 @@ impl<'a> LevelErrorBound<'a> {
             .iter()
             .map(|c| cells.rises_at(c.witness, push_rows, ahead(c)))
             .unzip();
+        let surface = exact
+            .contacts
+            .iter()
+            .map(|c| cells.surface_error_near(c.witness))
+            .collect::<Option<Vec<SurfaceError>>>()
+            .map(|errors| {
+                let push = exact
+                    .push_witness
+                    .and_then(|w| cells.surface_error_near(w))
+                    .unwrap_or(SurfaceError::UNBOUNDED);
+                (errors, push)
+            });
         Some(LevelErrorBound {
             curve,
             travels: exact.contacts.iter().map(|c| c.travel).collect(),
@@ -652,7 +701,28 @@ impl<'a> LevelErrorBound<'a> {
                 }
             }),
             pitch,
+            surface,
         })
+    }
+
+    /// Under the surface level, how far the grid's level may lie from the
+    /// exact one at travel `s` (mm; `None` where the surface's error was
+    /// not measured): the surface's measured error near the exact contacts
+    /// in force from `s` to one step (`p / 8`) of travel on (the push
+    /// contact's before the first), each way ([`SurfaceError`]: the grid's
+    /// level is the surface's minimum over the swept footprint, at most
+    /// `above` deeper than the mesh's minimum there and at most `below`
+    /// shallower), and the exact level's fall over that step (the grid
+    /// evaluates its level at steps of `p / 8`, SPEC v4).
+    pub fn surface_at(&self, s: f64) -> Option<(SurfaceError, f64)> {
+        let (errors, push) = self.surface.as_ref()?;
+        let step = self.pitch / crate::surface::STEPS_PER_PITCH;
+        let in_force = |t: f64| self.travels.partition_point(|&c| c <= t + LEVEL_TOL);
+        let (from, to) = (in_force(s), in_force(s + step));
+        let before = if from == 0 { *push } else { errors[from - 1] };
+        let error = errors[from..to].iter().fold(before, |m, &e| m.max(e));
+        let fall = self.curve.at(s).value - self.curve.at(s + step).value;
+        Some((error, fall.max(0.0)))
     }
 
     /// The rise of the exact push contact (mm).

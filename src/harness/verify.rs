@@ -131,7 +131,7 @@ pub(crate) fn tie_band_rule(per_mm: f64, window_mm: Option<f64>, level: Level) -
     let both = match level {
         Level::Node => "",
         Level::Surface => {
-            "; under --level surface the grid's error goes both ways, so each side of the band is widened by both terms (the near node's rise and the level error's bound) (a bound of the surface lying below a concave part between nodes is not measured yet)"
+            "; under --level surface the band is instead the grid's surface's own error, measured against the mesh, either way: a decided strike when the drop exceeds sigma x W by more than its error plus how far the surface may stand proud of the mesh within half a pitch of the contact W back and how far it lies below the touched point now (S - y there), plus the exact level's fall over one step (p / 8) W back; a decided non-strike when it falls short by more than its error plus the mirror terms (S - y W back, the surface standing proud near the contact now, the fall over a step now); the surface's error measured on the mesh sampled 8 times per pitch on each cell within half a pitch, unbounded on a cell where the grid has no surface over the mesh (the part's edge between its last node and the true edge) or a surface over no mesh"
         }
     };
     match window_mm {
