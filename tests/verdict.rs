@@ -124,7 +124,10 @@ fn verify_help_names_the_figure_judged_and_the_three_outcomes() {
 /// the level does not fall. At angle 0 the knee-form's apex leads, so the
 /// contacts lie on the start rows. The undecided nodes are therefore on
 /// the strip's rows, between `X0` and `X1` (to the nearest node), and
-/// fill the ramp once the knee-form has slid a window onto it.
+/// fill the ramp once the knee-form has slid a window onto it. Further in
+/// front, a step 10 mm proud (as `scenarios/step.toml`'s) is struck beyond
+/// doubt but where its riser's drop crosses the threshold: an undecided
+/// node at its foot, none on the flats between.
 #[test]
 fn the_undecided_nodes_lie_where_the_ramp_is_at_the_threshold() {
     use kneeform::harness::{self, StartSelection, TieBand, VerifyOptions};
@@ -133,6 +136,9 @@ fn the_undecided_nodes_lie_where_the_ramp_is_at_the_threshold() {
     use crate::util::{lattice_part, lines};
 
     let (x0, x1, pitch) = (-150.0, 100.0, 5.0);
+    // The step's foot and top (mm): 10 mm towards the knee-form over
+    // half a millimetre.
+    let (step_foot, step_top) = (-250.0, -250.5);
     let setup = Setup {
         pitch,
         angles: vec![0.0],
@@ -144,9 +150,12 @@ fn the_undecided_nodes_lie_where_the_ramp_is_at_the_threshold() {
         .window_mm()
         .expect("the window rule is the default");
     let verify = |slope: f64| {
-        let xs = lines(-300.0, 300.0, 10.0, &[x0, x1]);
+        let xs = lines(-300.0, 300.0, 10.0, &[x0, x1, step_top]);
         let zs = lines(-150.0, 150.0, 10.0, &[]);
-        let tris = lattice_part(&xs, &zs, |x, _| slope * (x.clamp(x0, x1) - x1));
+        let tris = lattice_part(&xs, &zs, |x, _| {
+            let rise = ((step_foot - x) / (step_foot - step_top)).clamp(0.0, 1.0);
+            slope * (x.clamp(x0, x1) - x1) - 10.0 * rise
+        });
         let part = Part::from_triangles("ramp", tris, 1.0, Side::Left).unwrap();
         let options = VerifyOptions {
             selection: StartSelection::Strip { z: [-pitch, pitch] },
@@ -167,12 +176,24 @@ fn the_undecided_nodes_lie_where_the_ramp_is_at_the_threshold() {
         .collect();
     assert_eq!(nodes.len(), runs.nodes);
     assert!(tie.counts.exact_undecided > 0, "{:?}", tie.counts);
-    // On the strip's rows, on the ramp to the nearest node.
+    // The step's strikes are decided.
+    assert!(tie.counts.exact_strikes_decided > 0, "{:?}", tie.counts);
+    // On the strip's rows, on the ramp to the nearest node, or at the
+    // step's riser: there the drop rises from 0 past sigma W within half a
+    // millimetre, and the contact where it crosses is in the tie band
+    // (SPEC's metric table: the first exact strike sits on the threshold).
+    // The riser's nearest node column is the foot's (x = -250).
     for &(x, z) in &nodes {
         assert!([-pitch, 0.0, pitch].contains(&z), "({x}, {z})");
         assert!(
-            (x0 - pitch / 2.0..=x1 + pitch / 2.0).contains(&x),
-            "({x}, {z}) off the ramp [{x0}, {x1}]"
+            (x0 - pitch / 2.0..=x1 + pitch / 2.0).contains(&x) || x == step_foot,
+            "({x}, {z}) off the ramp [{x0}, {x1}] and the step at {step_foot}"
+        );
+    }
+    for z in [-pitch, 0.0, pitch] {
+        assert!(
+            nodes.contains(&(step_foot, z)),
+            "the step's foot at z = {z}"
         );
     }
     // Filling the ramp on every row once a window has been slid on it
