@@ -776,8 +776,13 @@ fn a_killed_batch_resumes_and_ends_with_a_clean_batch_s_outputs() {
         .process_group(0)
         .spawn()
         .unwrap();
-    let done = dir.join("runs/bump-right/batch-item.json");
-    while !done.exists() {
+    // Killed once the second item is done: its fingerprint written and
+    // recorded in its run record (a kill between the two is the next
+    // test's).
+    let record = dir.join("runs/bump-right/kneeform-run.json");
+    let recorded =
+        || std::fs::read_to_string(&record).is_ok_and(|t| t.contains("\"batch-item.json\""));
+    while !recorded() {
         if let Some(status) = child.try_wait().unwrap() {
             panic!("the batch ended ({status}) before it could be killed");
         }
@@ -998,4 +1003,45 @@ fn runs_of_starts_are_chained_and_bad_runs_are_refused() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("no start is placed on this part"), "{err}");
     assert!(!err.contains("shorter runs"), "{err}");
+}
+
+/// A batch killed after writing an item's fingerprint and before recording
+/// it in the item's run record: the item is not taken as complete; the
+/// next batch runs it again, whole, and ends with a clean batch's files.
+#[test]
+fn a_fingerprint_written_but_not_recorded_runs_its_item_again() {
+    let dir = batch_dir("batch-unrecorded");
+    let manifest = dir.join("manifest.toml");
+    ok(
+        kneeform(&["batch", manifest.to_str().unwrap()]),
+        "the batch",
+    );
+    // The state the kill leaves: the fingerprint on disk, not in the record.
+    let run = dir.join("runs/bump-right");
+    let record_path = run.join("kneeform-run.json");
+    let mut record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&record_path).unwrap()).unwrap();
+    let files = record["files"].as_object_mut().unwrap();
+    assert!(files.remove("batch-item.json").is_some());
+    std::fs::write(&record_path, serde_json::to_string_pretty(&record).unwrap()).unwrap();
+    assert!(run.join("batch-item.json").is_file());
+    let again = ok(
+        kneeform(&["batch", manifest.to_str().unwrap()]),
+        "the batch again",
+    );
+    let text = String::from_utf8_lossy(&again.stderr);
+    assert!(text.contains("1 items run, 2 skipped"), "{text}");
+    assert!(
+        text.lines()
+            .any(|l| l.contains("runs/bump-right") && !l.contains("skipped")),
+        "{text}"
+    );
+    let clean = batch_dir("batch-unrecorded-clean");
+    ok(
+        kneeform(&["batch", clean.join("manifest.toml").to_str().unwrap()]),
+        "a clean batch",
+    );
+    assert_same_files(&run, &clean.join("runs/bump-right"));
+    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(&clean).unwrap();
 }

@@ -106,6 +106,14 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
             skipped += 1;
             continue;
         }
+        // A fingerprint written but not recorded: the batch was killed
+        // between the two. The file is the batch's own (its name is fixed);
+        // without it the folder is a complete run that --force replaces.
+        let unrecorded = out.join(FINGERPRINT_FILE);
+        if unrecorded.is_file() && !kneeform::output::is_recorded(&out, FINGERPRINT_FILE) {
+            std::fs::remove_file(&unrecorded)
+                .with_context(|| format!("{what}: cannot remove {}", unrecorded.display()))?;
+        }
         eprintln!("kneeform: {what}: kneeform {}", argv.join(" "));
         // --force: an earlier run of another fingerprint is replaced whole
         // (never a directory of other files: analyze refuses those).
@@ -164,14 +172,17 @@ fn analyze_switches() -> Vec<String> {
 }
 
 /// Whether `out` holds a complete run (or shard: `--shard` in the item's
-/// flags) of this fingerprint.
+/// flags) of this fingerprint, its fingerprint recorded in the run's
+/// record (a batch killed between writing and recording it is not done).
 fn is_done(out: &Path, fingerprint: &str) -> bool {
     let recorded = kneeform::limits::read_text_bounded(&out.join(FINGERPRINT_FILE))
         .ok()
         .and_then(|t| serde_json::from_str::<Fingerprint>(&t).ok());
     let complete =
         out.join(kneeform::output::SUMMARY_JSON).is_file() || out.join("shard.json").is_file();
-    complete && recorded.is_some_and(|r| r.fingerprint == fingerprint)
+    complete
+        && recorded.is_some_and(|r| r.fingerprint == fingerprint)
+        && kneeform::output::is_recorded(out, FINGERPRINT_FILE)
 }
 
 /// SHA-256 over this kneeform's version, `argv` and the SHA-256 of every

@@ -138,6 +138,13 @@ pub fn add_to_record(dir: &Path, names: &[&str]) -> io::Result<()> {
     })
 }
 
+/// Whether the run record of `dir` lists its file `name` (as
+/// [`add_to_record`] adds it): a file written but not yet recorded was
+/// cut short between the two.
+pub fn is_recorded(dir: &Path, name: &str) -> bool {
+    record::recorded(dir, name).is_some()
+}
+
 /// A result directory written atomically: files go into a hidden sibling
 /// staging directory (`<parent>/.<name>.partial-<pid>-<n>`) and are renamed
 /// into the final directory by [`OutputDir::commit`]. Dropped without a
