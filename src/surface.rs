@@ -541,6 +541,183 @@ pub(crate) fn trace(
     (i0, j0): (usize, usize),
     rule: &StrikeRule,
 ) -> SurfaceTrace {
+    slide_start(sg, sf, (i0, j0), rule, None)
+}
+
+/// The struck nodes (`mask[j * nx + i] = 1`) of every start of row `j0`
+/// on the surface of `sg`, as [`trace`] strikes them, and how many starts
+/// are placed. The starts run in increasing `i0` through one [`RowTrail`]:
+/// a start stops where it provably continues an earlier start's slide.
+pub(crate) fn trace_row(
+    sg: &SurfaceGrid,
+    sf: &SurfaceFootprint,
+    j0: usize,
+    rule: &StrikeRule,
+    mask: &mut [u8],
+) -> usize {
+    let nx = sg.grid.spec.nx;
+    let mut trail = RowTrail::new(sf, nx, rule);
+    let mut placed = 0;
+    for i0 in 0..nx {
+        let trace = slide_start(sg, sf, (i0, j0), rule, Some(&mut trail));
+        placed += usize::from(trace.yr.is_finite());
+        for ((i, j), _) in trace.strikes {
+            mask[j * nx + i] = 1;
+        }
+    }
+    placed
+}
+
+/// What a start's slide left at one position of the row's travel lattice.
+#[derive(Debug, Clone, Copy)]
+struct Record {
+    /// The level after the step.
+    level: f64,
+    /// The last contact's witness (grid units).
+    witness: [f64; 2],
+    /// The slide that wrote it ([`RowTrail::UNWRITTEN`] where none).
+    label: u32,
+    /// Whether a bisection midpoint lowered the level within the step.
+    mid: bool,
+}
+
+/// The slides of one start row so far, by absolute position on the travel
+/// lattice: position `m` is the outline's reference at `u = m / 8`, which
+/// start `i0` reaches at step `k = 8 i0 - m`. Everything a step evaluates
+/// there (the outline's samples, the nodes met, the bisection midpoints)
+/// is the same, to the bit, for every start that reaches it (SPEC v4,
+/// "Fast forms"), so a slide's future from `m` is a function of its state
+/// there: its level, its last contact's witness and its level over the
+/// window behind (the strike rule's `f(s - W)`). A start whose state
+/// equals the one recorded at `m` by an earlier slide strikes from there
+/// on exactly what that slide struck, so it stops: its mask is already
+/// marked.
+///
+/// The window behind is compared position by position: the run of
+/// consecutive positions where both levels are equal, both written by one
+/// slide (labels joined where one slide continued another), and neither
+/// lowered by a midpoint (whose travel lies between two positions). A run
+/// longer than the window (plus one position each side) with equal
+/// witnesses is the same state.
+#[derive(Debug)]
+pub(crate) struct RowTrail {
+    /// Index of position `m` is `m + offset`.
+    offset: i64,
+    records: Vec<Record>,
+    /// Per slide label, the slide it continues (itself where none).
+    parent: Vec<u32>,
+    /// Positions of agreement that make a state equal.
+    need: u32,
+}
+
+/// One slide's walk against a [`RowTrail`].
+#[derive(Debug, Clone, Copy)]
+struct Walk {
+    label: u32,
+    /// Positions of agreement so far.
+    run: u32,
+    /// The label recorded at the position before.
+    prev: u32,
+}
+
+impl RowTrail {
+    const UNWRITTEN: u32 = u32::MAX;
+
+    fn new(sf: &SurfaceFootprint, nx: usize, rule: &StrikeRule) -> RowTrail {
+        // The lowest position a slide reaches: its outline and its nodes
+        // in front left of column 0 (a margin beyond).
+        let reach = sf.extent.0.abs().ceil() as i64
+            + sf.rows
+                .iter()
+                .map(|r| i64::from(r.3).abs())
+                .max()
+                .unwrap_or(0)
+            + 4;
+        let lo = -(STEPS_PER_PITCH as i64) * reach;
+        let hi = STEPS_PER_PITCH as i64 * nx as i64;
+        let window = (rule.window * STEPS_PER_PITCH / sf.pitch).ceil();
+        RowTrail {
+            offset: -lo,
+            records: vec![
+                Record {
+                    level: f64::NAN,
+                    witness: [f64::NAN; 2],
+                    label: RowTrail::UNWRITTEN,
+                    mid: false,
+                };
+                (hi - lo + 1) as usize
+            ],
+            parent: Vec::new(),
+            need: if window.is_finite() && window < f64::from(u32::MAX / 2) {
+                window as u32 + 2
+            } else {
+                u32::MAX
+            },
+        }
+    }
+
+    /// A new slide's walk.
+    fn start(&mut self) -> Walk {
+        let label = self.parent.len() as u32;
+        self.parent.push(label);
+        Walk {
+            label,
+            run: 0,
+            prev: RowTrail::UNWRITTEN,
+        }
+    }
+
+    fn root(&mut self, mut label: u32) -> u32 {
+        while self.parent[label as usize] != label {
+            let up = self.parent[label as usize];
+            self.parent[label as usize] = self.parent[up as usize];
+            label = up;
+        }
+        label
+    }
+
+    /// The slide `walk` left `here` at position `m`: whether it continues
+    /// the slide recorded there from now on (then it stops and is joined
+    /// to it); otherwise its record replaces the one there.
+    fn visit(&mut self, m: i64, here: Record, walk: &mut Walk) -> bool {
+        let Some(slot) = usize::try_from(m + self.offset)
+            .ok()
+            .filter(|&n| n < self.records.len())
+        else {
+            (walk.run, walk.prev) = (0, RowTrail::UNWRITTEN);
+            return false;
+        };
+        let old = self.records[slot];
+        let agree = old.label != RowTrail::UNWRITTEN
+            && !old.mid
+            && !here.mid
+            && old.level == here.level
+            && (walk.run == 0 || self.root(old.label) == self.root(walk.prev));
+        walk.run = if agree { walk.run + 1 } else { 0 };
+        walk.prev = old.label;
+        if agree && walk.run >= self.need && old.witness == here.witness {
+            let root = self.root(old.label);
+            self.parent[walk.label as usize] = root;
+            return true;
+        }
+        self.records[slot] = Record {
+            label: walk.label,
+            ..here
+        };
+        false
+    }
+}
+
+/// [`trace`], continuing through `trail` where given: the trace then ends
+/// where the slide continues one recorded there (its strikes from there
+/// on are that slide's) and its levels stop there.
+fn slide_start(
+    sg: &SurfaceGrid,
+    sf: &SurfaceFootprint,
+    (i0, j0): (usize, usize),
+    rule: &StrikeRule,
+    mut trail: Option<&mut RowTrail>,
+) -> SurfaceTrace {
     let grid = sg.grid;
     let (nx, nz) = (grid.spec.nx as i64, grid.spec.nz as i64);
     let p = sf.pitch;
@@ -605,6 +782,8 @@ pub(crate) fn trace(
     let (du_max, dw_lo, dw_hi) = sf.extent;
     let rows_span = (w0 + dw_lo, w0 + dw_hi);
     let mut met: Vec<(usize, f64, [f64; 2])> = Vec::new();
+    let mut walk = trail.as_deref_mut().map(RowTrail::start);
+    let position = |k: u64| STEPS_PER_PITCH as i64 * i0 as i64 - k as i64;
     let mut k = 0u64;
     loop {
         k += 1;
@@ -642,12 +821,27 @@ pub(crate) fn trace(
         for &(_, value, at) in &met {
             step.take(value, at);
         }
-        let Some(point) = step.0 else { continue };
-        if rule.is_contact(point.value, slide.f) && apart(slide.witness, point.at) {
-            let (f0, w_lo) = (slide.f, slide.witness);
-            slide.bisect((t - 1.0, t), (w_lo, point.at), f0, 0);
+        let groups = slide.out.levels.len();
+        let mut mid = false;
+        if let Some(point) = step.0 {
+            if rule.is_contact(point.value, slide.f) && apart(slide.witness, point.at) {
+                let (f0, w_lo) = (slide.f, slide.witness);
+                slide.bisect((t - 1.0, t), (w_lo, point.at), f0, 0);
+                mid = slide.out.levels.len() > groups;
+            }
+            slide.fall(t, point.value, point.at);
         }
-        slide.fall(t, point.value, point.at);
+        if let Some((trail, walk)) = trail.as_deref_mut().zip(walk.as_mut()) {
+            let here = Record {
+                level: slide.f,
+                witness: slide.witness,
+                label: walk.label,
+                mid,
+            };
+            if trail.visit(position(k), here, walk) {
+                break;
+            }
+        }
     }
     slide.out
 }

@@ -195,7 +195,6 @@ fn surface_masks(
         Some(rows) => rows.iter().copied().filter(|&j| j < grid.spec.nz).collect(),
         None => (0..grid.spec.nz).collect(),
     };
-    let nx = grid.spec.nx;
     footprints
         .iter()
         .zip(probes)
@@ -206,14 +205,13 @@ fn surface_masks(
                 .fold(
                     || (vec![0u8; grid.spec.len()], 0usize),
                     |(mut mask, mut placed), &j0| {
-                        for i0 in 0..nx {
-                            let trace =
-                                crate::surface::trace(&surface, &outline, (i0, j0), &options.rule);
-                            placed += usize::from(trace.yr.is_finite());
-                            for ((i, j), _) in trace.strikes {
-                                mask[j * nx + i] = 1;
-                            }
-                        }
+                        placed += crate::surface::trace_row(
+                            &surface,
+                            &outline,
+                            j0,
+                            &options.rule,
+                            &mut mask,
+                        );
                         (mask, placed)
                     },
                 )
