@@ -133,8 +133,9 @@ impl<'a> SurfaceGrid<'a> {
         if u > (nx - 1) as f64 || w > (nz - 1) as f64 {
             return None;
         }
-        let i = (u.floor() as usize).min(nx - 2);
-        let j = (w.floor() as usize).min(nz - 2);
+        // Both are >= 0 here, where truncation is the floor.
+        let i = (u as usize).min(nx - 2);
+        let j = (w as usize).min(nz - 2);
         Some((i, j, u - i as f64, w - j as f64))
     }
 
@@ -254,6 +255,8 @@ pub(crate) struct SurfaceFootprint {
     /// Runs of [`BLOCK`] leading samples: the range and its extent
     /// `(du_lo, du_hi, dw_lo, dw_hi)`.
     pub blocks: Vec<(std::ops::Range<usize>, [f64; 4])>,
+    /// The same runs of the trailing samples.
+    pub trail_blocks: Vec<(std::ops::Range<usize>, [f64; 4])>,
     /// The extent of the leading outline, `(du_max, dw_lo, dw_hi)`.
     pub extent: (f64, f64, f64),
     /// The footprint's rows: `(dj, klo, khi, kf, d0)`, by `dj`.
@@ -301,22 +304,8 @@ impl SurfaceFootprint {
         };
         let lead = side(|iv| iv.0);
         let trail = side(|iv| iv.1);
-        let blocks = (0..lead.len())
-            .step_by(BLOCK)
-            .map(|lo| {
-                let hi = (lo + BLOCK).min(lead.len());
-                let mut e = [
-                    f64::INFINITY,
-                    f64::NEG_INFINITY,
-                    f64::INFINITY,
-                    f64::NEG_INFINITY,
-                ];
-                for &[du, dw] in &lead[lo..hi] {
-                    e = [e[0].min(du), e[1].max(du), e[2].min(dw), e[3].max(dw)];
-                }
-                (lo..hi, e)
-            })
-            .collect();
+        let blocks = runs(&lead);
+        let trail_blocks = runs(&trail);
         let extent = lead.iter().fold(
             (f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY),
             |(u, lo, hi), &[du, dw]| (u.max(du), lo.min(dw), hi.max(dw)),
@@ -325,6 +314,7 @@ impl SurfaceFootprint {
             lead,
             trail,
             blocks,
+            trail_blocks,
             extent,
             rows: fp
                 .rows
@@ -335,6 +325,27 @@ impl SurfaceFootprint {
             pitch: p,
         }
     }
+}
+
+/// Runs of [`BLOCK`] consecutive samples of `side` and their extents
+/// `(du_lo, du_hi, dw_lo, dw_hi)` (grid units).
+fn runs(side: &[[f64; 2]]) -> Vec<(std::ops::Range<usize>, [f64; 4])> {
+    (0..side.len())
+        .step_by(BLOCK)
+        .map(|lo| {
+            let hi = (lo + BLOCK).min(side.len());
+            let mut e = [
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+            ];
+            for &[du, dw] in &side[lo..hi] {
+                e = [e[0].min(du), e[1].max(du), e[2].min(dw), e[3].max(dw)];
+            }
+            (lo..hi, e)
+        })
+        .collect()
 }
 
 /// Inserts, in z order, the outline samples between `a` and `b` (grid
@@ -411,8 +422,17 @@ struct Slide<'s, 'g> {
 /// of the first column alone, so that a bound read for it holds while it
 /// stays.
 fn columns(base: f64, e: &[f64; 4]) -> (i64, i64) {
-    let first = (base + e[0]).floor() as i64;
+    let first = floor(base + e[0]);
     (first, first + (e[1] - e[0]).ceil() as i64 + 2)
+}
+
+/// `v.floor()` as an integer, for `|v| < 2^52`, without the library call
+/// that the baseline instruction set needs for `floor` (a tenth of the
+/// surface level's time where it was called per block and step).
+#[inline(always)]
+fn floor(v: f64) -> i64 {
+    let t = v as i64;
+    t - i64::from((t as f64) > v)
 }
 
 /// Whether two witnesses lie more than `p / 2` apart.
@@ -502,7 +522,8 @@ impl Slide<'_, '_> {
             }
             let [du, dw] = self.sf.lead[n];
             let here = [base + du, self.j0 + dw];
-            if here != at && value <= level + self.sg.tau(here[0], here[1]) {
+            // `tau` is at most `TAU_CAP p`: a point above `reach` is no tie.
+            if here != at && value <= reach && value <= level + self.sg.tau(here[0], here[1]) {
                 self.out.strikes.push((nearest(here), s));
             }
         }
@@ -558,7 +579,9 @@ pub(crate) fn trace_row(
     let nx = sg.grid.spec.nx;
     let mut trail = RowTrail::new(sf, nx, rule);
     let mut placed = 0;
+    let mut windows = PushWindows::new(sf, sg.grid, j0);
     for i0 in 0..nx {
+        trail.windows.lowest = windows.advance(sg.grid, i0);
         let trace = slide_start(sg, sf, (i0, j0), rule, Some(&mut trail));
         placed += usize::from(trace.yr.is_finite());
         for ((i, j), _) in trace.strikes {
@@ -608,6 +631,82 @@ pub(crate) struct RowTrail {
     parent: Vec<u32>,
     /// Positions of agreement that make a state equal.
     need: u32,
+    /// The push's nodes of the start in hand.
+    windows: PushNodes,
+}
+
+/// The first lowest node inside the footprint of one start, as the push
+/// reads them (rows in the footprint's order, columns increasing).
+#[derive(Debug, Default)]
+struct PushNodes {
+    lowest: Option<Point>,
+}
+
+/// Per footprint row, the nodes inside the footprint of starts `i0 =
+/// 0, 1, ...` of one start row as a sliding window: a queue of columns
+/// whose heights increase (an equal height keeps the earlier column), so
+/// its front is the row's first lowest node, as the push's scan finds it.
+struct PushWindows {
+    /// Per footprint row: its grid row (`None` off the grid), `klo`,
+    /// `khi`, the next column to enter and the queue `(column, height)`.
+    rows: Vec<(
+        Option<usize>,
+        i64,
+        i64,
+        i64,
+        std::collections::VecDeque<(i64, f64)>,
+    )>,
+}
+
+impl PushWindows {
+    fn new(sf: &SurfaceFootprint, grid: &HeightGrid, j0: usize) -> PushWindows {
+        let nz = grid.spec.nz as i64;
+        let rows = sf
+            .rows
+            .iter()
+            .map(|&(dj, klo, khi, _, _)| {
+                let j = j0 as i64 + i64::from(dj);
+                let on = (0..nz).contains(&j).then_some(j as usize);
+                let (klo, khi) = (i64::from(klo), i64::from(khi));
+                (on, klo, khi, klo, std::collections::VecDeque::new())
+            })
+            .collect();
+        PushWindows { rows }
+    }
+
+    /// The first lowest finite node inside start `i0`'s footprint; starts
+    /// are asked in increasing `i0`.
+    fn advance(&mut self, grid: &HeightGrid, i0: usize) -> Option<Point> {
+        let nx = grid.spec.nx as i64;
+        let i0 = i0 as i64;
+        let mut lowest = Lowest(None);
+        for (row, klo, khi, next, queue) in &mut self.rows {
+            let Some(j) = *row else { continue };
+            let hi = (i0 + *khi).min(nx - 1);
+            while *next <= hi {
+                let i = *next;
+                *next += 1;
+                if i < 0 {
+                    continue;
+                }
+                let h = grid.at(i as usize, j);
+                if !h.is_finite() {
+                    continue;
+                }
+                while queue.back().is_some_and(|&(_, b)| b > h) {
+                    queue.pop_back();
+                }
+                queue.push_back((i, h));
+            }
+            while queue.front().is_some_and(|&(i, _)| i < i0 + *klo) {
+                queue.pop_front();
+            }
+            if let Some(&(i, h)) = queue.front() {
+                lowest.take(h, [i as f64, j as f64]);
+            }
+        }
+        lowest.0
+    }
 }
 
 /// One slide's walk against a [`RowTrail`].
@@ -648,6 +747,7 @@ impl RowTrail {
                 (hi - lo + 1) as usize
             ],
             parent: Vec::new(),
+            windows: PushNodes::default(),
             need: if window.is_finite() && window < f64::from(u32::MAX / 2) {
                 window as u32 + 2
             } else {
@@ -722,25 +822,45 @@ fn slide_start(
     let (nx, nz) = (grid.spec.nx as i64, grid.spec.nz as i64);
     let p = sf.pitch;
     let (u0, w0) = (i0 as f64, j0 as f64);
-    // The push: the whole outline, then the nodes inside.
+    // The push: the whole outline, then the nodes inside; the nodes'
+    // first lowest from the trail's windows where given.
+    let nodes = match trail.as_deref() {
+        Some(trail) => trail.windows.lowest,
+        None => {
+            let mut nodes = Lowest(None);
+            let push_rows = sf.rows.iter().filter_map(|&(dj, klo, khi, _, _)| {
+                let j = j0 as i64 + i64::from(dj);
+                (0..nz).contains(&j).then_some((j as usize, klo, khi))
+            });
+            for (j, klo, khi) in push_rows {
+                for k in klo..=khi {
+                    let i = i0 as i64 + i64::from(k);
+                    if (0..nx).contains(&i) {
+                        nodes.take(grid.at(i as usize, j), [i as f64, j as f64]);
+                    }
+                }
+            }
+            nodes.0
+        }
+    };
+    // A run of outline samples whose bound lies above the lowest point so
+    // far (outline or nodes) holds no first lowest point: skipped.
     let mut push = Lowest(None);
-    for &[du, dw] in sf.lead.iter().chain(&sf.trail) {
-        let at = [u0 + du, w0 + dw];
-        push.take(sg.at(at[0], at[1]), at);
-    }
-    // Per row on the grid, in the slide's order: its row and the column
-    // of its first node in front, its d0.
-    let push_rows = sf.rows.iter().filter_map(|&(dj, klo, khi, _, _)| {
-        let j = j0 as i64 + i64::from(dj);
-        (0..nz).contains(&j).then_some((j as usize, klo, khi))
-    });
-    for (j, klo, khi) in push_rows {
-        for k in klo..=khi {
-            let i = i0 as i64 + i64::from(k);
-            if (0..nx).contains(&i) {
-                push.take(grid.at(i as usize, j), [i as f64, j as f64]);
+    let cut = nodes.map_or(f64::INFINITY, |n| n.value);
+    for (side, blocks) in [(&sf.lead, &sf.blocks), (&sf.trail, &sf.trail_blocks)] {
+        for (range, e) in blocks {
+            let limit = push.0.map_or(cut, |p| p.value.min(cut));
+            if sg.bound(columns(u0, e), (w0 + e[2], w0 + e[3])) > limit {
+                continue;
+            }
+            for &[du, dw] in &side[range.clone()] {
+                let at = [u0 + du, w0 + dw];
+                push.take(sg.at(at[0], at[1]), at);
             }
         }
+    }
+    if let Some(node) = nodes {
+        push.take(node.value, node.at);
     }
     let rows: Vec<(usize, i64, f64)> = sf
         .slide_order
