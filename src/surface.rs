@@ -415,6 +415,11 @@ struct Slide<'s, 'g> {
     out: SurfaceTrace,
     /// Per block: the columns its bound was read for, and the bound.
     cached: Vec<(i64, f64)>,
+    /// The step's contact as an earlier slide struck it at this position
+    /// (level and witness), where the trail recorded one.
+    prior: Option<(f64, [f64; 2])>,
+    /// Whether the step's contact struck.
+    struck: bool,
 }
 
 /// The columns whose cells the samples of a run with extent `e` read
@@ -483,8 +488,14 @@ impl Slide<'_, '_> {
         let s = t * p / STEPS_PER_PITCH;
         let earlier = self.history.earlier(s, self.rule.window);
         if self.rule.window_strikes(value, earlier) {
-            self.out.strikes.push((nearest(at), s));
-            self.ties(t, s, value, at);
+            self.struck = true;
+            // The same contact struck by an earlier slide at this position
+            // marked the same nodes (ties read the position, the level and
+            // the witness only).
+            if self.prior != Some((value, at)) {
+                self.out.strikes.push((nearest(at), s));
+                self.ties(t, s, value, at);
+            }
         }
         self.witness = at;
         self.f = value;
@@ -602,6 +613,18 @@ struct Record {
     label: u32,
     /// Whether a bisection midpoint lowered the level within the step.
     mid: bool,
+    /// Whether the step's contact struck (its level and witness are then
+    /// the contact's).
+    struck: bool,
+}
+
+/// What the leading outline at one position is known to hold.
+#[derive(Debug, Clone, Copy)]
+enum Known {
+    /// Its first lowest point.
+    Lowest(Point),
+    /// No point below this value.
+    Above(f64),
 }
 
 /// The slides of one start row so far, by absolute position on the travel
@@ -633,6 +656,8 @@ pub(crate) struct RowTrail {
     need: u32,
     /// The push's nodes of the start in hand.
     windows: PushNodes,
+    /// Per position, what its leading outline is known to hold.
+    outline: Vec<Known>,
 }
 
 /// The first lowest node inside the footprint of one start, as the push
@@ -743,9 +768,11 @@ impl RowTrail {
                     witness: [f64::NAN; 2],
                     label: RowTrail::UNWRITTEN,
                     mid: false,
+                    struck: false,
                 };
                 (hi - lo + 1) as usize
             ],
+            outline: vec![Known::Above(f64::NEG_INFINITY); (hi - lo + 1) as usize],
             parent: Vec::new(),
             windows: PushNodes::default(),
             need: if window.is_finite() && window < f64::from(u32::MAX / 2) {
@@ -776,14 +803,48 @@ impl RowTrail {
         label
     }
 
+    /// The index of position `m`, where the trail has one.
+    fn slot(&self, m: i64) -> Option<usize> {
+        usize::try_from(m + self.offset)
+            .ok()
+            .filter(|&n| n < self.records.len())
+    }
+
+    /// The contact an earlier slide struck at position `m` (the level and
+    /// witness it left), if one did.
+    fn struck(&self, m: i64) -> Option<(f64, [f64; 2])> {
+        let r = self.records[self.slot(m)?];
+        (r.label != RowTrail::UNWRITTEN && r.struck).then_some((r.level, r.witness))
+    }
+
+    /// [`Slide::lowest_below`] at position `m` (travel `t` steps of
+    /// `slide`): the outline's first lowest point below `limit` is its
+    /// first lowest point, if that lies below `limit`, so each position's
+    /// is found once per row (or that none lies below the lowest limit
+    /// asked so far).
+    fn outline_below(&mut self, slide: &mut Slide, m: i64, t: f64, limit: f64) -> Lowest {
+        let Some(n) = self.slot(m) else {
+            return slide.lowest_below(t, limit);
+        };
+        match self.outline[n] {
+            Known::Lowest(p) => Lowest((p.value < limit).then_some(p)),
+            Known::Above(above) if limit <= above => Lowest(None),
+            Known::Above(_) => {
+                let lowest = slide.lowest_below(t, limit);
+                self.outline[n] = match lowest.0 {
+                    Some(p) => Known::Lowest(p),
+                    None => Known::Above(limit),
+                };
+                lowest
+            }
+        }
+    }
+
     /// The slide `walk` left `here` at position `m`: whether it continues
     /// the slide recorded there from now on (then it stops and is joined
     /// to it); otherwise its record replaces the one there.
     fn visit(&mut self, m: i64, here: Record, walk: &mut Walk) -> bool {
-        let Some(slot) = usize::try_from(m + self.offset)
-            .ok()
-            .filter(|&n| n < self.records.len())
-        else {
+        let Some(slot) = self.slot(m) else {
             (walk.run, walk.prev) = (0, RowTrail::UNWRITTEN);
             return false;
         };
@@ -893,6 +954,8 @@ fn slide_start(
             ..SurfaceTrace::default()
         },
         cached: vec![(i64::MIN, 0.0); sf.blocks.len()],
+        prior: None,
+        struck: false,
     };
     // The nodes in front as one stream by distance: layer `layer` (the
     // `layer`-th node in front of each row), rows in the slide's order;
@@ -919,7 +982,10 @@ fn slide_start(
         if sg.bound_before(outline_at.max(node_at as f64), rows_span) >= floor {
             break;
         }
-        let mut step = slide.lowest_below(t, floor);
+        let mut step = match trail.as_deref_mut() {
+            Some(trail) => trail.outline_below(&mut slide, position(k), t, floor),
+            None => slide.lowest_below(t, floor),
+        };
         // The nodes met by this step, rows by j (one per row at most: a
         // step is shorter than a pitch).
         met.clear();
@@ -949,7 +1015,10 @@ fn slide_start(
                 slide.bisect((t - 1.0, t), (w_lo, point.at), f0, 0);
                 mid = slide.out.levels.len() > groups;
             }
+            slide.struck = false;
+            slide.prior = trail.as_deref().and_then(|trail| trail.struck(position(k)));
             slide.fall(t, point.value, point.at);
+            slide.prior = None;
         }
         if let Some((trail, walk)) = trail.as_deref_mut().zip(walk.as_mut()) {
             let here = Record {
@@ -957,6 +1026,7 @@ fn slide_start(
                 witness: slide.witness,
                 label: walk.label,
                 mid,
+                struck: step.0.is_some() && slide.struck,
             };
             if trail.visit(position(k), here, walk) {
                 break;
