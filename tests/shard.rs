@@ -213,6 +213,10 @@ fn merge_refuses_a_missing_a_repeated_or_a_foreign_shard() {
     let other = dir.join("other");
     std::fs::create_dir(&other).unwrap();
     let foreign = shard(&scenario("bump"), &other, 2, 3, &[]);
+    // The same run but for the level the knee-form follows (SPEC v4).
+    let surface = dir.join("surface");
+    std::fs::create_dir(&surface).unwrap();
+    let by_surface = shard(&wave, &surface, 2, 3, &["--level", "surface"]);
     let out = dir.join("merged");
     let s: Vec<&Path> = shards.iter().map(PathBuf::as_path).collect();
     for (given, needle, what) in [
@@ -226,6 +230,11 @@ fn merge_refuses_a_missing_a_repeated_or_a_foreign_shard() {
             vec![s[0], &foreign, s[2]],
             "shards of different runs",
             "foreign",
+        ),
+        (
+            vec![s[0], &by_surface, s[2]],
+            "`level` differ",
+            "another level",
         ),
     ] {
         let result = merge(&given, &out);

@@ -653,6 +653,17 @@ pub struct BenchArgs {
     /// Worker threads (default: one per CPU).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
+    /// Which level the timed engine follows (SPEC v4), as `analyze
+    /// --level`: `node` (default) or `surface`. Under `surface` the
+    /// comparison in the same runs is the node level (instead of `--rate
+    /// x-slope`); the paper-algorithm baseline stays at the node level.
+    #[arg(
+        long,
+        default_value = "node",
+        value_name = "LEVEL",
+        value_parser = one_of(&Level::ALL, Level::name)
+    )]
+    pub level: Level,
     /// Also write the figures as Markdown to this file.
     #[arg(long, value_name = "FILE")]
     pub markdown: Option<PathBuf>,

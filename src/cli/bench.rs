@@ -14,7 +14,7 @@ use anyhow::{Context, ensure};
 use kneeform::grid::GridSpec;
 use kneeform::scenario::{self, PAPER_TRIANGLES};
 use kneeform::setup::Sampled;
-use kneeform::strike::RateEstimate;
+use kneeform::strike::{Level, RateEstimate};
 use kneeform::{Algorithm, EngineOptions, GridFootprint, Setup, colliding_masks};
 
 use super::args::BenchArgs;
@@ -55,17 +55,28 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         angles,
         ..Setup::default()
     };
-    let fast = EngineOptions::default();
+    let node = EngineOptions::default();
+    let fast = EngineOptions {
+        rule: node.rule.with_level(args.level),
+        ..EngineOptions::default()
+    };
 
     let mut sample_s = Vec::new();
     let mut blind_s = Vec::new();
     let mut blind_count = 0;
     let mut slide_s = Vec::new();
     // SPEC's former x-slope rule on the same grid in the same runs: what
-    // the window rule costs, its load cancelling out.
-    let x_slope = EngineOptions {
-        rule: fast.rule.with_rate(RateEstimate::XSlope),
-        ..EngineOptions::default()
+    // the window rule costs, its load cancelling out; under the surface
+    // level, the node level: what the surface level costs.
+    let (other, other_name) = match args.level {
+        Level::Node => (
+            EngineOptions {
+                rule: node.rule.with_rate(RateEstimate::XSlope),
+                ..EngineOptions::default()
+            },
+            "`--rate x-slope`",
+        ),
+        Level::Surface => (node.clone(), "`--level node`"),
     };
     let mut x_slope_s = Vec::new();
     let mut grid = None;
@@ -89,14 +100,14 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         let masks = colliding_masks(&g, &footprints, &fast, &|| {});
         slide_s.push(t.elapsed().as_secs_f64());
         let t = Instant::now();
-        colliding_masks(&g, &footprints, &x_slope, &|| {});
+        colliding_masks(&g, &footprints, &other, &|| {});
         x_slope_s.push(t.elapsed().as_secs_f64());
         composite_nodes = kneeform::composite(&masks)
             .iter()
             .filter(|&&c| c > 0)
             .count();
         eprintln!(
-            "run {}/{}: sample {:.3} s, blind spots {:.3} s, push+slide {:.3} s ({:.3} s under x-slope)",
+            "run {}/{}: sample {:.3} s, blind spots {:.3} s, push+slide {:.3} s ({:.3} s under {other_name})",
             run + 1,
             args.runs,
             sample_s[run],
@@ -193,14 +204,19 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         "| blind-spot sampling, conservative per cell (median) | {blind:.3} s, {blind_ratio:.1}x the node sampling in the same runs; {blind_count} blind spots at {} mm |",
         Setup::DEFAULT_BLIND_DEPTH
     )?;
+    writeln!(md, "| level | {} |", args.level.name())?;
     writeln!(
         md,
         "| push + slide, {} angles (median) | {slide:.3} s |",
         footprints.len()
     )?;
+    let what = match args.level {
+        Level::Node => "the window rule",
+        Level::Surface => "the surface level",
+    };
     writeln!(
         md,
-        "| push + slide under `--rate x-slope` in the same runs (median) | {x_slope:.3} s; the window rule takes {window_ratio:.2}x that (median of the runs' ratios) |"
+        "| push + slide under {other_name} in the same runs (median) | {x_slope:.3} s; {what} takes {window_ratio:.2}x that (median of the runs' ratios) |"
     )?;
     writeln!(
         md,
@@ -218,7 +234,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     }
     writeln!(
         md,
-        "| paper algorithm, {} start rows x {} angles | {paper_sample_s:.3} s (fast on the same: {fast_sample_s:.4} s) |",
+        "| paper algorithm, {} start rows x {} angles, node level | {paper_sample_s:.3} s (fast on the same: {fast_sample_s:.4} s) |",
         rows.len(),
         sampled.len()
     )?;
