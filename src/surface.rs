@@ -613,9 +613,6 @@ struct Record {
     label: u32,
     /// Whether a bisection midpoint lowered the level within the step.
     mid: bool,
-    /// Whether the step's contact struck (its level and witness are then
-    /// the contact's).
-    struck: bool,
 }
 
 /// What the leading outline at one position is known to hold.
@@ -658,6 +655,8 @@ pub(crate) struct RowTrail {
     windows: PushNodes,
     /// Per position, what its leading outline is known to hold.
     outline: Vec<Known>,
+    /// Per position, the contact a slide struck there.
+    struck: Vec<Option<(f64, [f64; 2])>>,
 }
 
 /// The first lowest node inside the footprint of one start, as the push
@@ -768,11 +767,11 @@ impl RowTrail {
                     witness: [f64::NAN; 2],
                     label: RowTrail::UNWRITTEN,
                     mid: false,
-                    struck: false,
                 };
                 (hi - lo + 1) as usize
             ],
             outline: vec![Known::Above(f64::NEG_INFINITY); (hi - lo + 1) as usize],
+            struck: vec![None; (hi - lo + 1) as usize],
             parent: Vec::new(),
             windows: PushNodes::default(),
             need: if window.is_finite() && window < f64::from(u32::MAX / 2) {
@@ -810,11 +809,12 @@ impl RowTrail {
             .filter(|&n| n < self.records.len())
     }
 
-    /// The contact an earlier slide struck at position `m` (the level and
-    /// witness it left), if one did.
+    /// The contact a slide struck at position `m` (its level and
+    /// witness), if one did. A step's contact is the same for every slide
+    /// that has one there (its point is the position's), so all but the
+    /// first mark nodes already marked.
     fn struck(&self, m: i64) -> Option<(f64, [f64; 2])> {
-        let r = self.records[self.slot(m)?];
-        (r.label != RowTrail::UNWRITTEN && r.struck).then_some((r.level, r.witness))
+        self.struck[self.slot(m)?]
     }
 
     /// [`Slide::lowest_below`] at position `m` (travel `t` steps of
@@ -1003,8 +1003,16 @@ fn slide_start(
                 (next, layer) = (0, layer + 1);
             }
         }
-        met.sort_by_key(|m| m.0);
-        for &(_, value, at) in &met {
+        // The first lowest in row order: the lowest, the smaller row on a
+        // tie (met holds one node per row).
+        let first = met.iter().fold(
+            None,
+            |best: Option<&(usize, f64, [f64; 2])>, m| match best {
+                Some(b) if (b.1, b.0) <= (m.1, m.0) => Some(b),
+                _ => Some(m),
+            },
+        );
+        if let Some(&(_, value, at)) = first {
             step.take(value, at);
         }
         let groups = slide.out.levels.len();
@@ -1019,6 +1027,12 @@ fn slide_start(
             slide.prior = trail.as_deref().and_then(|trail| trail.struck(position(k)));
             slide.fall(t, point.value, point.at);
             slide.prior = None;
+            if let Some(n) = trail.as_deref().and_then(|trail| trail.slot(position(k)))
+                && slide.struck
+            {
+                trail.as_deref_mut().expect("a slot is the trail's").struck[n] =
+                    Some((slide.f, slide.witness));
+            }
         }
         if let Some((trail, walk)) = trail.as_deref_mut().zip(walk.as_mut()) {
             let here = Record {
@@ -1026,7 +1040,6 @@ fn slide_start(
                 witness: slide.witness,
                 label: walk.label,
                 mid,
-                struck: step.0.is_some() && slide.struck,
             };
             if trail.visit(position(k), here, walk) {
                 break;
