@@ -1048,3 +1048,78 @@ fn slide_start(
     }
     slide.out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::GridSpec;
+    use crate::kneeform::KneeForm;
+    use crate::strike::Level;
+
+    /// [`trace_row`] (starts joined through the row's trail, the push's
+    /// nodes from sliding windows, each position's outline once) marks
+    /// exactly the union of the per-start [`trace`]s and places the same
+    /// starts, on a curved surface where many slides do join earlier ones
+    /// (so the joining is what is tested), under windows shorter and
+    /// longer than a pitch.
+    #[test]
+    fn a_row_of_joined_slides_strikes_what_its_starts_strike_alone() {
+        let spec = GridSpec::explicit(0.0, 0.0, 48, 24, 1.0);
+        // A bowl with ripples and a plateau of equal heights (ties), and a
+        // hole (no surface).
+        let grid = HeightGrid::from_fn(spec, |x, z| {
+            if (x - 30.0).hypot(z - 12.0) < 2.5 {
+                return f64::INFINITY;
+            }
+            let bowl = 0.02 * ((x - 20.0).powi(2) + (z - 10.0).powi(2));
+            let ripple = 0.4 * (0.7 * x).sin() * (0.5 * z).cos();
+            (bowl + ripple).min(6.0)
+        });
+        let knee = KneeForm {
+            triangle_side: 9.0,
+            radius: 3.0,
+            thickness: 120.0,
+        };
+        let sg = SurfaceGrid::new(&grid);
+        let mut joined = 0;
+        for (angle, window, deflection) in [(0.0, 5.0, 0.5), (17.0, 0.6, 0.0), (-30.0, 3.0, 3.0)] {
+            let fp = GridFootprint::new(&knee, angle, &spec);
+            let sf = SurfaceFootprint::new(&fp);
+            let rule = StrikeRule::new(deflection, StrikeRule::DEFAULT_E0)
+                .with_window(window)
+                .with_level(Level::Surface);
+            for j0 in 0..spec.nz {
+                let mut want = vec![0u8; spec.len()];
+                let mut placed = 0;
+                for i0 in 0..spec.nx {
+                    let t = trace(&sg, &sf, (i0, j0), &rule);
+                    placed += usize::from(t.yr.is_finite());
+                    for ((i, j), _) in t.strikes {
+                        want[j * spec.nx + i] = 1;
+                    }
+                }
+                let mut got = vec![0u8; spec.len()];
+                let mut trail = RowTrail::new(&sf, spec.nx, &rule);
+                let mut windows = PushWindows::new(&sf, &grid, j0);
+                let mut got_placed = 0;
+                for i0 in 0..spec.nx {
+                    trail.windows.lowest = windows.advance(&grid, i0);
+                    let t = slide_start(&sg, &sf, (i0, j0), &rule, Some(&mut trail));
+                    got_placed += usize::from(t.yr.is_finite());
+                    for ((i, j), _) in t.strikes {
+                        got[j * spec.nx + i] = 1;
+                    }
+                }
+                joined += (0..trail.parent.len())
+                    .filter(|&l| trail.parent[l] as usize != l)
+                    .count();
+                assert_eq!(got, want, "angle {angle}, window {window}, row {j0}");
+                assert_eq!(got_placed, placed, "angle {angle}, row {j0}");
+                let mut row_mask = vec![0u8; spec.len()];
+                assert_eq!(trace_row(&sg, &sf, j0, &rule, &mut row_mask), placed);
+                assert_eq!(row_mask, want, "trace_row, angle {angle}, row {j0}");
+            }
+        }
+        assert!(joined > 100, "only {joined} slides joined an earlier one");
+    }
+}

@@ -164,11 +164,12 @@ pub fn colliding_masks(
 }
 
 /// [`colliding_masks`] under the surface level (SPEC v4): the union of the
-/// per-start slides of [`crate::surface::trace`], start rows in parallel.
-/// There is no streaming form yet, so each start slides until a bound of
-/// everything ahead of it is at or above its level: on the README console
-/// at 1.24 mm, one angle did not finish in 15 minutes on a loaded 2-core
-/// machine where the node level's whole analysis took 2 s. The blind spots' probes are still judged at the node level,
+/// per-start slides of [`crate::surface::trace`], start rows in parallel,
+/// each row's starts through [`crate::surface::trace_row`] (a start stops
+/// where it continues an earlier start's slide). There is no streaming
+/// form across rows yet: on the README console at 1.24 mm an angle takes
+/// about 150 s on a loaded 2-core machine, where the node level's takes
+/// 2 s (`results/ab.md`). The blind spots' probes are still judged at the node level,
 /// which is never below the surface level (the surface's minimum is taken
 /// over the nodes too), so a blind spot the surface level meets is
 /// reported.
