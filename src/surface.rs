@@ -671,15 +671,19 @@ struct PushNodes {
 /// whose heights increase (an equal height keeps the earlier column), so
 /// its front is the row's first lowest node, as the push's scan finds it.
 struct PushWindows {
-    /// Per footprint row: its grid row (`None` off the grid), `klo`,
-    /// `khi`, the next column to enter and the queue `(column, height)`.
-    rows: Vec<(
-        Option<usize>,
-        i64,
-        i64,
-        i64,
-        std::collections::VecDeque<(i64, f64)>,
-    )>,
+    rows: Vec<PushWindow>,
+}
+
+/// One footprint row's window of [`PushWindows`].
+struct PushWindow {
+    /// Its grid row, `None` off the grid.
+    row: Option<usize>,
+    klo: i64,
+    khi: i64,
+    /// The next column to enter.
+    next: i64,
+    /// `(column, height)`, heights increasing.
+    queue: std::collections::VecDeque<(i64, f64)>,
 }
 
 impl PushWindows {
@@ -692,7 +696,13 @@ impl PushWindows {
                 let j = j0 as i64 + i64::from(dj);
                 let on = (0..nz).contains(&j).then_some(j as usize);
                 let (klo, khi) = (i64::from(klo), i64::from(khi));
-                (on, klo, khi, klo, std::collections::VecDeque::new())
+                PushWindow {
+                    row: on,
+                    klo,
+                    khi,
+                    next: klo,
+                    queue: std::collections::VecDeque::new(),
+                }
             })
             .collect();
         PushWindows { rows }
@@ -704,7 +714,14 @@ impl PushWindows {
         let nx = grid.spec.nx as i64;
         let i0 = i0 as i64;
         let mut lowest = Lowest(None);
-        for (row, klo, khi, next, queue) in &mut self.rows {
+        for PushWindow {
+            row,
+            klo,
+            khi,
+            next,
+            queue,
+        } in &mut self.rows
+        {
             let Some(j) = *row else { continue };
             let hi = (i0 + *khi).min(nx - 1);
             while *next <= hi {
