@@ -139,6 +139,7 @@ pub fn check_analysis(
     let given = GridSide {
         cells: Some(&cells),
         fault: None,
+        tick: None,
     };
     let comparison = compare_grid_with(
         triangles,

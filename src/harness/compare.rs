@@ -732,14 +732,17 @@ pub(crate) fn compare_grid_with(
 }
 
 /// What a comparison's grid side may be handed: the grid's blind spots
-/// when an analysis found them already (else they are found again), and a
-/// deliberate mistake (tests only).
+/// when an analysis found them already (else they are found again), a
+/// deliberate mistake (tests only), and what to call as each pair is
+/// compared (a progress bar's step: minutes on a large part).
 #[derive(Default, Clone, Copy)]
 pub(crate) struct GridSide<'a> {
     /// The grid's cells and blind spots.
     pub(crate) cells: Option<&'a Cells>,
     /// A mistake the harness must catch.
     pub(crate) fault: Option<Fault>,
+    /// Called once per pair compared, from any thread.
+    pub(crate) tick: Option<&'a (dyn Fn() + Sync)>,
 }
 
 /// Every start-angle pair of `starts` (positions in mm, nodes of `grid`,
@@ -754,7 +757,7 @@ pub(crate) fn pair_results(
     options: &CompareOptions,
     given: GridSide,
 ) -> Result<Vec<PairResult>, HarnessError> {
-    let GridSide { cells, fault } = given;
+    let GridSide { cells, fault, tick } = given;
     crate::engine::assert_same_pitch(grid, footprints);
     let spec = grid.spec;
     let band = TieBand::new(options.rule.sigma, spec.pitch, options.tie_band_per_mm);
@@ -902,6 +905,9 @@ pub(crate) fn pair_results(
                     };
                     let result = one((a, s), &g, &mut finer_before);
                     before = Some(g);
+                    if let Some(tick) = tick {
+                        tick();
+                    }
                     result
                 })
                 .collect()

@@ -371,6 +371,18 @@ impl<'a> Ladder<'a> {
             // A verification does not time the engine.
             (Vec::new(), 0.0)
         };
+        // The comparison, pair by pair with the time left (a minute on
+        // the console's default verification).
+        let comparing = super::stage::comparing(self.traces.len());
+        progress.begin(
+            &if at.converging {
+                format!("pitch {p} mm: {comparing}")
+            } else {
+                comparing
+            },
+            Some(self.traces.len() as u64),
+        );
+        let step = || progress.step();
         let t = Instant::now();
         let pairs = pair_results(
             self.triangles,
@@ -382,6 +394,7 @@ impl<'a> Ladder<'a> {
             GridSide {
                 cells: None,
                 fault: self.fault,
+                tick: Some(&step),
             },
         );
         let grid_s = t.elapsed().as_secs_f64();
