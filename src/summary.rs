@@ -742,6 +742,68 @@ pub struct PitchChoice {
     pub reason: String,
 }
 
+/// How far, in units of the last place (relative: `v * f64::EPSILON`),
+/// a figure of a result's JSON may move to a shorter decimal
+/// ([`json_text`]).
+pub const JSON_NOISE_ULPS: f64 = 4.0;
+
+/// `value` as the pretty JSON of a result file (`summary.json`,
+/// `verify.json`, `converge.json`, `diff.json`), with a final newline:
+/// every fractional number written as the shortest decimal within
+/// [`JSON_NOISE_ULPS`] units in the last place of it ([`rounded_figure`]),
+/// so that a computed `-234.36` (`i * p`) is `-234.36`, not its double's
+/// `-234.35999999999999`, and `nodes * p^2` is `337680.024`, not
+/// `337680.02400000003`. Arithmetic leaves its noise in a double's last
+/// few places, and only there: a figure moves by at most 9e-16 of itself
+/// (1e-12 mm on a metre), far within the 1e-12 relative tolerance with
+/// which a reader places a grid coordinate on its node (the report's
+/// `ORIGIN_TOL`), and every digit a figure means is kept (an irrational
+/// `sqrt 2 * 1.24` keeps its 15 or 16). Integers are written as they are.
+pub fn json_text(value: &impl serde::Serialize) -> serde_json::Result<String> {
+    let mut value = serde_json::to_value(value)?;
+    round_figures(&mut value);
+    Ok(serde_json::to_string_pretty(&value)? + "\n")
+}
+
+/// Rounds every floating-point number in `value` ([`json_text`]).
+fn round_figures(value: &mut serde_json::Value) {
+    use serde_json::Value;
+    match value {
+        Value::Number(n) if n.is_f64() => {
+            if let Some(rounded) = n
+                .as_f64()
+                .map(rounded_figure)
+                .and_then(serde_json::Number::from_f64)
+            {
+                *n = rounded;
+            }
+        }
+        Value::Array(items) => items.iter_mut().for_each(round_figures),
+        Value::Object(fields) => fields.values_mut().for_each(round_figures),
+        _ => {}
+    }
+}
+
+/// The shortest decimal within [`JSON_NOISE_ULPS`] units in the last
+/// place of `v` (as a relative `v * f64::EPSILON`), as the double that
+/// reads back from it: `v` without its float noise (`-0` as `0`; a
+/// non-finite value as it is).
+pub fn rounded_figure(v: f64) -> f64 {
+    if !v.is_finite() || v == 0.0 {
+        return if v == 0.0 { 0.0 } else { v };
+    }
+    let within = JSON_NOISE_ULPS * f64::EPSILON * v.abs();
+    for digits in 1..=17 {
+        let text = format!("{v:.*e}", digits - 1);
+        if let Ok(r) = text.parse::<f64>()
+            && (r - v).abs() <= within
+        {
+            return if r == 0.0 { 0.0 } else { r };
+        }
+    }
+    v
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -815,5 +877,70 @@ mod tests {
         // A message names the key, with short numbers.
         let err = with("pitch_mm", json!(1e-300)).unwrap_err().to_string();
         assert!(err.starts_with("`pitch_mm` is 1e-300, outside"), "{err}");
+    }
+}
+
+#[cfg(test)]
+mod json_tests {
+    use super::*;
+
+    #[test]
+    fn json_figures_lose_their_float_noise_and_nothing_else() {
+        // A computed grid origin (-189 * 1.24) and an area (nodes * p^2).
+        let origin = -189.0 * 1.24;
+        let area = 219_615.0 * (1.24 * 1.24);
+        assert_ne!(origin.to_string(), "-234.36", "the double carries noise");
+        assert_ne!(area.to_string(), "337680.024", "the double carries noise");
+        let text = json_text(&serde_json::json!({
+            "origin": origin,
+            "area": area,
+            "tenth": 0.1 + 0.2,
+            "sum": 0.1 + 0.2 + 0.3,
+            "tolerance": 2f64.sqrt() * 1.24,
+            "root": std::f64::consts::FRAC_1_SQRT_2,
+            "small": 1e-6,
+            "tiny": 3.2e-15,
+            "count": 219_615,
+            "whole": 30.0,
+            "negative_zero": -0.0,
+            "nested": [[0.1 + 0.2]],
+        }))
+        .unwrap();
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(v["origin"].to_string(), "-234.36");
+        assert_eq!(v["area"].to_string(), "337680.024");
+        assert_eq!(v["tenth"].to_string(), "0.3");
+        assert_eq!(v["sum"].to_string(), "0.6");
+        assert_eq!(v["nested"][0][0].to_string(), "0.3");
+        // A figure that means all its digits keeps them, to within 1e-15.
+        for (key, exact) in [
+            ("tolerance", 2f64.sqrt() * 1.24),
+            ("root", std::f64::consts::FRAC_1_SQRT_2),
+        ] {
+            let written = v[key].as_f64().unwrap();
+            assert!((written - exact).abs() <= 1e-15 * exact, "{key}: {written}");
+            assert!(v[key].to_string().len() >= 16, "{key}: {}", v[key]);
+        }
+        assert_eq!(v["small"].as_f64(), Some(1e-6));
+        assert_eq!(v["tiny"].as_f64(), Some(3.2e-15));
+        assert_eq!(v["count"].to_string(), "219615");
+        assert_eq!(v["whole"].to_string(), "30.0");
+        assert_eq!(v["negative_zero"].to_string(), "0.0");
+        assert!(text.ends_with("}\n"));
+        // Within 1e-15 of itself: far within the 1e-12 relative tolerance
+        // a reader places a grid coordinate with.
+        for x in [
+            origin,
+            area,
+            1.0 + 4.9e-13,
+            9.999_999_999_999_5,
+            -1e300,
+            5e-324,
+        ] {
+            let r = rounded_figure(x);
+            assert!((r - x).abs() <= 1e-15 * x.abs(), "{x} -> {r}");
+        }
+        assert!(rounded_figure(f64::NAN).is_nan());
+        assert_eq!(rounded_figure(f64::INFINITY), f64::INFINITY);
     }
 }

@@ -21,6 +21,11 @@ pub(crate) fn kneeform(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
+/// What a run said: its results (stdout), then its messages (stderr).
+pub(crate) fn said(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr)
+}
+
 /// [`kneeform`] run in the directory `dir`.
 pub(crate) fn kneeform_in(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_kneeform"))
@@ -35,12 +40,10 @@ fn real_meshes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/meshes")
 }
 
-const OUTPUTS: [&str; 7] = [
+const OUTPUTS: [&str; 5] = [
     "summary.json",
-    "composite.csv",
+    "composite.csv.gz",
     "zones.csv",
-    "colliding_area.stl",
-    "colliding_area.ply",
     "depth.png",
     "composite.png",
 ];
@@ -48,7 +51,7 @@ const OUTPUTS: [&str; 7] = [
 /// Asserts a run failed cleanly: exit 2, one line on stderr, no output
 /// directory and no staging directory left beside it.
 pub(crate) fn assert_clean_failure(out: &Output, dir: &Path, what: &str) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert_eq!(out.status.code(), Some(2), "{what}: {stderr}");
     assert_eq!(stderr.lines().count(), 1, "{what}: not one line: {stderr}");
     assert!(stderr.starts_with("kneeform: error: "), "{what}: {stderr}");
@@ -218,12 +221,16 @@ fn thread_count_does_not_change_any_byte() {
     analyse_to(
         &part,
         &scratch.join("one"),
-        &["--threads", "1", "--points-csv"],
+        &["--threads", "1", "--points-csv", "--stl", "--ply"],
     );
-    analyse_to(&part, &scratch.join("many"), &["--points-csv"]);
+    analyse_to(
+        &part,
+        &scratch.join("many"),
+        &["--points-csv", "--stl", "--ply"],
+    );
     for f in [
         "colliding_points.csv",
-        "composite.csv",
+        "composite.csv.gz",
         "colliding_area.stl",
         "colliding_area.ply",
     ] {
@@ -238,9 +245,27 @@ fn thread_count_does_not_change_any_byte() {
     std::fs::remove_dir_all(&scratch).unwrap();
 }
 
-/// Rows of a CSV file as text fields, header dropped.
+/// The text of a run's table: `path` itself, or where it is missing its
+/// compressed form, `path` with `.gz` (as `composite.csv.gz`, written by
+/// default) decompressed.
+pub(crate) fn table_text(path: &Path) -> String {
+    if path.exists() {
+        return std::fs::read_to_string(path).unwrap();
+    }
+    let mut gz = path.as_os_str().to_owned();
+    gz.push(".gz");
+    let file = std::fs::File::open(&gz)
+        .unwrap_or_else(|e| panic!("neither {} nor its .gz: {e}", path.display()));
+    let mut text = String::new();
+    std::io::Read::read_to_string(&mut flate2::read::GzDecoder::new(file), &mut text).unwrap();
+    text
+}
+
+/// Rows of a CSV file (or its `.gz`, [`table_text`]) as text fields,
+/// header dropped.
 pub(crate) fn csv_rows(path: &Path) -> Vec<Vec<String>> {
-    let mut reader = csv::Reader::from_path(path).unwrap();
+    let text = table_text(path);
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
     reader
         .records()
         .map(|r| r.unwrap().iter().map(str::to_string).collect())
@@ -451,14 +476,14 @@ fn verify_warns_when_nothing_is_struck_on_either_side() {
         ])
     };
     let flat = run("flat-wall.toml", "flat");
-    let stderr = String::from_utf8_lossy(&flat.stderr);
+    let stderr = crate::cli::said(&flat);
     assert_eq!(flat.status.code(), Some(3), "{stderr}");
     assert!(
         stderr.contains("strikes nothing on these starts"),
         "{stderr}"
     );
     let ramp = run("ramp.toml", "ramp");
-    let stderr = String::from_utf8_lossy(&ramp.stderr);
+    let stderr = crate::cli::said(&ramp);
     assert!(!stderr.contains("strikes nothing"), "{stderr}");
     std::fs::remove_dir_all(dir).unwrap();
 }
@@ -511,7 +536,7 @@ fn built_in_names_are_the_scenario_files_from_any_directory() {
         assert_eq!(written.len(), 84 + 50 * count, "{stem}");
     }
     let out = run(&["scenario", "no-such-part", "--out", "x.stl"]);
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stderr = crate::cli::said(&out);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
     for stem in &stems {
@@ -522,4 +547,117 @@ fn built_in_names_are_the_scenario_files_from_any_directory() {
     }
     assert!(!dir.join("x.stl").exists());
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Issue 39, item 6: every command's results (what it found and where it
+/// wrote them) on stdout, every message (progress with the time left,
+/// notes, warnings) on stderr: `analyze`, `verify` and `report` of a
+/// small run, with a progress line forced every 50 ms off a terminal.
+#[test]
+fn results_go_to_stdout_and_messages_to_stderr() {
+    let dir = scratch_dir("stdout-stderr");
+    let part = crate::util::scenario("bump");
+    let run = |args: &[&str]| -> (Option<i32>, String, String) {
+        let out = Command::new(env!("CARGO_BIN_EXE_kneeform"))
+            .current_dir(&dir)
+            .args(args)
+            .env_remove("RUST_BACKTRACE")
+            .env("KNEEFORM_PROGRESS_EVERY", "0.05")
+            .output()
+            .expect("the binary runs");
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    // What only a message says: progress (elapsed, left), a warning, the
+    // memory note, an error.
+    let is_message = |line: &str| {
+        line.contains(" elapsed")
+            || line.starts_with("kneeform: warning")
+            || line.starts_with("kneeform: error")
+            || line.contains("needs about")
+    };
+    let check = |what: &str, stdout: &str, stderr: &str, results: &[&str]| {
+        assert!(
+            !stdout.is_empty(),
+            "{what}: nothing on stdout; stderr:\n{stderr}"
+        );
+        for line in stdout.lines() {
+            assert!(!is_message(line), "{what}: a message on stdout: {line}");
+        }
+        for needle in results {
+            assert!(
+                stdout.contains(needle),
+                "{what}: {needle:?} not on stdout:\n{stdout}"
+            );
+            assert!(
+                !stderr.contains(needle),
+                "{what}: {needle:?} on stderr:\n{stderr}"
+            );
+        }
+    };
+    let (code, stdout, stderr) = run(&[
+        "analyze",
+        &part,
+        "--pitch",
+        "2",
+        "--angles=-30:30:2",
+        "--out",
+        "run",
+    ]);
+    assert_eq!(code, Some(0), "{stderr}");
+    check(
+        "analyze",
+        &stdout,
+        &stderr,
+        &[
+            "composite",
+            "results in run",
+            "struck zones",
+            "sample check against",
+        ],
+    );
+    // The push and slide's progress, with the time left, on stderr.
+    assert!(
+        stderr
+            .lines()
+            .any(|l| l.starts_with("kneeform: push and slide: ") && l.contains(" left")),
+        "no progress with the time left on stderr:\n{stderr}"
+    );
+    let (code, stdout, stderr) = run(&[
+        "verify",
+        &part,
+        "--pitch",
+        "2",
+        "--angles=-30,0,30",
+        "--out",
+        "v",
+    ]);
+    assert!(matches!(code, Some(0 | 1 | 3)), "{stderr}");
+    check(
+        "verify",
+        &stdout,
+        &stderr,
+        &["at tolerance", "results in v"],
+    );
+    // The oracle's pairs and the comparison, counted with the time left.
+    for stage in ["kneeform: exact oracle: ", "kneeform: grid against exact: "] {
+        assert!(
+            stderr
+                .lines()
+                .any(|l| l.starts_with(stage) && l.contains('/')),
+            "no counted progress of {stage:?}:\n{stderr}"
+        );
+    }
+    let (code, stdout, stderr) = run(&["report", "run", "v", "--out", "r.html"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    check("report", &stdout, &stderr, &["written to r.html"]);
+    // An error: one line on stderr, nothing on stdout.
+    let (code, stdout, stderr) = run(&["analyze", "missing.stl", "--out", "x"]);
+    assert_eq!(code, Some(2));
+    assert_eq!(stdout, "");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }

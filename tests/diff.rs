@@ -121,7 +121,7 @@ fn runs_computed_differently_are_refused() {
     let b = analyse(&dir, &p, "b", &["--deflection", "1"]);
     let out = dir.join("diff");
     let run = kneeform(&["diff", &a, &b, "--out", &out.display().to_string()]);
-    let stderr = String::from_utf8_lossy(&run.stderr);
+    let stderr = crate::cli::said(&run);
     assert_eq!(run.status.code(), Some(2), "{stderr}");
     assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
     assert!(stderr.contains("deflection_deg"), "{stderr}");

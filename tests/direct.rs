@@ -246,7 +246,7 @@ fn the_report_compares_a_direct_run_with_a_slide_run_of_the_same_part() {
         &["report", "slide", "--compare", "slide", "--out", "x.html"],
     );
     assert_eq!(out.status.code(), Some(2));
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = crate::cli::said(&out);
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("the report's run itself"), "{err}");
 }
@@ -308,7 +308,7 @@ fn verify_compares_the_direct_approach_with_its_exact_oracle() {
         "v",
     ];
     let out = kneeform_cli(&dir, &args);
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = crate::cli::said(&out);
     // PASS or FAIL at the default 1 mm tolerance, never an error.
     assert!(matches!(out.status.code(), Some(0 | 1 | 3)), "{err}");
     let json = std::fs::read_to_string(dir.join("v/verify.json")).unwrap();
@@ -326,7 +326,7 @@ fn verify_compares_the_direct_approach_with_its_exact_oracle() {
     *budget.last_mut().unwrap() = "with-budget";
     budget.extend(["--budget-s", "1000"]);
     let out = kneeform_cli(&dir, &budget);
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = crate::cli::said(&out);
     assert!(matches!(out.status.code(), Some(0 | 1 | 3)), "{err}");
     assert!(
         err.contains(&format!("kneeform: warning: {warning}")),

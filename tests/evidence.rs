@@ -149,7 +149,7 @@ fn every_command_refuses_an_existing_or_locked_out_before_any_work() {
     let lock = DirLock::take(&locked).unwrap();
     for command in ["verify", "converge"] {
         let o = long_study(command, &locked, &[]);
-        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        let err = crate::cli::said(&o);
         assert_eq!(o.status.code(), Some(2), "{command}: {err}");
         assert!(err.contains("another kneeform run"), "{command}: {err}");
         no_work(&err, command);
@@ -163,7 +163,7 @@ fn every_command_refuses_an_existing_or_locked_out_before_any_work() {
     if std::fs::write(read_only.join("probe"), "").is_err() {
         for command in ["verify", "converge"] {
             let o = long_study(command, &read_only.join("v"), &[]);
-            let err = String::from_utf8_lossy(&o.stderr).into_owned();
+            let err = crate::cli::said(&o);
             assert_eq!(o.status.code(), Some(2), "{command}: {err}");
             assert_eq!(err.lines().count(), 1, "{command}: {err}");
             no_work(&err, command);
@@ -270,7 +270,7 @@ fn force_replaces_only_what_the_record_proves_kneeform_wrote() {
     }
     // A run's own file given as its input.
     let run = dir.join("run");
-    ok(quick_analyze(&bump, &run, &[]), "a run");
+    ok(quick_analyze(&bump, &run, &["--stl"]), "a run");
     assert!(run.join("kneeform-run.json").is_file());
     let input = run.join("colliding_area.stl");
     let before = snapshot(&run);
@@ -713,7 +713,7 @@ fn the_sample_check_keeps_within_the_memory_allowed() {
     );
     let note = s["sample_check"]["note"].as_str().unwrap();
     assert!(note.contains("--max-memory"), "{note}");
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = crate::cli::said(&o);
     assert!(err.contains("not run"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

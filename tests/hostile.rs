@@ -740,7 +740,7 @@ args = ["--ignore", "soft.toml", "--frame", "@frame.txt"]
     .unwrap();
     let ran = |what: &str| {
         let o = batch(&manifest);
-        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        let err = crate::cli::said(&o);
         assert!(o.status.success(), "{what}: {err}");
         err.contains("1 items run")
     };
@@ -1011,7 +1011,7 @@ fn a_blind_spot_with_no_resolving_pitch_says_so() {
         "--out",
         &dir.join("run").display().to_string(),
     ]);
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = crate::cli::said(&o);
     assert!(o.status.success(), "{err}");
     let line = err
         .lines()
@@ -1035,7 +1035,7 @@ fn manifest_values_and_flags_are_refused_naming_what_was_given() {
     ] {
         std::fs::write(&manifest, format!("[[item]]\n{item}")).unwrap();
         let o = batch(&manifest);
-        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        let err = crate::cli::said(&o);
         assert_eq!(o.status.code(), Some(2), "{item}: {err}");
         assert!(!err.contains("Usage"), "{item}: clap's usage: {err}");
         assert!(err.contains(needle), "{item}: {err}");
@@ -1150,7 +1150,7 @@ fn a_report_reads_one_run_whole_or_refuses() {
             Some(0) => {}
             // Refused in one line: replaced while read, or busy.
             Some(2) => {
-                let err = String::from_utf8_lossy(&out.stderr);
+                let err = crate::cli::said(&out);
                 assert_eq!(err.lines().count(), 1, "{err}");
                 assert!(err.starts_with("kneeform: error: "), "{err}");
             }
@@ -1191,7 +1191,7 @@ fn dev_zero_in_place_of_any_file_is_refused_in_one_line() {
     assert!(assert_refused(&o, &dir, "a /dev/zero part").contains("not a regular file"));
     let run = dir.join("run");
     small_run(&run, &[]);
-    std::fs::remove_file(run.join("composite.csv")).unwrap();
+    std::fs::remove_file(run.join("composite.csv.gz")).unwrap();
     std::os::unix::fs::symlink(zero, run.join("composite.csv")).unwrap();
     let o = kneeform(&[
         "report",

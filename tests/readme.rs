@@ -435,12 +435,7 @@ fn quick_start(ctx: &Ctx) -> Result<(), String> {
     let s = ctx.json("kneeform-out/summary.json");
     assert_eq!(s["angles_deg"].as_array().unwrap().len(), 61, "{s}");
     assert!(composite_nodes(&s) > 0, "{s}");
-    for f in [
-        "composite.csv",
-        "colliding_area.stl",
-        "depth.png",
-        "composite.png",
-    ] {
+    for f in ["composite.csv.gz", "depth.png", "composite.png"] {
         assert!(ctx.dir.join("kneeform-out").join(f).is_file(), "{f}");
     }
     Ok(())
@@ -520,7 +515,7 @@ fn assembly(ctx: &Ctx) -> Result<(), String> {
 fn pitch_auto(ctx: &Ctx) -> Result<(), String> {
     ctx.part("part.stl", &small("step"));
     let out = ctx.sh(&ctx.block.text);
-    let said = String::from_utf8_lossy(&out.stderr);
+    let said = crate::cli::said(&out);
     assert!(
         said.contains("decided exact strike away from flagged blind spots")
             && said.contains("the whole-part change from the coarser pitch is shown, not judged"),
@@ -573,7 +568,7 @@ fn angle_sets(ctx: &Ctx) -> Result<(), String> {
     let version = match probe {
         Err(e) => return Err(format!("python3 does not run: {e}")),
         Ok(o) if !o.status.success() => {
-            let err = String::from_utf8_lossy(&o.stderr);
+            let err = crate::cli::said(&o);
             let last = err.lines().last().unwrap_or("").to_string();
             return Err(format!("pandas is not importable: {last}"));
         }
@@ -729,7 +724,7 @@ fn batch_manifest(ctx: &Ctx) -> Result<(), String> {
     let door = ctx.json("runs/door_left/summary.json");
     assert!(composite_nodes(&door) > 0, "{door}");
     let again = ctx.sh("kneeform batch manifest.toml");
-    let said = String::from_utf8_lossy(&again.stderr);
+    let said = crate::cli::said(&again);
     assert!(
         said.contains("skip"),
         "a second batch redid its items: {said}"

@@ -50,6 +50,7 @@ fn step_run(name: &str, side: &str) -> PathBuf {
                 // The long table too: the tests check the report's masks
                 // (from composite.csv) against it.
                 "--points-csv",
+                "--csv",
             ],
         ),
         "analyze",
@@ -556,6 +557,18 @@ fn every_value_the_report_cites_from_real_studies_is_in_their_files() {
             "nothing cited from {file}"
         );
     }
+    // Issue 39, item 5: printed, every table fits the page; verify.csv's
+    // per-start table (27 columns) lost its last columns.
+    assert!(
+        html.contains("table class=\"csv\""),
+        "no per-start table to print"
+    );
+    if let Some(over) = crate::util::tables_wider_than_print(&dir.join("report.html"), &dir) {
+        assert!(
+            over.is_empty(),
+            "tables wider than the printed page: {over:?}"
+        );
+    }
 }
 
 #[test]
@@ -662,6 +675,7 @@ fn analyze_report_writes_the_report_and_the_coloured_mesh_with_the_run() {
             &dir,
             &[
                 "analyze", "part.stl", "--pitch", PITCH, ANGLES, "--out", "run", "--report",
+                "--ply",
             ],
         ),
         "analyze --report",
@@ -680,18 +694,30 @@ fn analyze_report_writes_the_report_and_the_coloured_mesh_with_the_run() {
     // The coloured mesh: one patch of four vertices per node of the strip
     // (a single column of nodes makes no cell), each in the brightest
     // colour with quality 5, as every one of the 5 angles strikes it.
-    let ply = std::fs::read_to_string(dir.join("run/colliding_area.ply")).unwrap();
-    let (header, body) = ply.split_once("end_header\n").expect("a PLY header");
-    assert!(header.starts_with("ply\nformat ascii 1.0\n"));
+    // Binary: x y z as floats, red green blue, quality as a float (19
+    // bytes a vertex), then per face 3 and three int indices (13 bytes).
+    let ply = std::fs::read(dir.join("run/colliding_area.ply")).unwrap();
+    let end = ply
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .expect("a PLY header")
+        + 11;
+    let header = String::from_utf8(ply[..end].to_vec()).unwrap();
+    assert!(header.starts_with("ply\nformat binary_little_endian 1.0\n"));
     assert!(header.contains("element vertex 604\n"), "{header}");
     assert!(header.contains("element face 302\n"), "{header}");
     assert!(header.contains("property uchar red\n"));
-    let lines: Vec<&str> = body.lines().collect();
-    assert_eq!(lines.len(), 604 + 302);
-    for v in &lines[..604] {
-        let f: Vec<f64> = v.split(' ').map(|t| t.parse().unwrap()).collect();
-        assert!((f[0] + 2.0).abs() <= 0.25, "{v}");
-        assert_eq!(&f[3..], [253.0, 231.0, 37.0, 5.0], "{v}");
+    assert_eq!(ply.len() - end, 604 * 19 + 302 * 13);
+    let float = |at: usize| f32::from_le_bytes(ply[at..at + 4].try_into().unwrap());
+    for v in 0..604 {
+        let at = end + 19 * v;
+        assert!(
+            (float(at) + 2.0).abs() <= 0.25,
+            "vertex {v}: x {}",
+            float(at)
+        );
+        assert_eq!(ply[at + 12..at + 15], [253, 231, 37], "vertex {v}");
+        assert_eq!(float(at + 15), 5.0, "vertex {v}");
     }
     std::fs::remove_dir_all(dir).unwrap();
 }
@@ -703,7 +729,7 @@ fn a_changed_part_is_refused_with_a_clear_message() {
     bytes[0] ^= 1;
     std::fs::write(dir.join("part.stl"), bytes).unwrap();
     let out = kneeform(&dir, &["report", "run", "--out", "report.html"]);
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stderr = crate::cli::said(&out);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("has changed since the run"), "{stderr}");
     assert!(stderr.contains("--part"), "{stderr}");

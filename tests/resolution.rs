@@ -161,7 +161,7 @@ fn blind_spots_are_written_crossed_and_reported() {
         ])
         .output()
         .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stderr = crate::cli::said(&out);
     assert!(out.status.success(), "{stderr}");
     // Loud: the knee-form meets the ribs the grid cannot see.
     assert!(

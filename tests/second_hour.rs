@@ -97,7 +97,7 @@ fn analyze(dir: &Path, part: &Path, extra: &[&str]) -> (String, serde_json::Valu
     ];
     args.extend_from_slice(extra);
     let o = kneeform(&args);
-    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    let err = crate::cli::said(&o);
     assert!(o.status.success(), "{err}");
     (err, summary(&out))
 }
@@ -194,7 +194,7 @@ fn off_a_terminal_progress_comes_as_lines() {
         .env("KNEEFORM_PROGRESS_EVERY", "0.05")
         .output()
         .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = crate::cli::said(&o);
     assert!(matches!(o.status.code(), Some(0 | 1 | 3)), "{err}");
     let progress: Vec<&str> = err.lines().filter(|l| l.contains(" elapsed")).collect();
     assert!(!progress.is_empty(), "no progress line: {err}");
@@ -243,7 +243,7 @@ fn report_finds_a_relative_part_from_elsewhere_and_keeps_an_existing_file() {
     // Again: refused, the file untouched.
     std::fs::write(dir.join("runs/step/report.html"), b"my notes").unwrap();
     let o = report(&["report", "."]);
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = crate::cli::said(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("--force"), "{err}");
     assert_eq!(
@@ -253,7 +253,7 @@ fn report_finds_a_relative_part_from_elsewhere_and_keeps_an_existing_file() {
     // Nor with --force (issue 41, item 4): the file is not a report
     // kneeform wrote.
     let o = report(&["report", ".", "--force"]);
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = crate::cli::said(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("not a report kneeform wrote"), "{err}");
     assert_eq!(
@@ -291,7 +291,7 @@ fn the_area_iou_says_what_it_cannot_see() {
         ]
         .concat(),
     );
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = crate::cli::said(&o);
     assert!(matches!(o.status.code(), Some(0 | 1 | 3)), "{err}");
     assert!(err.contains("snapped to their nearest nodes"), "{err}");
     let o = kneeform_in(&dir, &["report", "run", "v", "--out", "r.html"]);
@@ -313,7 +313,7 @@ fn study(dir: &Path, common: &[&str], out: &str, extra: &[&str]) -> std::process
 /// twenty, spread over the starts and angles (6 of 40 x 3).
 fn holds_to_its_budget(dir: &Path, common: &[&str], free: &[&str]) {
     let o = study(dir, common, "refused", &["--budget-s", "0.000001"]);
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = crate::cli::said(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(
         err.contains("--budget-s") && err.contains("--shard K/"),
@@ -321,7 +321,7 @@ fn holds_to_its_budget(dir: &Path, common: &[&str], free: &[&str]) {
     );
     assert!(!dir.join("refused").exists(), "a refused run wrote nothing");
     let o = study(dir, common, "free", free);
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = crate::cli::said(&o);
     assert!(matches!(o.status.code(), Some(0 | 1 | 3)), "{err}");
     assert!(
         err.contains("predicted from 6 of them spread over the starts and angles"),
@@ -408,7 +408,7 @@ fn csvs_and_messages_carry_no_float_noise() {
             "run",
         ],
     );
-    let mut said = String::from_utf8_lossy(&run.stderr).into_owned();
+    let mut said = crate::cli::said(&run);
     assert!(run.status.success(), "{said}");
     let verify = kneeform_in(
         &dir,
@@ -422,7 +422,7 @@ fn csvs_and_messages_carry_no_float_noise() {
             "v",
         ],
     );
-    said.push_str(&String::from_utf8_lossy(&verify.stderr));
+    said.push_str(&crate::cli::said(&verify));
     // Six scattered starts are INCONCLUSIVE (exit 3): a study written all the same.
     assert!(matches!(verify.status.code(), Some(0 | 1 | 3)), "{said}");
     let converge = kneeform_in(
@@ -441,7 +441,7 @@ fn csvs_and_messages_carry_no_float_noise() {
             "c",
         ],
     );
-    said.push_str(&String::from_utf8_lossy(&converge.stderr));
+    said.push_str(&crate::cli::said(&converge));
     assert_eq!(converge.status.code(), Some(0), "{said}");
     // Item 7: the declined verdict names its reason.
     assert!(
@@ -455,7 +455,7 @@ fn csvs_and_messages_carry_no_float_noise() {
         "run/blind_spots.csv",
         "v/verify.csv",
     ] {
-        let text = std::fs::read_to_string(dir.join(file)).unwrap();
+        let text = crate::cli::table_text(&dir.join(file));
         // Only the coordinates: the metrics are measured values, written
         // whole.
         let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
@@ -474,6 +474,30 @@ fn csvs_and_messages_carry_no_float_noise() {
             rows += 1;
         }
         assert!(rows > 0 || file.contains("blind"), "{file} is empty");
+    }
+    // Issue 39, item 5: nor in the JSON files, where a computed grid
+    // origin (`i * p`) was `-234.35999999999999` and an area
+    // `337680.02400000003`. Every fractional number is checked, and there
+    // are such numbers to check (areas, the origin, distances).
+    for file in ["run/summary.json", "v/verify.json"] {
+        let text = std::fs::read_to_string(dir.join(file)).unwrap();
+        let mut fractional = 0;
+        let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let mut stack = vec![&json];
+        while let Some(v) = stack.pop() {
+            match v {
+                serde_json::Value::Number(n) if n.is_f64() => {
+                    let written = n.to_string();
+                    fractional += usize::from(written.contains('.'));
+                    assert_eq!(float_noise(&written), None, "{file}: {written}");
+                }
+                serde_json::Value::Array(a) => stack.extend(a),
+                serde_json::Value::Object(o) => stack.extend(o.values()),
+                _ => {}
+            }
+        }
+        assert!(fractional > 10, "{file}: {fractional} fractional numbers");
+        assert_eq!(float_noise(&text), None, "{file}");
     }
 }
 
@@ -498,7 +522,10 @@ fn an_analysis_states_its_sample_check_or_that_it_was_skipped() {
         ];
         args.extend_from_slice(extra);
         let o = kneeform_in(Path::new(env!("CARGO_MANIFEST_DIR")), &args);
-        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        // The sample check's line is a result (stdout), its warning a
+        // message (stderr): both read here.
+        let err =
+            String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
         assert!(o.status.success(), "{err}");
         (err, summary(&out))
     };

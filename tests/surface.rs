@@ -153,7 +153,7 @@ fn the_level_is_a_flag_recorded_by_every_run_and_refused_where_it_has_no_form() 
         args.extend(["--level", "surface", flag, value]);
         let run = crate::cli::kneeform(&args);
         crate::cli::assert_clean_failure(&run, &dir.join("refused"), flag);
-        let stderr = String::from_utf8_lossy(&run.stderr);
+        let stderr = crate::cli::said(&run);
         assert!(stderr.contains("--level"), "{flag}: {stderr}");
     }
     std::fs::remove_dir_all(&dir).unwrap();

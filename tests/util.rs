@@ -488,6 +488,63 @@ pub fn pdf_pages(page: &std::path::Path, dir: &std::path::Path) -> Option<usize>
     Some(pages)
 }
 
+/// The tables of the page `page` wider than the printed page: the page's
+/// print stylesheet applied on screen (`@media print` read as `@media
+/// all`) with the body as wide as an A4 portrait page's text (186 mm:
+/// 210 mm less the 12 mm margins), each table measured in headless
+/// Chromium. Each overflowing table as `class#id: width/body px`; `None`
+/// when Chromium is not installed ([`headless`]).
+pub fn tables_wider_than_print(
+    page: &std::path::Path,
+    dir: &std::path::Path,
+) -> Option<Vec<String>> {
+    let html = std::fs::read_to_string(page).expect("the page");
+    assert!(
+        html.contains("@media print"),
+        "the page has no print stylesheet"
+    );
+    let probe = html.replace("@media print", "@media all").replacen(
+        "</head>",
+        "<style>body { width: 186mm !important; max-width: none !important; }</style>
+<script>
+addEventListener('load', () => {
+  const body = document.body.getBoundingClientRect();
+  const over = [];
+  document.querySelectorAll('table').forEach((t, k) => {
+    const r = t.getBoundingClientRect();
+    if (r.right > body.right + 1) {
+      over.push((t.className || 'table') + '#' + (t.id || k) + ': ' + Math.round(r.width) + '/' + Math.round(body.width) + ' px');
+    }
+  });
+  const out = document.createElement('pre');
+  out.id = 'print-overflow';
+  out.textContent = 'measured\\n' + over.join('\\n');
+  document.body.appendChild(out);
+});
+</script></head>",
+        1,
+    );
+    let probe_path = dir.join("print-probe.html");
+    std::fs::write(&probe_path, probe).unwrap();
+    let args = [
+        "--virtual-time-budget=5000".to_string(),
+        "--dump-dom".to_string(),
+    ];
+    let out = headless(&probe_path, dir, "print width check", &args)?;
+    let dom = String::from_utf8_lossy(&out.stdout);
+    let start = dom
+        .find("<pre id=\"print-overflow\">measured")
+        .unwrap_or_else(|| {
+            panic!(
+                "the probe did not run: {}",
+                String::from_utf8_lossy(&out.stderr)
+            )
+        });
+    let rest = &dom[start..];
+    let text = &rest[..rest.find("</pre>").expect("the probe's end")];
+    Some(text.lines().skip(1).map(str::to_string).collect())
+}
+
 /// A decoded RGB(A) image.
 pub struct Image {
     pub width: usize,

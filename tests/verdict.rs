@@ -24,9 +24,13 @@ fn a_verification_with_nothing_to_miss_is_inconclusive() {
         &dir,
         &["verify", &wall, "--pitch", "8", "--angles=0", "--out", "v"],
     );
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = crate::cli::said(&o);
+    let said = String::from_utf8_lossy(&o.stdout);
     assert_eq!(o.status.code(), Some(3), "{err}");
-    assert!(err.contains("kneeform: INCONCLUSIVE at tolerance"), "{err}");
+    assert!(
+        said.contains("kneeform: INCONCLUSIVE at tolerance"),
+        "{said}"
+    );
     let v = json(&dir.join("v/verify.json"));
     assert_eq!(v["outcome"], "INCONCLUSIVE");
     assert_eq!(v["pass"], false);
@@ -59,7 +63,7 @@ fn a_verification_with_nothing_to_miss_is_inconclusive() {
             "c",
         ],
     );
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = crate::cli::said(&o);
     assert_eq!(o.status.code(), Some(0), "{err}");
     assert!(!err.contains("exact at every pitch"), "{err}");
     assert!(err.contains("no error was measured"), "{err}");
@@ -89,7 +93,7 @@ fn scattered_starts_are_inconclusive() {
             "v",
         ],
     );
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = crate::cli::said(&o);
     assert_eq!(o.status.code(), Some(3), "{err}");
     let v = json(&dir.join("v/verify.json"));
     assert_eq!(v["outcome"], "INCONCLUSIVE", "{v}");

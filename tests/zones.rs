@@ -147,8 +147,8 @@ fn analyze_writes_zones_csv_beside_the_summary() {
         );
         assert_eq!(&row[12], zone["angle_runs"].as_str().unwrap());
     }
-    let stderr = String::from_utf8_lossy(&run.stderr);
-    assert!(stderr.contains("kneeform:   zone 1: "), "{stderr}");
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(stdout.contains("kneeform:   zone 1: "), "{stdout}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -47,8 +47,8 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
             "--shard needs a pitch in mm: every shard must sample the same grid, and --pitch auto chooses one per run"
         );
         ensure!(
-            !args.report && !args.points_csv,
-            "--report and --points-csv are for the merged run: pass them to `kneeform merge`"
+            !args.report && !args.points_csv && !args.files.any(),
+            "--report, --points-csv, --csv, --stl and --ply are for the merged run: pass them to `kneeform merge`"
         );
         let angles = setup.angles.len();
         if shard.count > angles {
@@ -78,7 +78,7 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
             harness::choose_pitch(&input, &setup, auto, &bars).map_err(super::harness_error)?;
         for row in &chosen.study {
             let mm = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
-            eprintln!(
+            super::print_result(&format!(
                 "kneeform: pitch study: {:>6} mm: judged area distance to the exact knee-form {} mm (the level error's false alarms, safe side, shown: {} mm; change from the coarser grid, shown: {} mm), analysis about {:.1} s, {:.2} GiB{}",
                 row.pitch_mm,
                 mm(row.exact_area_distance_mm),
@@ -91,12 +91,12 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
                 } else {
                     ""
                 }
-            );
+            ));
         }
-        eprintln!(
+        super::print_result(&format!(
             "kneeform: --pitch auto chose {} mm: {}; the analysis should take about {:.1} s (study {:.1} s)",
             chosen.pitch_mm, chosen.reason, chosen.predicted_s, chosen.study_s
-        );
+        ));
         setup.pitch = chosen.pitch_mm;
         choice = Some(chosen);
     }
@@ -121,17 +121,20 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         kneeform::shard::write_shard(&out, &analysis)?;
         out.commit()
             .with_context(|| format!("cannot move the shard into {}", args.out.display()))?;
-        eprintln!(
+        super::print_result(&format!(
             "kneeform: shard {shard}: {} of {} angles written to {}; `kneeform merge` puts the {} shards together",
             angles.indices(setup.angles.len()).len(),
             setup.angles.len(),
             args.out.display(),
             shard.count
-        );
+        ));
         return Ok(ExitCode::SUCCESS);
     }
     let options = output::WriteOptions {
         points_csv: args.points_csv,
+        plain_csv: args.files.csv,
+        stl: args.files.stl,
+        ply: args.files.ply,
     };
     let summary = output::write_analysis(&out, &analysis, &options)?;
     // Held until the report is written: no other run replaces the
@@ -148,7 +151,7 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
             chosen.predicted_s
         );
     }
-    eprintln!(
+    super::print_result(&format!(
         "kneeform: {} angles, composite {} nodes ({:.0} mm^2); knee-form L = {} mm{}, R = {} mm; results in {}",
         analysis.masks.len(),
         summary.composite_nodes,
@@ -161,9 +164,9 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
         },
         setup.knee.radius,
         args.out.display()
-    );
+    ));
     for (k, f) in summary.files.iter().enumerate() {
-        eprintln!(
+        super::print_result(&format!(
             "kneeform: file {k}, {}: {}",
             f.path,
             if f.ignored {
@@ -174,7 +177,7 @@ pub fn run(args: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
                     f.colliding_nodes, f.colliding_area_mm2
                 )
             }
-        );
+        ));
     }
     print_zones(&summary.zones);
     if let Some(check) = &analysis.sample_check {
@@ -215,14 +218,14 @@ fn print_zones(zones: &[kneeform::zones::Zone]) {
         return;
     }
     let specks = zones.iter().filter(|z| z.speck).count();
-    eprintln!(
+    super::print_result(&format!(
         "kneeform: {} struck zones ({specks} of them specks under {} nodes), largest first (zones.csv lists them all):",
         zones.len(),
         kneeform::zones::SPECK_NODES
-    );
+    ));
     for z in zones.iter().take(SHOWN) {
         let c = z.centroid;
-        eprintln!(
+        super::print_result(&format!(
             "kneeform:   zone {}: {:.0} mm^2 around ({:.1}, {:.1}, {:.1}) mm, angles {}{}",
             z.id,
             z.area_mm2,
@@ -235,9 +238,9 @@ fn print_zones(zones: &[kneeform::zones::Zone]) {
             } else {
                 ""
             }
-        );
+        ));
     }
     if zones.len() > SHOWN {
-        eprintln!("kneeform:   ... and {} more", zones.len() - SHOWN);
+        super::print_result(&format!("kneeform:   ... and {} more", zones.len() - SHOWN));
     }
 }

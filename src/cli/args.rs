@@ -281,8 +281,11 @@ pub struct AnalyzeArgs {
     pub part: PartArgs,
     #[command(flatten)]
     pub setup: SetupArgs,
-    /// Output directory (created; it appears whole or not at all). An
-    /// existing one is refused unless --force is given.
+    /// Output directory (created; it appears whole or not at all): it
+    /// holds summary.json, composite.csv.gz, zones.csv, blind_spots.csv,
+    /// depth.png, composite.png and kneeform-run.json (about 2 MB for the
+    /// bundled console), and what --csv, --stl, --ply, --points-csv and
+    /// --report add. An existing one is refused unless --force is given.
     #[arg(long, default_value = "kneeform-out", value_name = "DIR")]
     pub out: PathBuf,
     /// Replace an existing --out directory of an earlier result (one whose
@@ -302,6 +305,8 @@ pub struct AnalyzeArgs {
     /// its angles as a bit mask (angle_mask), some fifty times smaller.
     #[arg(long)]
     pub points_csv: bool,
+    #[command(flatten)]
+    pub files: FileArgs,
     /// Compute one shard of the angles and write it as a partial result
     /// (shard.json, shard.bin) for `kneeform merge`: shard K of N takes
     /// the run's angles a (0-based, in --angles order) with a % N == K - 1.
@@ -356,6 +361,43 @@ pub struct MergeArgs {
     /// analysis's shards only).
     #[arg(long)]
     pub points_csv: bool,
+    /// (An analysis's shards only.)
+    #[command(flatten)]
+    pub files: FileArgs,
+}
+
+/// The large result files an analysis writes only when asked: by default
+/// a run keeps `composite.csv.gz`, the images, `zones.csv`,
+/// `blind_spots.csv` and `summary.json` (about 2 MB for the bundled
+/// console at its default pitch).
+#[derive(Debug, Args)]
+pub struct FileArgs {
+    /// Write the composite table as plain composite.csv instead of
+    /// composite.csv.gz (the same rows, uncompressed: about 50 bytes per
+    /// colliding node, 11 MB for the bundled console at its default pitch,
+    /// some eight times the compressed file). Default: compressed, which
+    /// `zcat`, `gunzip -k` and pandas' `read_csv` read as it is.
+    #[arg(long)]
+    pub csv: bool,
+    /// Also write colliding_area.stl: the colliding area as a binary STL
+    /// surface in the part's coordinates (mm), 100 bytes per triangle,
+    /// 22 MB for the bundled console. Default: not written.
+    #[arg(long)]
+    pub stl: bool,
+    /// Also write colliding_area.ply: the colliding area as a binary PLY
+    /// mesh (mm, part's coordinates, 32-bit floats of values rounded to
+    /// 1 um), each vertex coloured by its number of striking angles, for
+    /// MeshLab or Blender; about 45 bytes per colliding node, 10 MB for the
+    /// bundled console. Default: not written.
+    #[arg(long)]
+    pub ply: bool,
+}
+
+impl FileArgs {
+    /// Whether any large file is asked for.
+    pub fn any(&self) -> bool {
+        self.csv || self.stl || self.ply
+    }
 }
 
 /// `kneeform batch`.

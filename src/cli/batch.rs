@@ -154,7 +154,9 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
         .with_context(|| format!("{what}: cannot record its fingerprint"))?;
         ran += 1;
     }
-    eprintln!("kneeform: batch done: {ran} items run, {skipped} skipped (complete)");
+    super::print_result(&format!(
+        "kneeform: batch done: {ran} items run, {skipped} skipped (complete)"
+    ));
     Ok(ExitCode::SUCCESS)
 }
 

@@ -18,21 +18,21 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<()> {
     out.commit()
         .with_context(|| format!("cannot move results into {}", args.out.display()))?;
     let cell = diff.cell_mm2();
-    eprintln!("kneeform: {}", diff.mapping);
-    eprintln!(
+    super::print_result(&format!("kneeform: {}", diff.mapping));
+    super::print_result(&format!(
         "kneeform: struck only in A {:.0} mm^2, only in B {:.0} mm^2, in both {:.0} mm^2; results in {}",
         diff.count(NodeState::OnlyA) as f64 * cell,
         diff.count(NodeState::OnlyB) as f64 * cell,
         diff.count(NodeState::Both) as f64 * cell,
         args.out.display()
-    );
+    ));
     let changed: Vec<_> = diff
         .zones
         .iter()
         .filter(|z| z.change != ZoneChange::Unchanged)
         .collect();
     if changed.is_empty() {
-        eprintln!("kneeform: no struck zone changed");
+        super::print_result("kneeform: no struck zone changed");
     }
     for z in changed.iter().take(SHOWN) {
         let word = match z.change {
@@ -42,7 +42,7 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<()> {
             ZoneChange::Shrank => "shrank",
             ZoneChange::Unchanged => "unchanged",
         };
-        eprintln!(
+        super::print_result(&format!(
             "kneeform:   {word}: {:+.0} mm^2 ({:.0} -> {:.0}) around x = {:.1}, z = {:.1} mm (A's zones {:?}, B's {:?})",
             z.change_mm2,
             z.area_a_mm2,
@@ -51,13 +51,13 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<()> {
             z.centroid_xz[1],
             z.a_zones,
             z.b_zones
-        );
+        ));
     }
     if changed.len() > SHOWN {
-        eprintln!(
+        super::print_result(&format!(
             "kneeform:   ... and {} more (diff_zones.csv)",
             changed.len() - SHOWN
-        );
+        ));
     }
     Ok(())
 }

@@ -30,8 +30,8 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<ExitCode> {
         );
     }
     ensure!(
-        kind == ShardKind::Analysis || !args.points_csv,
-        "--points-csv is for an analysis's shards: a study writes no colliding points"
+        kind == ShardKind::Analysis || !(args.points_csv || args.files.any()),
+        "--points-csv, --csv, --stl and --ply are for an analysis's shards: a study writes no composite"
     );
     let shards: Vec<&std::path::Path> = args.shards.iter().map(|p| p.as_path()).collect();
     let out = super::stage_output(&args.out, args.force, &shards)?;
@@ -43,7 +43,10 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<ExitCode> {
     output::write_study_files(&out, &merged)?;
     out.commit()
         .with_context(|| format!("cannot move results into {}", args.out.display()))?;
-    eprintln!("kneeform: merged {} shards of {kind}", args.shards.len());
+    super::print_result(&format!(
+        "kneeform: merged {} shards of {kind}",
+        args.shards.len()
+    ));
     Ok(super::study::print_study(&merged, &args.out))
 }
 
@@ -51,6 +54,9 @@ fn merge_analysis(args: &MergeArgs, out: OutputDir) -> anyhow::Result<ExitCode> 
     let merged = kneeform::shard::merge(&args.shards).context("cannot merge the shards")?;
     let options = WriteOptions {
         points_csv: args.points_csv,
+        plain_csv: args.files.csv,
+        stl: args.files.stl,
+        ply: args.files.ply,
     };
     let summary = kneeform::shard::write_merged(&out, &merged, &options)?;
     // The whole run's warnings: a shard's own were of its angles alone.
@@ -59,14 +65,14 @@ fn merge_analysis(args: &MergeArgs, out: OutputDir) -> anyhow::Result<ExitCode> 
     }
     out.commit()
         .with_context(|| format!("cannot move results into {}", args.out.display()))?;
-    eprintln!(
+    super::print_result(&format!(
         "kneeform: merged {} shards: {} angles, composite {} nodes ({:.0} mm^2); results in {}",
         args.shards.len(),
         summary.angles_deg.len(),
         summary.composite_nodes,
         summary.composite_area_mm2,
         args.out.display()
-    );
+    ));
     if let Some(check) = &summary.sample_check {
         super::print_check(check);
     }

@@ -26,7 +26,18 @@ use kneeform::{PartFile, Setup};
 
 use args::StudyArgs;
 
-/// Writes the report of `options` to `out` and says so on stderr, naming
+/// Prints `line`, a line of the command's results (what it found, and
+/// where it wrote them), on the standard output. Everything else a command
+/// says (progress, notes on its work, warnings, errors) goes to the
+/// standard error, so that `kneeform ... > results.txt` keeps the results
+/// alone. A reader that went away (`| head`) is no error: the results are
+/// in their files.
+pub fn print_result(line: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stdout().lock(), "{line}");
+}
+
+/// Writes the report of `options` to `out` and says so on stdout, naming
 /// the file `shown_as` (where it will be once staged files are moved):
 /// `report`'s work, and `analyze --report`'s.
 pub fn write_report(options: &ReportOptions, out: &Path, shown_as: &Path) -> anyhow::Result<()> {
@@ -37,13 +48,13 @@ pub fn write_report(options: &ReportOptions, out: &Path, shown_as: &Path) -> any
             shown_as.display()
         )
     })?;
-    eprintln!(
+    print_result(&format!(
         "kneeform: report of {} ({} triangles, views rendered in {:.2} s) written to {}",
         report.part_path.display(),
         report.triangles,
         report.render_s,
         shown_as.display()
-    );
+    ));
     Ok(())
 }
 
@@ -123,7 +134,7 @@ pub fn run_study(
 /// The sample check's line, and its warning where it found the grid beyond
 /// its tolerance.
 pub fn print_check(check: &kneeform::summary::SampleCheck) {
-    eprintln!("kneeform: {}", check.line());
+    print_result(&format!("kneeform: {}", check.line()));
     if check.exceeds_tolerance {
         eprintln!(
             "kneeform: warning: the sample check found the grid's colliding area further than sqrt 2 pitches ({} mm, `verify`'s default tolerance) from the exact knee-form's; run `kneeform verify` on this part with the same flags for the evidence, or choose a finer pitch (`--pitch auto --tolerance MM`)",
@@ -144,13 +155,13 @@ pub fn write_study_shard(
         .commit()
         .with_context(|| format!("cannot move the shard into {}", out.display()))?;
     let shard = part.shard;
-    eprintln!(
+    print_result(&format!(
         "kneeform: shard {shard}: {} of {} starts written to {}; `kneeform merge` puts the {} shards together",
         shard.indices(part.starts.len()).len(),
         part.starts.len(),
         out.display(),
         shard.count
-    );
+    ));
     Ok(ExitCode::SUCCESS)
 }
 

@@ -41,10 +41,10 @@ pub fn run(args: &ScenarioArgs) -> anyhow::Result<()> {
         .context("the scenario makes no usable part")?;
     kneeform::output::write_stl(&args.out, &triangles)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
-    eprintln!(
+    super::print_result(&format!(
         "kneeform: wrote {} triangles (step {step:.4} mm) to {}",
         triangles.len(),
         args.out.display()
-    );
+    ));
     Ok(())
 }

@@ -322,7 +322,7 @@ impl<'a> StudyFile<'a> {
         StudyFile::Text(
             name.into(),
             Box::new(move |out| {
-                let text = serde_json::to_string_pretty(value)? + "\n";
+                let text = crate::summary::json_text(value)?;
                 out.write_all(text.as_bytes())
             }),
         )

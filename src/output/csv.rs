@@ -139,6 +139,14 @@ pub fn micrometres(v: f64) -> String {
     s
 }
 
+/// `v` rounded to 1 um as [`micrometres`] writes it, as a number (`-0`
+/// as `0`): what a reader of the tables parses back.
+pub(super) fn micrometres_value(v: f64) -> f64 {
+    let mut s = String::new();
+    push_micrometres(&mut s, v);
+    s.parse().unwrap_or(v)
+}
+
 /// [`micrometres`] appended to `s`.
 pub(super) fn push_micrometres(s: &mut String, v: f64) {
     // Most values are rounded here with integers. `m` is the product

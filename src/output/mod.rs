@@ -1,12 +1,13 @@
-//! Result files: the composite (and on request the colliding points) as
-//! CSV, the colliding area as a binary STL surface, and the height grid and
-//! the composite as PNG images.
+//! Result files: the composite as CSV (compressed unless asked plain; on
+//! request the colliding points too), on request the colliding area as a
+//! binary STL surface and a binary PLY mesh, and the height grid and the
+//! composite as PNG images.
 //!
 //! * `write_composite`: a CSV table, one row per colliding node with its
 //!   count and set of angles, in the part's own coordinates (mm, to 1 um);
 //!   `write_colliding_points`: one row per node and angle (on request);
 //! * `write_colliding_area`: the composite area as a triangle surface in
-//!   the part's coordinates (mm), facing the knee;
+//!   the part's coordinates (mm), facing the knee (on request);
 //! * `write_depth_png`, `write_composite_png`: images with mm axes, the
 //!   vehicle front (-x) on the left and z up;
 //! * [`OutputDir`]: every file of a run is written into a staging directory
@@ -53,10 +54,30 @@ pub(crate) use self::stl::write_colliding_area;
 pub use self::stl::write_stl;
 #[cfg(feature = "harness")]
 pub use self::studies::{write_study, write_study_files};
+pub use crate::summary::{JSON_NOISE_ULPS, json_text, rounded_figure};
 
 /// A run's record of everything it did (`summary.json`): the one name
 /// every reader and writer uses.
 pub const SUMMARY_JSON: &str = "summary.json";
+
+/// The composite table as plain text (`analyze --csv`).
+pub const COMPOSITE_CSV: &str = "composite.csv";
+
+/// The composite table compressed (gzip), as an analysis writes it by
+/// default: `composite.csv`'s bytes, some eight times smaller; `zcat`,
+/// `gunzip -k` or pandas' `read_csv` read it as it is.
+pub const COMPOSITE_CSV_GZ: &str = "composite.csv.gz";
+
+/// A run directory's composite table: `composite.csv` where the run
+/// wrote it plain (or an earlier version did), else `composite.csv.gz`.
+pub fn composite_table(dir: &Path) -> PathBuf {
+    let plain = dir.join(COMPOSITE_CSV);
+    if plain.symlink_metadata().is_ok() {
+        plain
+    } else {
+        dir.join(COMPOSITE_CSV_GZ)
+    }
+}
 
 /// Why a result could not be written.
 #[derive(Debug, thiserror::Error)]

@@ -14,13 +14,27 @@ use crate::frame::Placement;
 use crate::grid::HeightGrid;
 use crate::summary::Summary;
 
-/// What [`write_analysis`] writes besides the default files.
+/// What [`write_analysis`] writes besides the default files
+/// (`composite.csv.gz`, the images, `zones.csv`, `blind_spots.csv`,
+/// `summary.json`): the large ones, only when asked, so that a run a user
+/// keeps stays small (about 2 MB for the bundled console at its default
+/// pitch, where the four below add some 60 MB).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct WriteOptions {
     /// Also `colliding_points.csv`, one row per colliding node per angle
     /// (`analyze --points-csv`): the sets `composite.csv`'s `angle_mask`
     /// holds, some fifty times larger.
     pub points_csv: bool,
+    /// The composite as plain `composite.csv` instead of
+    /// `composite.csv.gz` (`analyze --csv`): the same bytes, uncompressed
+    /// (about 50 bytes a colliding node, 11 MB on the console).
+    pub plain_csv: bool,
+    /// Also `colliding_area.stl` (`analyze --stl`): the area as binary
+    /// STL, 100 bytes a triangle (22 MB on the console).
+    pub stl: bool,
+    /// Also `colliding_area.ply` (`analyze --ply`): the area as a binary
+    /// PLY mesh coloured by count (about 45 bytes a colliding node).
+    pub ply: bool,
 }
 
 /// An analysis's results as the writers take them: from an
@@ -59,8 +73,9 @@ impl<'a> RunResults<'a> {
 }
 
 /// Writes the files of an analysis into the staged directory `out`: the
-/// composite as CSV (with `options.points_csv`, the colliding points too),
-/// the colliding area as STL and PLY, the depth and composite images, and
+/// composite as compressed CSV (plain with `options.plain_csv`; with
+/// `options.points_csv`, the colliding points too), the colliding area as
+/// STL and PLY when asked, the depth and composite images, and
 /// `summary.json` last, with the writing time. Returns the summary written.
 pub fn write_analysis(
     out: &OutputDir,
@@ -114,19 +129,34 @@ pub fn write_results(
                 )?)
             })?;
         }
-        file("composite.csv", &|w| {
-            Ok(super::write_composite(
-                w, grid, masks, counts, placement, node_file,
-            )?)
-        })
+        if options.plain_csv {
+            file(super::COMPOSITE_CSV, &|w| {
+                Ok(super::write_composite(
+                    w, grid, masks, counts, placement, node_file,
+                )?)
+            })
+        } else {
+            // gzip's header carries no time or name: the same result
+            // gives the same bytes.
+            file(super::COMPOSITE_CSV_GZ, &|w| {
+                let mut gz = flate2::write::GzEncoder::new(w, flate2::Compression::default());
+                super::write_composite(&mut gz, grid, masks, counts, placement, node_file)?;
+                gz.finish().map(drop)
+            })
+        }
     };
     let meshes = || -> Result<(), WriteError> {
-        file("colliding_area.stl", &|w| {
-            super::write_colliding_area(w, grid, counts, placement).map(drop)
-        })?;
-        file("colliding_area.ply", &|w| {
-            super::write_colliding_area_ply(w, grid, counts, masks.len(), placement).map(drop)
-        })
+        if options.stl {
+            file("colliding_area.stl", &|w| {
+                super::write_colliding_area(w, grid, counts, placement).map(drop)
+            })?;
+        }
+        if options.ply {
+            file("colliding_area.ply", &|w| {
+                super::write_colliding_area_ply(w, grid, counts, masks.len(), placement).map(drop)
+            })?;
+        }
+        Ok(())
     };
     let pictures = || -> Result<(), WriteError> {
         super::write_depth_png(&out.path("depth.png"), grid, placement)?;
@@ -251,8 +281,9 @@ fn write_blind_spots(
     .map_err(WriteError::at(path))
 }
 
-/// Writes `value` as pretty JSON with a final newline.
+/// Writes `value` as pretty JSON with a final newline, its figures
+/// rounded ([`crate::summary::json_text`]).
 pub(super) fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<(), WriteError> {
-    let text = serde_json::to_string_pretty(value).map_err(WriteError::at(path))? + "\n";
+    let text = crate::summary::json_text(value).map_err(WriteError::at(path))?;
     std::fs::write(path, text).map_err(WriteError::at(path))
 }

@@ -343,8 +343,7 @@ pub fn write_diff(dir: &Path, diff: &RevisionDiff) -> Result<(), ReportError> {
         "zones": diff.zones,
     });
     let path = dir.join(DIFF_FILES[0]);
-    let mut text = serde_json::to_string_pretty(&json).expect("JSON of plain values");
-    text.push('\n');
+    let text = crate::output::json_text(&json).expect("JSON of plain values");
     std::fs::write(&path, text).map_err(io(path.clone()))?;
 
     let path = dir.join(DIFF_FILES[1]);

@@ -172,8 +172,17 @@ code, .mono { font-family: 'DejaVu Sans Mono', monospace; font-size: 12px; word-
 .headline { font-size: 16px; }
 footer { margin-top: 32px; font-size: 11px; color: #555; border-top: 1px solid #999; padding-top: 4px; }
 * { -webkit-print-color-adjust: exact; print-color-adjust: exact; }
+table.csv-print { display: none; }
 @page { size: A4; margin: 12mm; }
 @media print {
+  table.metrics { width: 100%; max-width: 100%; }
+  table.metrics th, table.metrics td { overflow-wrap: anywhere; }
+  table.csv { width: 100%; max-width: 100%; font-size: 6pt; }
+  table.csv th, table.csv td { padding: 0 2px; overflow-wrap: anywhere; }
+  table.csv:has(+ table.csv-print) { display: none; }
+  table.csv-print { display: table; width: 100%; max-width: 100%; font-size: 5.5pt; margin: 2px 0 4px 0; }
+  table.csv-print caption { text-align: left; font-size: 7pt; }
+  table.csv-print th, table.csv-print td { padding: 0 2px; overflow-wrap: anywhere; }
   body { max-width: none; margin: 0; padding: 0; font-size: 10pt; }
   h2 { break-after: avoid; margin-top: 0; }
   section + section { break-before: page; }
@@ -1385,7 +1394,67 @@ fn csv_table(name: &str, text: &str) -> Markup {
             }
         }
         "\n"
+        // In print, a wide table (verify.csv's 27 columns) lost its last
+        // columns past the page's edge: it is printed instead as parts
+        // of a few columns each, every part with the key columns first.
+        @let parts = printed_parts(header.len());
+        @if parts.len() > 1 {
+            @for (k, part) in parts.iter().enumerate() {
+                table class="csv-print" {
+                    caption {
+                        code { (name) } ", columns " (part[PRINTED_KEYS] + 1) " to " (part[part.len() - 1] + 1)
+                        " of " (header.len()) " (printed part " (k + 1) " of " (parts.len()) ")"
+                        @if shown.len() > PRINTED_ROWS {
+                            ": the first " (PRINTED_ROWS) " of the " (shown.len()) " rows shown on screen"
+                        }
+                    }
+                    tr {
+                        @for &c in part {
+                            th class="num" { (header.get(c).unwrap_or("")) }
+                        }
+                    }
+                    @for record in shown.iter().take(PRINTED_ROWS) {
+                        tr {
+                            @for &c in part {
+                                td class="num" { (record.get(c).unwrap_or("")) }
+                            }
+                        }
+                    }
+                }
+                "\n"
+            }
+        }
     }
+}
+
+/// The rows a printed part of a CSV table holds: the first of those
+/// shown (the largest, where the table is ranked), so that a table
+/// printed in parts takes about the page it took in one.
+const PRINTED_ROWS: usize = 10;
+
+/// The columns a printed part of a CSV table repeats first (verify.csv's
+/// `i, j, angle_deg`: which pair a row is).
+const PRINTED_KEYS: usize = 3;
+
+/// The columns a printed part holds besides its keys: as many as fit an
+/// A4 page's width at the print stylesheet's size.
+const PRINTED_COLUMNS: usize = 8;
+
+/// The printed parts of a table of `columns` columns ([`csv_table`]):
+/// each the key columns and the next [`PRINTED_COLUMNS`]; one part, the
+/// whole table, when it fits.
+fn printed_parts(columns: usize) -> Vec<Vec<usize>> {
+    if columns <= PRINTED_KEYS + PRINTED_COLUMNS {
+        return vec![(0..columns).collect()];
+    }
+    (PRINTED_KEYS..columns)
+        .step_by(PRINTED_COLUMNS)
+        .map(|start| {
+            (0..PRINTED_KEYS)
+                .chain(start..(start + PRINTED_COLUMNS).min(columns))
+                .collect()
+        })
+        .collect()
 }
 
 /// Section 6: what the grid cannot see, how the pitch was chosen, and the

@@ -136,7 +136,7 @@ impl RunTables {
             approach: summary.approach,
             side: summary.side,
         };
-        let composite = read_composite(&dir.join("composite.csv"), spec, &frame, axes)?;
+        let composite = read_composite(&crate::output::composite_table(dir), spec, &frame, axes)?;
         check_counts(&summary, &composite).map_err(|reason| ReportError::Inconsistent {
             path: summary_path.clone(),
             reason,
@@ -352,7 +352,7 @@ impl Run {
     /// angle `a` strikes the node. `None` for a run of a version that wrote
     /// no masks.
     pub fn angle_bits(&self) -> Result<Option<AngleBits>, ReportError> {
-        let composite = self.dir.join("composite.csv");
+        let composite = crate::output::composite_table(&self.dir);
         if !CsvRows::open(&composite, &[])?.has_column("angle_mask") {
             return Ok(None);
         }
@@ -597,7 +597,7 @@ fn read_blind_spots(path: &Path, spec: GridSpec) -> Result<Vec<BlindRow>, Report
 /// A CSV file read row by row, its columns located by name.
 struct CsvRows {
     path: PathBuf,
-    reader: csv::Reader<std::fs::File>,
+    reader: csv::Reader<Box<dyn std::io::Read>>,
     /// Column of each wanted name.
     columns: Vec<usize>,
     names: Vec<String>,
@@ -616,6 +616,18 @@ impl CsvRows {
                 source,
             },
         )?;
+        // A compressed table (`composite.csv.gz`) is read through gzip, at
+        // most the same bytes decompressed (a bomb ends there, and the
+        // table's rows then disagree with its summary).
+        let gzipped = path.extension().is_some_and(|e| e == "gz");
+        let file: Box<dyn std::io::Read> = if gzipped {
+            Box::new(std::io::Read::take(
+                flate2::read::GzDecoder::new(std::io::BufReader::new(file)),
+                crate::limits::MAX_RUN_TABLE_BYTES,
+            ))
+        } else {
+            Box::new(file)
+        };
         let mut reader = csv::Reader::from_reader(file);
         let bad = |reason: String| ReportError::Inconsistent {
             path: path.to_path_buf(),
