@@ -55,6 +55,7 @@ pub(crate) const ORACLE_BYTES_PER_TRIANGLE: f64 = 143.0;
 
 /// Bytes a study holds per node of each pitch's grid: the heights and
 /// the comparison's copy of them with the blind spots (`Cells`), about 20.
+#[cfg(feature = "harness")]
 pub(crate) const STUDY_GRID_BYTES_PER_NODE: f64 = 20.0;
 
 const MIB: f64 = 1024.0 * 1024.0;

@@ -567,6 +567,7 @@ impl Slide<'_, '_> {
 /// SPEC v4's push and slide of the start at node `(i0, j0)` on the
 /// surface of `sg`, its outline `sf`, under `rule` (whose window is read;
 /// its rate and level are not).
+#[cfg(any(test, feature = "harness"))]
 pub(crate) fn trace(
     sg: &SurfaceGrid,
     sf: &SurfaceFootprint,
