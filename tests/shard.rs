@@ -1042,7 +1042,7 @@ fn a_fingerprint_written_but_not_recorded_runs_its_item_again() {
         kneeform(&["batch", manifest.to_str().unwrap()]),
         "the batch again",
     );
-    let text = String::from_utf8_lossy(&again.stderr);
+    let text = crate::cli::said(&again);
     assert!(text.contains("1 items run, 2 skipped"), "{text}");
     assert!(
         text.lines()
