@@ -649,14 +649,7 @@ mod tests {
             slope * x - rib
         };
         let triangles = tessellate(&xs, &zs, |i, _| y(xs[i]));
-        let spec = GridSpec {
-            pitch: 2.0,
-            i_origin: 0,
-            j_origin: 0,
-            nx: 21,
-            nz: 11,
-        };
-        let grid = HeightGrid::sample(&triangles, spec);
+        let grid = at_pitch_two(&triangles);
         (triangles, grid)
     }
 
@@ -678,12 +671,8 @@ mod tests {
         assert!(!deep.touches_blind_spot([21.0, -3.0, 7.0]));
     }
 
-    /// A V-shaped ridge along z, `y = g |x - x_c|` (its crease the part's
-    /// point nearest the knee), at pitch 2 mm over [0, 40] x [0, 20].
-    fn ridge(g: f64, x_c: f64) -> (Vec<Triangle>, HeightGrid) {
-        let xs = [0.0, x_c, 40.0];
-        let zs = [0.0, 10.0, 20.0];
-        let triangles = tessellate(&xs, &zs, |i, _| g * (xs[i] - x_c).abs());
+    /// `triangles` sampled at pitch 2 mm over [0, 40] x [0, 20].
+    fn at_pitch_two(triangles: &[Triangle]) -> HeightGrid {
         let spec = GridSpec {
             pitch: 2.0,
             i_origin: 0,
@@ -691,7 +680,16 @@ mod tests {
             nx: 21,
             nz: 11,
         };
-        let grid = HeightGrid::sample(&triangles, spec);
+        HeightGrid::sample(triangles, spec)
+    }
+
+    /// A V-shaped ridge along z, `y = g |x - x_c|` (its crease the part's
+    /// point nearest the knee), at pitch 2 mm over [0, 40] x [0, 20].
+    fn ridge(g: f64, x_c: f64) -> (Vec<Triangle>, HeightGrid) {
+        let xs = [0.0, x_c, 40.0];
+        let zs = [0.0, 10.0, 20.0];
+        let triangles = tessellate(&xs, &zs, |i, _| g * (xs[i] - x_c).abs());
+        let grid = at_pitch_two(&triangles);
         (triangles, grid)
     }
 
