@@ -265,13 +265,7 @@ pub fn direct_mask(
             })
         })
         .collect();
-    AngleMask {
-        angle_deg: fp.angle_deg,
-        colliding: mask.iter().filter(|&&m| m != 0).count(),
-        mask,
-        placed,
-        probes_met,
-    }
+    AngleMask::new(fp.angle_deg, mask, placed, probes_met)
 }
 
 /// [`direct_mask`] at every angle of `footprints`, in their order, one

@@ -52,6 +52,20 @@ pub struct AngleMask {
     pub probes_met: Vec<bool>,
 }
 
+impl AngleMask {
+    /// The result at `angle_deg` whose colliding nodes are those of `mask`
+    /// (the count derived from it), with `placed` starts and the probes met.
+    pub fn new(angle_deg: f64, mask: Vec<u8>, placed: usize, probes_met: Vec<bool>) -> AngleMask {
+        AngleMask {
+            angle_deg,
+            colliding: mask.iter().filter(|&&m| m != 0).count(),
+            mask,
+            placed,
+            probes_met,
+        }
+    }
+}
+
 /// Starts per block of [`push_levels`]: two AVX2 registers of ranks. The
 /// analysis's blocks are wider, per instruction set ([`band::fast_band`]).
 const LANES: usize = 16;
@@ -147,18 +161,13 @@ pub fn colliding_masks(
                 probe_levels,
             } = acc.into_inner().expect("no band panics");
             on_angle();
-            AngleMask {
-                angle_deg: fp.angle_deg,
-                colliding: mask.iter().filter(|&&m| m != 0).count(),
-                mask,
-                placed,
-                probes_met: options
-                    .probes
-                    .iter()
-                    .zip(&probe_levels)
-                    .map(|(probe, &level)| probe.y < level - options.rule.e0)
-                    .collect(),
-            }
+            let probes_met = options
+                .probes
+                .iter()
+                .zip(&probe_levels)
+                .map(|(probe, &level)| probe.y < level - options.rule.e0)
+                .collect();
+            AngleMask::new(fp.angle_deg, mask, placed, probes_met)
         })
         .collect()
 }
@@ -226,13 +235,7 @@ fn surface_masks(
                     },
                 );
             on_angle();
-            AngleMask {
-                angle_deg: fp.angle_deg,
-                colliding: mask.iter().filter(|&&m| m != 0).count(),
-                mask,
-                placed,
-                probes_met,
-            }
+            AngleMask::new(fp.angle_deg, mask, placed, probes_met)
         })
         .collect()
 }

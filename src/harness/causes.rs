@@ -741,14 +741,7 @@ mod tests {
         let xs = [0.0, 10.0, 21.0];
         let zs = [0.0, 10.0, 20.0];
         let triangles = tessellate(&xs, &zs, |_, _| 0.0);
-        let spec = GridSpec {
-            pitch: 2.0,
-            i_origin: 0,
-            j_origin: 0,
-            nx: 21,
-            nz: 11,
-        };
-        let grid = HeightGrid::sample(&triangles, spec);
+        let grid = at_pitch_two(&triangles);
         let cells = Cells::of(&triangles, &grid, 10.0).with_surface_error(&triangles, &grid);
         let edge = cells.surface_error_near([20.8, 0.0, 7.0]).unwrap();
         assert_eq!(edge.above, f64::INFINITY);

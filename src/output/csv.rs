@@ -308,13 +308,7 @@ mod tests {
     }
 
     fn mask(angle_deg: f64, mask: Vec<u8>) -> AngleMask {
-        AngleMask {
-            angle_deg,
-            colliding: mask.iter().filter(|&&m| m != 0).count(),
-            mask,
-            placed: 1,
-            probes_met: Vec::new(),
-        }
+        AngleMask::new(angle_deg, mask, 1, Vec::new())
     }
 
     fn composite_of(masks: &[AngleMask]) -> Vec<u16> {
