@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::compare::{
     CompareOptions, Comparison, GridSide, PairResult, StartSelection, assemble, chain_of,
-    pair_results,
+    covering_nodes, pair_results,
 };
 use super::error::HarnessError;
 use super::method::{Laid, Method, Pitch, Tracing, sampled_at, spec_at};
@@ -334,7 +334,13 @@ impl<'a> Ladder<'a> {
         let (pairs, pitch, masks, grid) = self.measure_raw(at, progress)?;
         let result = PitchResult {
             pitch: p,
-            comparison: assemble(pairs, &self.setup.angles, pitch.band, pitch.grid_s),
+            comparison: assemble(
+                pairs,
+                &self.setup.angles,
+                pitch.band,
+                pitch.grid_s,
+                &pitch.covering,
+            ),
             seconds: pitch.seconds,
             nodes: pitch.nodes,
         };
@@ -397,8 +403,31 @@ impl<'a> Ladder<'a> {
                 tick: Some(&step),
             },
         );
-        let grid_s = t.elapsed().as_secs_f64();
         progress.end();
+        let pairs = pairs?;
+        // The analysis's area nearest to each exact strike: what the
+        // area's misses are measured to (none where a deliberate mistake
+        // is on the grid side: the engine would hide it).
+        let covering = match self.fault {
+            Some(_) => Vec::new(),
+            None => super::stage::in_stage(
+                progress,
+                &super::stage::covering(footprints.len()),
+                Some(footprints.len() as u64),
+                || {
+                    let step = || progress.step();
+                    covering_nodes(
+                        &grid,
+                        &footprints,
+                        &self.setup.rule,
+                        &pairs,
+                        at.converging.then_some(&masks[..]),
+                        &step,
+                    )
+                },
+            ),
+        };
+        let grid_s = t.elapsed().as_secs_f64();
         let part = PitchPart {
             pitch: p,
             pairs: Pairs::of(Vec::<PairResult>::new()),
@@ -406,8 +435,9 @@ impl<'a> Ladder<'a> {
             grid_s,
             seconds,
             nodes: spec.len(),
+            covering,
         };
-        Ok((pairs?, part, masks, grid))
+        Ok((pairs, part, masks, grid))
     }
 }
 

@@ -541,6 +541,7 @@ impl Method for DirectMethod<'_> {
             grid_s,
             seconds: 0.0,
             nodes: spec.len(),
+            covering: Vec::new(),
         })
     }
 }

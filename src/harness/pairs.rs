@@ -132,6 +132,11 @@ pub struct PitchPart {
     pub seconds: f64,
     /// Grid nodes at this pitch.
     pub nodes: usize,
+    /// Per angle, the analysis's struck nodes nearest to the share's exact
+    /// strikes (mm, xz; [`super::compare::covering_nodes`]): what the
+    /// area's misses are measured to, beside the compared starts' own
+    /// strikes. None for the direct approach.
+    pub covering: Vec<Vec<[f64; 2]>>,
 }
 
 /// `shard`'s share of `all` ([`Shard::WHOLE`]: all of it); an error when

@@ -239,6 +239,9 @@ pub(crate) struct MergedClocks {
     pub nodes: usize,
     pub grid_s: f64,
     pub seconds: f64,
+    /// Per angle, the union of the shards' covering nodes
+    /// ([`super::pairs::PitchPart::covering`]), sorted.
+    pub covering: Vec<Vec<[f64; 2]>>,
 }
 
 /// [`MergedClocks`] of pitch `k` of the shares `parts`.
@@ -253,7 +256,29 @@ pub(crate) fn merged_clocks(parts: &[StudyPart], k: usize) -> MergedClocks {
             .iter()
             .map(|p| p.pitches[k].seconds)
             .fold(0.0, f64::max),
+        covering: merged_covering(parts.iter().map(|p| &p.pitches[k].covering)),
     }
+}
+
+/// The union, per angle, of the shares' covering nodes, sorted: the same
+/// points whatever the shards (the nearest node of each exact strike is
+/// the same in every share).
+fn merged_covering<'a>(shares: impl Iterator<Item = &'a Vec<Vec<[f64; 2]>>>) -> Vec<Vec<[f64; 2]>> {
+    let mut merged: Vec<Vec<[f64; 2]>> = Vec::new();
+    for share in shares {
+        if merged.len() < share.len() {
+            merged.resize(share.len(), Vec::new());
+        }
+        for (to, from) in merged.iter_mut().zip(share) {
+            to.extend(from);
+        }
+    }
+    for points in &mut merged {
+        points.sort_by(|a, b| a[1].total_cmp(&b[1]).then(a[0].total_cmp(&b[0])));
+        points
+            .dedup_by(|a, b| a[0].to_bits() == b[0].to_bits() && a[1].to_bits() == b[1].to_bits());
+    }
+    merged
 }
 
 /// The oracle's seconds summed over the shards.

@@ -89,7 +89,7 @@ impl StudyApproach for Slide {
             StudyOptions::Verify(o) => {
                 // A verification compares one pitch.
                 let pitch = &parts[0];
-                let none = assemble(Vec::new(), &setup.angles, pitch.band, 0.0);
+                let none = assemble(Vec::new(), &setup.angles, pitch.band, 0.0, &[]);
                 let mut s = VerifySummary::new(input, setup, o, coarse, &none, sample_s, oracle_s);
                 s.timings.grid_s = pitch.grid_s;
                 StudySummary::new(self.named(StudyKind::Verify), s)
@@ -162,7 +162,7 @@ impl StudyApproach for Slide {
         let sample_s = parts.iter().map(|p| p.sample_s).fold(0.0, f64::max);
         let results = merged_pitches(parts, |clocks, pairs| PitchResult {
             pitch: clocks.pitch,
-            comparison: assemble(pairs, &angles, clocks.band, clocks.grid_s),
+            comparison: assemble(pairs, &angles, clocks.band, clocks.grid_s, &clocks.covering),
             seconds: clocks.seconds,
             nodes: clocks.nodes,
         })?;

@@ -20,3 +20,9 @@ pub(crate) fn in_stage<T>(
 pub(crate) fn comparing(pairs: usize) -> String {
     format!("grid against exact: {pairs} start-angle pairs")
 }
+
+/// The stage in which the analysis's colliding area is run at each of
+/// `angles` angles and the node nearest each exact strike found in it.
+pub(crate) fn covering(angles: usize) -> String {
+    format!("grid: the analysis's area at {angles} angles")
+}

@@ -458,11 +458,11 @@ impl VerifySummary {
                     .unwrap_or("the evidence is too thin")
             ),
             Outcome::Pass => format!(
-                "every decided exact strike away from blind spots lies within {} of the grid's colliding area (worst angle)",
+                "every decided exact strike away from blind spots lies within {} of the grid's colliding area (the analysis's, every start's strikes; worst angle)",
                 mm(self.area_miss_decided_mm)
             ),
             Outcome::Fail => format!(
-                "a decided exact strike lies {} from the grid's colliding area (worst angle)",
+                "a decided exact strike lies {} from the grid's colliding area (the analysis's, every start's strikes; worst angle)",
                 mm(self.area_miss_decided_mm)
             ),
         };

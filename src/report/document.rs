@@ -488,11 +488,11 @@ fn verdict_first(
             @match verdict {
                 Verdict::Pass => {
                     "every decided exact strike away from blind spots lies within "
-                    (c("/area_miss_decided_mm")) " mm of the grid's colliding area (worst angle), within the tolerance of "
+                    (c("/area_miss_decided_mm")) " mm of the grid's colliding area (the analysis's, every start's strikes; worst angle), within the tolerance of "
                 }
                 Verdict::Fail => {
                     "a decided exact strike away from blind spots lies "
-                    (c("/area_miss_decided_mm")) " mm (\u{2014}: infinite, no grid strike at that angle) from the grid's colliding area (worst angle), beyond the tolerance of "
+                    (c("/area_miss_decided_mm")) " mm (\u{2014}: infinite, no grid strike at that angle) from the grid's colliding area (the analysis's, every start's strikes; worst angle), beyond the tolerance of "
                 }
                 _ => {
                     "no claim: " (c("/outcome_reason")) ". The tolerance asked was "

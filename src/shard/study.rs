@@ -47,7 +47,9 @@ use crate::output::{OutputDir, WriteError};
 pub struct StudyRecord {
     /// The format of the shard's files (`FORMAT`; 5: pairs carry their
     /// miss at half and at a quarter of the pitch and the points they set
-    /// apart; 6: and their undecided contacts, as points and as nodes).
+    /// apart; 6: and their undecided contacts, as points and as nodes; 7:
+    /// each pitch, per angle, the analysis's struck nodes nearest to its exact
+    /// strikes).
     pub format: u32,
     /// Which shard of how many.
     pub shard: Shard,
@@ -75,9 +77,9 @@ pub struct StudyRecord {
 }
 
 /// The format [`write_study_shard`] writes and [`merge_study`] reads.
-pub(crate) const FORMAT: u32 = 6;
+pub(crate) const FORMAT: u32 = 7;
 
-const MAGIC: &[u8; 16] = b"kneeform study 6";
+const MAGIC: &[u8; 16] = b"kneeform study 7";
 
 /// The largest `shard.bin` read (bytes): far beyond a study's (a few
 /// hundred bytes per start and angle), short of exhausting memory.
@@ -103,6 +105,10 @@ pub fn write_study_shard(out: &OutputDir, part: &StudyPart) -> Result<(), WriteE
             put_f64(&mut bin, v);
         }
         put_u64(&mut bin, p.nodes as u64);
+        put_u64(&mut bin, p.covering.len() as u64);
+        for points in &p.covering {
+            put_points(&mut bin, points);
+        }
         put_u64(&mut bin, p.pairs.len() as u64);
         p.pairs.put(&mut bin);
     }
@@ -425,6 +431,16 @@ fn decode(bin: &[u8], record: &StudyRecord) -> Result<StudyPart, String> {
         };
         let (grid_s, seconds) = (r.f64()?, r.f64()?);
         let nodes = r.len()?;
+        let angles = r.len()?;
+        if angles != 0 && angles != angles_deg.len() {
+            return Err(format!(
+                "pitch {p} mm holds covering nodes of {angles} angles where shard.json names {}",
+                angles_deg.len()
+            ));
+        }
+        let covering = (0..angles)
+            .map(|_| r.points())
+            .collect::<Result<Vec<_>, _>>()?;
         let count = r.len()?;
         if p.to_bits() != expected.to_bits() || count != expected_pairs {
             return Err(format!(
@@ -444,6 +460,7 @@ fn decode(bin: &[u8], record: &StudyRecord) -> Result<StudyPart, String> {
             grid_s,
             seconds,
             nodes,
+            covering,
         });
     }
     if r.at != bin.len() {
