@@ -504,10 +504,25 @@ impl Method for DirectMethod<'_> {
             angles.len()
         );
         let t = Instant::now();
-        let traces = super::stage::in_stage(progress, &stage, None, || {
+        // An angle at a time (the same traces, angle-major), so that the
+        // stage counts its pairs and tells the time left.
+        let pairs = (share.len() * angles.len()) as u64;
+        let traces = super::stage::in_stage(progress, &stage, Some(pairs), || {
             let part = kneeform_oracle::Part::from_triangles(&self.input.part.triangles)?;
             let options = direct_oracle_options(&self.setup.knee, self.setup.rule.e0);
-            kneeform_oracle::evaluate_direct(&part, &share, angles, &options)
+            let mut traces = Vec::with_capacity(share.len() * angles.len());
+            for &angle in angles {
+                traces.extend(kneeform_oracle::evaluate_direct(
+                    &part,
+                    &share,
+                    &[angle],
+                    &options,
+                )?);
+                for _ in &share {
+                    progress.step();
+                }
+            }
+            Ok::<_, kneeform_oracle::OracleError>(traces)
         })?;
         self.share = share;
         self.traces = traces;
