@@ -29,6 +29,14 @@ pub(crate) const REGULATION_ANGLE_DEG: f64 = 30.0;
 /// not.
 pub(crate) const SMALL_FACTOR: f64 = 20.0;
 
+/// A part whose larger xz extent is below the knee-form's divided by this
+/// (but not by [`SMALL_FACTOR`]) is "smaller than a knee-form": 80 mm with
+/// the default knee-form. The bundled console side read in inches is 59
+/// "mm" across and struck at 61 angles as if it were a switch: nothing
+/// else in its results looks wrong. A real part of that size (a switch, a
+/// bezel) gets the warning too, which says so: a warning, not a refusal.
+pub(crate) const UNITS_FACTOR: f64 = 4.0;
+
 /// A part whose larger xz extent is above the knee-form's times this is
 /// "much larger than a knee-form": with the default knee-form, 9.6 m, more
 /// than any car's interior (a part in micrometres, or scaled twice).
@@ -55,6 +63,17 @@ pub enum Warning {
         "the part is {extent_mm:.3} mm across, much smaller than the {knee_mm:.0} mm knee-form: if its file is in metres, pass --scale 1000 (in cm, --scale 10; in inches, --scale 25.4)"
     )]
     TooSmall {
+        /// The part's larger extent in x and z (mm, after `--scale`).
+        extent_mm: f64,
+        /// The knee-form footprint's larger extent (mm).
+        knee_mm: f64,
+    },
+    /// The part is smaller than a quarter of the knee-form: a large part
+    /// modelled in inches or centimetres, read as mm?
+    #[error(
+        "the part is {extent_mm:.1} mm across, under a quarter of the {knee_mm:.0} mm knee-form: if it is a console side or door panel modelled in inches, pass --scale 25.4 (in cm, --scale 10); a small part (a switch, a bezel) of that size is analysed as it is"
+    )]
+    Small {
         /// The part's larger extent in x and z (mm, after `--scale`).
         extent_mm: f64,
         /// The knee-form footprint's larger extent (mm).
@@ -182,7 +201,8 @@ fn axis_facing_areas(part: &Part) -> [(f64, f64); 3] {
 }
 
 /// The checks of a part read for `side` against `knee`: its size and its
-/// facing (see [`SMALL_FACTOR`], [`LARGE_FACTOR`], [`FACING_RATIO`]).
+/// facing (see [`SMALL_FACTOR`], [`UNITS_FACTOR`], [`LARGE_FACTOR`],
+/// [`FACING_RATIO`]).
 pub(crate) fn part_warnings(part: &Part, side: Side, knee: &KneeForm) -> Vec<Warning> {
     let mut warnings = Vec::new();
     let bbox = part.bbox();
@@ -190,6 +210,8 @@ pub(crate) fn part_warnings(part: &Part, side: Side, knee: &KneeForm) -> Vec<War
     let knee_mm = knee_extent(knee);
     if extent_mm < knee_mm / SMALL_FACTOR {
         warnings.push(Warning::TooSmall { extent_mm, knee_mm });
+    } else if extent_mm < knee_mm / UNITS_FACTOR {
+        warnings.push(Warning::Small { extent_mm, knee_mm });
     } else if extent_mm > knee_mm * LARGE_FACTOR {
         warnings.push(Warning::TooLarge {
             extent_mm,
@@ -428,6 +450,29 @@ mod tests {
         assert!((plus - 100.0).abs() < 1e-9 && (minus - 25.0).abs() < 1e-9);
     }
 
+    /// The bundled console side modelled in inches (1,500 mm: 59 "mm"
+    /// across) is warned of, naming `--scale 25.4`; a part just over a
+    /// quarter of the knee-form, and the console in mm, are not.
+    #[test]
+    fn a_part_under_a_quarter_of_the_knee_form_is_warned_of_its_units() {
+        let knee = KneeForm::default();
+        let quarter = knee_extent(&knee) / UNITS_FACTOR;
+        let small = |w: &Warning| matches!(w, Warning::Small { .. });
+        let w = part_warnings(
+            &part(sheet(1500.0 / 25.4, true, 0.0), Side::Left),
+            Side::Left,
+            &knee,
+        );
+        assert!(w.iter().any(small), "{w:?}");
+        assert!(w[0].to_string().contains("--scale 25.4"), "{}", w[0]);
+        let p = part(sheet(quarter * 1.01, true, 0.0), Side::Left);
+        assert!(part_warnings(&p, Side::Left, &knee).is_empty());
+        let p = part(sheet(quarter * 0.99, true, 0.0), Side::Left);
+        assert!(part_warnings(&p, Side::Left, &knee).iter().any(small));
+        let p = part(sheet(1500.0, true, 0.0), Side::Left);
+        assert!(part_warnings(&p, Side::Left, &knee).is_empty());
+    }
+
     #[test]
     fn a_surface_facing_away_from_the_side_is_flagged_and_a_solid_is_not() {
         let knee = KneeForm::default();
@@ -529,7 +574,9 @@ mod tests {
         let w = size(1.5);
         assert!(matches!(w[..], [Warning::TooSmall { .. }]), "{w:?}");
         assert!(w[0].to_string().contains("--scale 1000"));
-        assert!(size(15.9).len() == 1 && size(16.1).is_empty());
+        assert!(matches!(size(15.9)[..], [Warning::TooSmall { .. }]));
+        assert!(matches!(size(16.1)[..], [Warning::Small { .. }]));
+        assert!(size(79.9).len() == 1 && size(80.1).is_empty());
         assert!(size(1500.0).is_empty() && size(9_500.0).is_empty());
         assert!(matches!(size(1.5e6)[..], [Warning::TooLarge { .. }]));
         // A smaller knee-form moves the bounds.

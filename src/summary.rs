@@ -653,7 +653,7 @@ impl SampleCheck {
                 )
             }
             CheckStatus::Checked => format!(
-                "{head}: {}per-start decided misses up to {}; per-start decided false alarms up to {}, {}{}; on this sample alone these per-start figures are {} the tolerance of {} mm (sqrt 2 pitches)",
+                "{head}: {}per-start decided misses up to {}; per-start decided false alarms up to {}, {}{}; on this sample alone its decided misses, and the false alarms the level error does not explain, are {} the tolerance of {} mm (sqrt 2 pitches; the explained false alarms are the cost side, not judged)",
                 self.outcome.map_or(String::new(), |o| format!(
                     "{} ({} scattered starts and {} decided exact strikes measure no area: a sample, not the evidence); ",
                     o.word(),

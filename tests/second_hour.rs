@@ -208,7 +208,8 @@ fn off_a_terminal_progress_comes_as_lines() {
         progress
             .iter()
             .all(|l| l.starts_with("kneeform: exact oracle")
-                || l.starts_with("kneeform: grid against exact")),
+                || l.starts_with("kneeform: grid against exact")
+                || l.starts_with("kneeform: grid: the analysis's area")),
         "{progress:?}"
     );
 }
