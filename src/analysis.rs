@@ -138,6 +138,45 @@ pub struct Analysis {
     pub timings: Timings,
 }
 
+/// Sizes up every file of `source` before any is read, and checks that
+/// reading them fits `max_memory_bytes` and the system's limits
+/// ([`MemoryEstimate::reading`]): a part too large is refused in a line
+/// before it is read, not in an abort while it is. The files' bytes, where
+/// known (regular files).
+pub fn check_reading(
+    source: &PartSource,
+    max_memory_bytes: f64,
+) -> Result<Option<u64>, AnalysisError> {
+    // Every file is sized up before any is read.
+    let (mut file_bytes, mut triangles, mut known) = (0u64, 0u64, true);
+    for path in source.files.iter().chain(&source.ignored) {
+        let size = crate::input::part_size(path)?;
+        file_bytes = file_bytes.saturating_add(size.file_bytes);
+        triangles = triangles.saturating_add(size.triangles);
+        known &= size.known;
+    }
+    let reading = MemoryEstimate::reading(file_bytes, triangles);
+    let shown = source
+        .files
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect::<Vec<_>>()
+        .join(" + ");
+    check_estimate(&reading, max_memory_bytes).map_err(|limit| {
+        let (limit_gib, what) = match limit {
+            Limit::Allowed(b) => (b / GIB, "--max-memory"),
+            Limit::Machine(b, what) => (b / GIB, what),
+        };
+        AnalysisError::ReadTooLarge {
+            path: shown.clone(),
+            need_gib: reading.bytes() / GIB,
+            limit_gib,
+            what,
+        }
+    })?;
+    Ok(known.then_some(file_bytes))
+}
+
 impl Analysis {
     /// Reads the part at `path` ([`crate::read_part`]) and analyses it.
     pub fn of_file(
@@ -179,33 +218,7 @@ impl Analysis {
         for w in &angle_warnings {
             progress.warn(w);
         }
-        // Every file is sized up before any is read.
-        let (mut file_bytes, mut triangles, mut known) = (0u64, 0u64, true);
-        for path in source.files.iter().chain(&source.ignored) {
-            let size = crate::input::part_size(path)?;
-            file_bytes = file_bytes.saturating_add(size.file_bytes);
-            triangles = triangles.saturating_add(size.triangles);
-            known &= size.known;
-        }
-        let reading = MemoryEstimate::reading(file_bytes, triangles);
-        let shown = source
-            .files
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect::<Vec<_>>()
-            .join(" + ");
-        check_estimate(&reading, setup.max_memory_bytes).map_err(|limit| {
-            let (limit_gib, what) = match limit {
-                Limit::Allowed(b) => (b / GIB, "--max-memory"),
-                Limit::Machine(b, what) => (b / GIB, what),
-            };
-            AnalysisError::ReadTooLarge {
-                path: shown.clone(),
-                need_gib: reading.bytes() / GIB,
-                limit_gib,
-                what,
-            }
-        })?;
+        let known = check_reading(source, setup.max_memory_bytes)?;
         let t = Instant::now();
         let input = source.read()?;
         let read_s = t.elapsed().as_secs_f64();
@@ -213,7 +226,7 @@ impl Analysis {
         // (A stream's bytes, unknown before, as those of the binary STL of
         // the triangles read.)
         let n = input.part.file_triangles as u64;
-        let read_bytes = if known {
+        let read_bytes = if let Some(file_bytes) = known {
             file_bytes
         } else {
             crate::input::binary_stl_len(n)
@@ -221,9 +234,7 @@ impl Analysis {
         let read = MemoryEstimate::reading(read_bytes, n);
         let mut analysis = Analysis::run_checked(input, setup, angles, progress, angle_warnings)?;
         analysis.timings.read_s = read_s;
-        if read.bytes() > analysis.memory.bytes() {
-            analysis.memory = read;
-        }
+        analysis.memory.cover_reading(read.bytes());
         Ok(analysis)
     }
 

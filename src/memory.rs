@@ -21,9 +21,13 @@
 //!   between them: `MASK_BYTES_PER_NODE`) and the composite (`2 N`);
 //! * the writers' buffers (the colliding-area surface, the images), at most
 //!   `WRITE_BYTES_PER_NODE` per node;
-//! * with `analyze`'s sample check, the oracle's mesh, `143 n`
-//!   ([`MemoryEstimate::add_sample_check`]);
-//! * the program itself, `BASE_BYTES`.
+//! * reading the part, before all of these, the file and two copies of
+//!   its triangles ([`MemoryEstimate::reading`]), and with `analyze`'s
+//!   sample check, after them, the oracle's mesh and its BVH, `400 n`, on
+//!   what the analysis keeps ([`MemoryEstimate::add_sample_check`]): the
+//!   whole is the largest of the three phases;
+//! * the program itself, `BASE_BYTES`, and each thread's stack and
+//!   arena, `THREAD_BYTES` a thread.
 //!
 //! The figures were checked against the measured peak (`VmHWM`) on runs
 //! from 40 MiB to 1.3 GiB (`tests/hostile.rs` holds the bound test).
@@ -40,6 +44,12 @@ pub(crate) const BASE_BYTES: f64 = 10.0 * MIB;
 /// analysis's own buffers.
 pub(crate) const WRITE_BYTES_PER_NODE: f64 = 4.0;
 
+/// Bytes each worker thread holds beyond the buffers counted: its stack's
+/// pages and what its allocator's arena keeps of the chunks it freed
+/// (measured 0.7 MiB: the console at 2 mm, 31 angles, 16 threads, peaked
+/// 10.8 MiB above the estimate without it).
+pub(crate) const THREAD_BYTES: f64 = MIB;
+
 /// Bytes a finished angle's mask holds per grid node: one, and the
 /// allocator's holes between the masks, where each angle's larger padded
 /// buffers were freed (measured 1.27 on 1801 angles at 2 and 4 mm).
@@ -48,10 +58,12 @@ pub(crate) const MASK_BYTES_PER_NODE: f64 = 1.4;
 /// Bytes held per triangle of the part.
 pub(crate) const BYTES_PER_TRIANGLE: f64 = 72.0;
 
-/// Bytes the exact oracle's copy of the part holds per triangle (parry's
-/// mesh and its BVH): measured 143 on the wave's 90,000 triangles (the
-/// peak of `analyze` with and without its sample check, 2 mm, 2 threads).
-pub(crate) const ORACLE_BYTES_PER_TRIANGLE: f64 = 143.0;
+/// Bytes the exact oracle's copy of the part holds per triangle at its
+/// peak, while parry builds its BVH (the BVH's nodes twice over while it
+/// refits them, its leaves, the mesh): 377 measured as the slope of
+/// `analyze`'s peak over the bump at 1 and 3 million triangles, with its
+/// sample check (`results/hostile.md`).
+pub(crate) const ORACLE_BYTES_PER_TRIANGLE: f64 = 400.0;
 
 /// Bytes a study holds per node of each pitch's grid: the heights and
 /// the comparison's copy of them with the blind spots (`Cells`), about 20.
@@ -59,6 +71,12 @@ pub(crate) const ORACLE_BYTES_PER_TRIANGLE: f64 = 143.0;
 pub(crate) const STUDY_GRID_BYTES_PER_NODE: f64 = 20.0;
 
 const MIB: f64 = 1024.0 * 1024.0;
+
+/// The items an analysis still holds once the engine is done.
+const KEPT_AFTER_THE_ENGINE: [&str; 5] = ["program", "threads", "part", "height grid", "masks"];
+
+/// The item by which reading the part holds more than a later phase.
+const READING_BEYOND: &str = "reading the part, beyond the rest";
 
 /// An estimate of an analysis's peak working memory, by item.
 #[derive(Debug, Clone, PartialEq)]
@@ -82,6 +100,7 @@ impl MemoryEstimate {
         let angles = footprints.len() as f64;
         let mut items = vec![
             ("program", BASE_BYTES),
+            ("threads", THREAD_BYTES * threads as f64),
             ("part", BYTES_PER_TRIANGLE * triangles as f64),
         ];
         items.extend(crate::engine::working_bytes(
@@ -95,14 +114,34 @@ impl MemoryEstimate {
     }
 
     /// Adds the sample check's working memory (`analyze`'s check against
-    /// the exact oracle, after the analysis): the oracle's mesh and its
-    /// BVH, `ORACLE_BYTES_PER_TRIANGLE` per triangle. Its copy of the
-    /// grid's heights and its per-pair buffers fit in what the engine's
-    /// buffers freed by then (measured: on the console at 2 mm the check
-    /// raised no peak).
+    /// the exact oracle, after the analysis): by then the engine's
+    /// buffers are freed, and the check holds what the analysis keeps
+    /// (the program, the part, the height grid, the masks) and the
+    /// oracle's mesh and its BVH, `ORACLE_BYTES_PER_TRIANGLE` per
+    /// triangle (its copy of the heights and its per-pair buffers are
+    /// small beside them). The item is by how much that phase passes the
+    /// earlier ones (reading the part, the analysis): the whole stays the
+    /// peak of the three.
     pub fn add_sample_check(&mut self, triangles: usize) {
-        self.items
-            .push(("sample check", ORACLE_BYTES_PER_TRIANGLE * triangles as f64));
+        let before = self.bytes();
+        let kept: f64 = self
+            .items
+            .iter()
+            .filter(|(item, _)| KEPT_AFTER_THE_ENGINE.contains(item))
+            .map(|(_, b)| b)
+            .sum();
+        let check = kept + ORACLE_BYTES_PER_TRIANGLE * triangles as f64;
+        self.items.push(("sample check", (check - before).max(0.0)));
+    }
+
+    /// Makes the whole at least `reading` bytes, what reading the part
+    /// held before this estimate's phase ([`MemoryEstimate::reading`]): the
+    /// excess over the rest, where there is one, is an item of its own.
+    pub fn cover_reading(&mut self, reading: f64) {
+        let rest = self.bytes();
+        if reading > rest {
+            self.items.push((READING_BEYOND, reading - rest));
+        }
     }
 
     /// The estimate of reading a part file of `file_bytes` bytes holding at
@@ -222,8 +261,40 @@ pub(crate) fn cgroup_limit_under(root: &std::path::Path, proc_cgroup: &str) -> O
     limits.into_iter().reduce(f64::min)
 }
 
+/// Whether this process can map `bytes` more now, found by asking for
+/// them (`Vec::try_reserve_exact`, given back at once, no page touched):
+/// `None` where it can, else about the most it can (bytes, to a 64th of
+/// `bytes`). What the figures of [`limit_bytes`] miss refuses here before
+/// any work, in a line, rather than in an abort part way: `ulimit -v` with
+/// `/proc` unreadable, a strict overcommit policy (`vm.overcommit_memory`
+/// 2), an address space already crowded.
+pub(crate) fn unmappable(bytes: f64) -> Option<f64> {
+    let fits = |b: f64| Vec::<u8>::new().try_reserve_exact(b as usize).is_ok();
+    if !(bytes.is_finite() && bytes > 0.0) || fits(bytes) {
+        return None;
+    }
+    let (mut lo, mut hi) = (0.0, bytes);
+    while hi - lo > bytes / 64.0 {
+        let mid = 0.5 * (lo + hi);
+        if fits(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(lo)
+}
+
+/// The address space glibc's allocator reserves for each thread's arena
+/// (`HEAP_MAX_SIZE` on 64-bit Linux), mapped as the thread first
+/// allocates: it counts in `ulimit -v`, though it is not memory used.
+const ARENA_BYTES: f64 = 64.0 * MIB;
+
 /// `RLIMIT_AS` (`ulimit -v`) less this process's mapped address space
-/// (`VmSize`), where a limit is set (bytes).
+/// (`VmSize`) and the arenas its threads may still map (one per worker
+/// thread and one for the progress ticker, [`ARENA_BYTES`] each: without
+/// them, runs that the check let through aborted on an allocation the
+/// address space no longer held), where a limit is set (bytes).
 fn address_space_left_bytes() -> Option<f64> {
     let text = std::fs::read_to_string("/proc/self/limits").ok()?;
     let line = text.lines().find(|l| l.starts_with("Max address space"))?;
@@ -234,7 +305,8 @@ fn address_space_left_bytes() -> Option<f64> {
         .parse()
         .ok()?;
     let used = proc_field("/proc/self/status", "VmSize:").unwrap_or(0.0);
-    Some((soft - used).max(0.0))
+    let arenas = ARENA_BYTES * (rayon::current_num_threads() + 1) as f64;
+    Some((soft - used - arenas).max(0.0))
 }
 
 /// A `/proc` line `KEY:   1234 kB` as bytes.

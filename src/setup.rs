@@ -412,14 +412,22 @@ pub(crate) enum Limit {
     Machine(f64, &'static str),
 }
 
-/// Whether `estimate` fits `allowed` bytes and the machine's memory.
+/// Whether `estimate` fits `allowed` bytes and the machine's memory, and
+/// the system gives that much now ([`crate::memory::unmappable`]).
 pub(crate) fn check_estimate(estimate: &MemoryEstimate, allowed: f64) -> Result<(), Limit> {
     let need = estimate.bytes();
     if need > allowed {
         return Err(Limit::Allowed(allowed));
     }
     match crate::memory::limit_bytes() {
-        Some((machine, what)) if need > machine => Err(Limit::Machine(machine, what)),
-        _ => Ok(()),
+        Some((machine, what)) if need > machine => return Err(Limit::Machine(machine, what)),
+        _ => {}
+    }
+    match crate::memory::unmappable(need) {
+        Some(mappable) => Err(Limit::Machine(mappable, UNMAPPABLE)),
+        None => Ok(()),
     }
 }
+
+/// The limit [`crate::memory::unmappable`] finds, in words.
+const UNMAPPABLE: &str = "memory the system would give this process now";

@@ -977,6 +977,83 @@ fn a_run_beyond_ulimit_v_is_refused_before_the_work() {
     assert!(!dir.join(".run.lock").exists());
 }
 
+/// Issue 41, item 7: a failed allocation aborted the run (134, a
+/// backtrace, `.lock` and `.partial` left): the oracle's BVH took 2.6
+/// times what the estimate counted for it, and `verify` read its part
+/// unchecked. Under every address-space limit from far too little to
+/// enough, each command either runs or refuses in one line (exit 2),
+/// leaving nothing behind: never an abort. The limits step by 49 MiB
+/// over a part whose oracle alone needs about 150 MiB, so that every
+/// stage (reading, the grid, the oracle's BVH, the traces) meets one.
+#[cfg(target_os = "linux")]
+#[test]
+fn no_address_space_limit_ends_in_an_abort() {
+    let dir = scratch_dir("hostile-ulimit-sweep");
+    let part = dir.join("bump.stl");
+    run_ok(&[
+        "scenario",
+        "bump",
+        "--triangles",
+        "400000",
+        "--out",
+        part.to_str().unwrap(),
+    ]);
+    // `verify` on a few starts; `analyze` with its sample check.
+    let commands = [("verify", " --starts 4"), ("analyze", "")];
+    let mut refused = 0;
+    for k in (100_000..=800_000).step_by(50_000) {
+        for (command, extra) in commands {
+            let out = dir.join("out");
+            let o = Command::new("sh")
+                .arg("-c")
+                .arg(format!(
+                    "ulimit -v {k} && exec {} {command} {} --pitch 4 --angles=0 --threads 2{extra} --out {}",
+                    env!("CARGO_BIN_EXE_kneeform"),
+                    part.display(),
+                    out.display()
+                ))
+                .env_remove("RUST_BACKTRACE")
+                .output()
+                .unwrap();
+            let what = format!("{command} under ulimit -v {k}");
+            let stderr = String::from_utf8_lossy(&o.stderr);
+            let code = o.status.code();
+            assert!(matches!(code, Some(0..=3)), "{what}: {code:?}: {stderr}");
+            assert!(
+                !stderr.contains("memory allocation")
+                    && !stderr.contains("backtrace")
+                    && !stderr.contains("panicked"),
+                "{what}: {stderr}"
+            );
+            let debris: Vec<String> = std::fs::read_dir(&dir)
+                .unwrap()
+                .flatten()
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| n.ends_with(".lock") || n.contains(".partial-") || n.contains(".tmp-"))
+                .collect();
+            assert!(debris.is_empty(), "{what}: {debris:?}");
+            if code == Some(2) {
+                refused += 1;
+                let errors: Vec<&str> = stderr
+                    .lines()
+                    .filter(|l| !l.starts_with("kneeform: exact oracle: about"))
+                    .collect();
+                assert_eq!(errors.len(), 1, "{what}: not one line: {stderr}");
+                assert!(
+                    errors[0].starts_with("kneeform: error: "),
+                    "{what}: {stderr}"
+                );
+                assert!(!out.exists(), "{what}: an output directory");
+            } else {
+                std::fs::remove_dir_all(&out).unwrap();
+            }
+        }
+    }
+    // The sweep reached the refusals it is for.
+    assert!(refused > 0);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// Issue 25, item 18: the blind-spot warning recommended pitches the tool
 /// refuses (`--pitch 0.000000001862645149230957` for a fin of no
 /// thickness). A sheet seen edge-on has no resolving pitch: the warning

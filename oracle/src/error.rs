@@ -28,6 +28,14 @@ pub enum OracleError {
     /// The scale factor is not a finite positive number.
     #[error("scale must be finite and > 0, got {0}")]
     InvalidScale(f64),
+    /// The system would not give the memory the part's mesh and its BVH
+    /// take: asked for before parry builds them, since an allocation
+    /// failing inside parry aborts the process.
+    #[error("cannot allocate the {:.2} GiB the exact oracle's copy of the part takes", *bytes as f64 / f64::from(1u32 << 30))]
+    OutOfMemory {
+        /// The bytes asked for.
+        bytes: usize,
+    },
     /// parry3d refused the mesh.
     #[error("parry3d refused the mesh: {0}")]
     Mesh(String),

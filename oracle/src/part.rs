@@ -17,6 +17,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::OracleError;
 
+/// Bytes parry's BVH takes per triangle while it is built: its wide nodes
+/// (128 bytes a triangle in f64) twice over while it refits them, its
+/// leaves (64) and their indices.
+const BVH_BUILD_BYTES_PER_TRIANGLE: usize = 352;
+
 /// Which side of the vehicle the part is on (SPEC, "Frame and units").
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Side {
@@ -56,30 +61,40 @@ impl Part {
     /// [`OracleError::NoTriangles`] when nothing is left after dropping
     /// degenerate triangles.
     pub fn from_triangles(triangles: &[[[f64; 3]; 3]]) -> Result<Self, OracleError> {
-        let mut index_of: HashMap<[u64; 3], u32> = HashMap::new();
-        let mut vertices: Vec<Vector> = Vec::new();
-        let mut indices: Vec<[u32; 3]> = Vec::with_capacity(triangles.len());
-        let mut dropped = 0;
-        for (t, tri) in triangles.iter().enumerate() {
-            if tri.iter().flatten().any(|c| !c.is_finite()) {
-                return Err(OracleError::NonFinite { triangle: t });
+        // The map from coordinates to vertex ids is dropped before parry
+        // builds its BVH: both at once were the oracle's peak.
+        let (vertices, indices, dropped) = {
+            let mut index_of: HashMap<[u64; 3], u32> = HashMap::new();
+            let mut vertices: Vec<Vector> = Vec::new();
+            let mut indices: Vec<[u32; 3]> = Vec::new();
+            indices
+                .try_reserve_exact(triangles.len())
+                .map_err(|_| OracleError::OutOfMemory {
+                    bytes: triangles.len().saturating_mul(12),
+                })?;
+            let mut dropped = 0;
+            for (t, tri) in triangles.iter().enumerate() {
+                if tri.iter().flatten().any(|c| !c.is_finite()) {
+                    return Err(OracleError::NonFinite { triangle: t });
+                }
+                let ids = tri.map(|p| {
+                    // -0.0 and 0.0 are the same point.
+                    let key = p.map(|c| (c + 0.0).to_bits());
+                    *index_of.entry(key).or_insert_with(|| {
+                        vertices.push(Vector::from_array(p));
+                        (vertices.len() - 1) as u32
+                    })
+                });
+                let [a, b, c] = ids.map(|i| vertices[i as usize]);
+                let repeats = ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2];
+                if repeats || (b - a).cross(c - a).length() == 0.0 {
+                    dropped += 1;
+                    continue;
+                }
+                indices.push(ids);
             }
-            let ids = tri.map(|p| {
-                // -0.0 and 0.0 are the same point.
-                let key = p.map(|c| (c + 0.0).to_bits());
-                *index_of.entry(key).or_insert_with(|| {
-                    vertices.push(Vector::from_array(p));
-                    (vertices.len() - 1) as u32
-                })
-            });
-            let [a, b, c] = ids.map(|i| vertices[i as usize]);
-            let repeats = ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2];
-            if repeats || (b - a).cross(c - a).length() == 0.0 {
-                dropped += 1;
-                continue;
-            }
-            indices.push(ids);
-        }
+            (vertices, indices, dropped)
+        };
         if indices.is_empty() {
             return Err(OracleError::NoTriangles { dropped });
         }
@@ -94,6 +109,13 @@ impl Part {
                 }
             }
         }
+        // parry allocates its BVH without a way to fail: the memory it
+        // takes is asked for (and given back) first, so that where the
+        // system would not give it the oracle fails, not the process.
+        let bvh = indices.len().saturating_mul(BVH_BUILD_BYTES_PER_TRIANGLE);
+        Vec::<u8>::new()
+            .try_reserve_exact(bvh)
+            .map_err(|_| OracleError::OutOfMemory { bytes: bvh })?;
         let mesh = TriMesh::new(vertices, indices).map_err(|e| OracleError::Mesh(e.to_string()))?;
         Ok(Self {
             mesh,

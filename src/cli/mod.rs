@@ -80,6 +80,7 @@ pub fn study_inputs(
         .collect();
     let staged = stage_output(out, study.force, &inputs)?;
     set_threads(threads)?;
+    kneeform::analysis::check_reading(&source, setup.max_memory_bytes)?;
     let input = source.read()?;
     Ok((input, setup, staged))
 }
@@ -231,14 +232,18 @@ fn cap(line: String, max: usize) -> String {
     format!("{cut} ... ({left} more characters left out)")
 }
 
-/// Sizes rayon's global pool (default: one thread per CPU).
+/// Sizes rayon's global pool (default: one thread per CPU) and starts it
+/// now, so that a system that gives no threads (`ulimit -v` leaves no
+/// room for their stacks) is said in a line, not in rayon's panic at its
+/// first use.
 pub fn set_threads(threads: Option<usize>) -> anyhow::Result<()> {
     if let Some(n) = threads {
         args::check_threads(n)?;
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()?;
     }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build_global()
+        .context("cannot start the worker threads")?;
     Ok(())
 }
 

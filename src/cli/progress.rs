@@ -78,6 +78,9 @@ impl Logged {
     }
 }
 
+/// The progress ticker's stack: it formats a line and sleeps.
+const TICKER_STACK_BYTES: usize = 64 * 1024;
+
 impl Default for Bars {
     fn default() -> Bars {
         let log = (!std::io::stderr().is_terminal()).then(|| {
@@ -93,18 +96,23 @@ impl Default for Bars {
                 every,
             }));
             // A stage whose steps are slow (or that has none) still gets
-            // its line: a ticker that ends with the bars.
+            // its line: a ticker that ends with the bars. Where the system
+            // gives no thread (`ulimit -v` leaves no room for its stack),
+            // the lines come with the steps alone.
             let weak: Weak<Mutex<Logged>> = Arc::downgrade(&log);
-            std::thread::spawn(move || {
-                loop {
-                    std::thread::sleep((every / 2).min(Duration::from_secs(1)));
-                    let Some(log) = weak.upgrade() else { return };
-                    let line = log.lock().unwrap_or_else(|e| e.into_inner()).due_line();
-                    if let Some(line) = line {
-                        eprintln!("{line}");
+            let _ = std::thread::Builder::new()
+                .name("progress".into())
+                .stack_size(TICKER_STACK_BYTES)
+                .spawn(move || {
+                    loop {
+                        std::thread::sleep((every / 2).min(Duration::from_secs(1)));
+                        let Some(log) = weak.upgrade() else { return };
+                        let line = log.lock().unwrap_or_else(|e| e.into_inner()).due_line();
+                        if let Some(line) = line {
+                            eprintln!("{line}");
+                        }
                     }
-                }
-            });
+                });
             log
         });
         Bars {

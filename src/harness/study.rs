@@ -126,6 +126,24 @@ fn run(
         &coarse,
         &pitches,
     );
+    // What every share holds is checked before the oracle is built (its
+    // BVH aborted the run where it did not fit); the traces are checked
+    // once a sample of them is measured.
+    let held = crate::memory::MemoryEstimate {
+        items: vec![("study", held_bytes)],
+    };
+    crate::setup::check_estimate(&held, setup.max_memory_bytes).map_err(|limit| {
+        let limit = match limit {
+            crate::setup::Limit::Allowed(b) | crate::setup::Limit::Machine(b, _) => b,
+        };
+        HarnessError::StudyMemory {
+            need_gib: held_bytes / crate::setup::GIB,
+            held_gib: held_bytes / crate::setup::GIB,
+            limit_gib: limit / crate::setup::GIB,
+            pairs: method.laid().starts.len() * setup.angles.len(),
+            shards: 0,
+        }
+    })?;
     let tracing = Tracing {
         share: share(&method.laid().starts, shard)?,
         finest: pitches[pitches.len() - 1],

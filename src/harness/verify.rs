@@ -241,19 +241,26 @@ pub(super) fn run_oracle(
         let sample = trace(&first)?;
         let sample_s = t.elapsed().as_secs_f64();
         let predicted_s = sample_s * pairs as f64 / first.len().max(1) as f64;
-        if !rest.is_empty() {
-            progress.note(&format!(
-                "exact oracle: about {} for {pairs} start-angle pairs (predicted from {} of them spread over the starts and angles, {:.1} s)",
-                crate::limits::duration_words(predicted_s),
-                first.len(),
-                sample_s
-            ));
-        }
-        if let Some(memory) = memory {
+        // The study's memory, predicted from the sample's contacts.
+        let traces_need = memory.map(|memory| {
             let contacts: usize = sample.iter().map(|t| t.contacts.len()).sum();
             let traces = BYTES_PER_CONTACT * memory.pitches as f64 * contacts as f64 * pairs as f64
                 / first.len().max(1) as f64;
-            let need = traces + memory.held_bytes;
+            (traces, traces + memory.held_bytes)
+        });
+        if !rest.is_empty() {
+            progress.note(&format!(
+                "exact oracle: about {} for {pairs} start-angle pairs (predicted from {} of them spread over the starts and angles, {:.1} s){}",
+                crate::limits::duration_words(predicted_s),
+                first.len(),
+                sample_s,
+                traces_need.map_or(String::new(), |(_, need)| format!(
+                    "; the study should hold about {:.2} GiB",
+                    need / GIB
+                ))
+            ));
+        }
+        if let (Some(memory), Some((traces, need))) = (memory, traces_need) {
             let limit = match crate::memory::limit_bytes() {
                 Some((machine, _)) => memory.bytes.min(machine),
                 None => memory.bytes,
