@@ -14,6 +14,8 @@ use cli::args::{Cli, Command};
 /// report an interrupted command).
 const INTERRUPTED: i32 = 130;
 
+const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
@@ -56,6 +58,13 @@ fn main() -> ExitCode {
 }
 
 fn run(cli: &Cli) -> anyhow::Result<ExitCode> {
+    if let Some((need, room)) = kneeform::memory::short_to_start() {
+        anyhow::bail!(
+            "kneeform needs about {:.2} GiB of address space to start (the program, and an allocator arena for each thread), more than the {:.2} GiB the system gives it now (ulimit -v, or its overcommit limit)",
+            need / GIB,
+            room / GIB
+        );
+    }
     match &cli.command {
         Command::Analyze(args) => return cli::analyze::run(args),
         Command::Scenario(args) => cli::scenario::run(args)?,

@@ -285,6 +285,19 @@ pub(crate) fn unmappable(bytes: f64) -> Option<f64> {
     Some(lo)
 }
 
+/// Where this process could not start its work: the address space it
+/// needs whatever the command (the program, [`BASE_BYTES`], and an
+/// allocator arena, [`ARENA_BYTES`], for each thread it may start: one
+/// per CPU and the progress ticker) and about the most the system gives
+/// now (bytes, [`unmappable`]). Under a tight `ulimit -v` a command that
+/// counts nothing else (`merge`, `report`) aborted on its first
+/// allocation.
+pub fn short_to_start() -> Option<(f64, f64)> {
+    let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let need = BASE_BYTES + ARENA_BYTES * (cpus + 1) as f64;
+    unmappable(need).map(|room| (need, room))
+}
+
 /// The address space glibc's allocator reserves for each thread's arena
 /// (`HEAP_MAX_SIZE` on 64-bit Linux), mapped as the thread first
 /// allocates: it counts in `ulimit -v`, though it is not memory used.
