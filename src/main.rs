@@ -99,21 +99,7 @@ fn flag_error(err: &clap::Error) -> ExitCode {
             ExitCode::SUCCESS
         };
     }
-    // The message is the lines before the usage and the tip (a list of
-    // missing arguments runs on to a second line).
-    let text = err.render().to_string();
-    let message: Vec<&str> = text
-        .lines()
-        .map(str::trim)
-        .take_while(|l| !l.is_empty() && !l.starts_with("Usage:") && !l.starts_with("tip:"))
-        .collect();
-    let message = message.join(" ");
-    let first = message.strip_prefix("error: ").unwrap_or(&message);
-    let first = if first.is_empty() {
-        "the command line is not understood"
-    } else {
-        first
-    };
+    let first = cli::clap_message(err);
     eprintln!("kneeform: error: {first} (`kneeform help COMMAND` lists its flags)");
     ExitCode::from(2)
 }

@@ -709,6 +709,35 @@ fn batch(manifest: &Path) -> Output {
     kneeform(&["batch", &manifest.display().to_string()])
 }
 
+/// Issue 41's re-run (batch class): an item's flag of nonsense (an
+/// unknown flag, a second `--out`, a pitch of -1, angles that are not
+/// numbers) failed only once the items before it had run, in three lines.
+/// Every item's flags are checked first: one line, nothing run.
+#[test]
+fn a_batch_checks_every_items_flags_before_the_first_runs() {
+    let dir = scratch_dir("hostile-batch-flags");
+    std::fs::copy(scenario("bump"), dir.join("bump.toml")).unwrap();
+    for bad in [
+        r#"args = ["--bogus"]"#,
+        r#"args = ["--out", "elsewhere"]"#,
+        "pitch = -1",
+        r#"angles = "a:b:c""#,
+    ] {
+        let manifest = dir.join("m.toml");
+        std::fs::write(
+            &manifest,
+            format!(
+                "[[item]]\npart = \"bump.toml\"\nout = \"first\"\npitch = 8\nangles = \"0\"\n\n[[item]]\npart = \"bump.toml\"\nout = \"second\"\n{bad}\n"
+            ),
+        )
+        .unwrap();
+        let err = assert_refused(&batch(&manifest), &dir, bad);
+        assert!(err.contains("item 2"), "{bad}: {err}");
+        assert!(!dir.join("first").exists(), "{bad}: item 1 ran");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// Issue 25, item 6: a batch item's fingerprint left out the files its
 /// arguments name (`--ignore FILE`, `--frame @FILE`, a second part among
 /// `args`), so after one of them changed the item was skipped on stale

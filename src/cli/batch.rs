@@ -93,6 +93,27 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
             );
         }
     }
+    // Every item's flags are checked before the first item runs: an item
+    // further down with a flag of nonsense failed only once the items
+    // before it had run.
+    for (k, item) in items.iter().enumerate() {
+        let argv = std::iter::once("kneeform").chain(item.argv.iter().map(String::as_str));
+        let checked = match <super::args::Cli as clap::Parser>::try_parse_from(argv) {
+            Ok(cli) => match &cli.command {
+                super::args::Command::Analyze(analyze) => analyze.setup.validate().map(|_| ()),
+                _ => Err(anyhow::anyhow!("not an analysis")),
+            },
+            Err(err) => Err(anyhow::anyhow!(super::clap_message(&err))),
+        };
+        checked.with_context(|| {
+            format!(
+                "manifest {}: item {} ({})",
+                args.manifest.display(),
+                k + 1,
+                item.out.display()
+            )
+        })?;
+    }
     let exe = std::env::current_exe().context("cannot find this kneeform binary")?;
     let total = items.len();
     let (mut ran, mut skipped) = (0, 0);

@@ -232,6 +232,25 @@ fn cap(line: String, max: usize) -> String {
     format!("{cut} ... ({left} more characters left out)")
 }
 
+/// What clap found wrong with a command line, in one line: its message,
+/// without the usage and the tip that follow it (a list of missing
+/// arguments runs on to a second line, joined).
+pub fn clap_message(err: &clap::Error) -> String {
+    let text = err.render().to_string();
+    let message: Vec<&str> = text
+        .lines()
+        .map(str::trim)
+        .take_while(|l| !l.is_empty() && !l.starts_with("Usage:") && !l.starts_with("tip:"))
+        .collect();
+    let message = message.join(" ");
+    let first = message.strip_prefix("error: ").unwrap_or(&message);
+    if first.is_empty() {
+        "the command line is not understood".into()
+    } else {
+        first.into()
+    }
+}
+
 /// Sizes rayon's global pool (default: one thread per CPU) and starts it
 /// now, so that a system that gives no threads (`ulimit -v` leaves no
 /// room for their stacks) is said in a line, not in rayon's panic at its
