@@ -286,10 +286,10 @@ pub(crate) fn unmappable(bytes: f64) -> Option<f64> {
 }
 
 /// Where this process could not start its work: the address space it
-/// needs whatever the command (the program, [`BASE_BYTES`], and an
-/// allocator arena, [`ARENA_BYTES`], for each thread it may start: one
+/// needs whatever the command (the program, `BASE_BYTES`, and an
+/// allocator arena, `ARENA_BYTES`, for each thread it may start: one
 /// per CPU and the progress ticker) and about the most the system gives
-/// now (bytes, [`unmappable`]). Under a tight `ulimit -v` a command that
+/// now (bytes, `unmappable`). Under a tight `ulimit -v` a command that
 /// counts nothing else (`merge`, `report`) aborted on its first
 /// allocation.
 pub fn short_to_start() -> Option<(f64, f64)> {
