@@ -1014,7 +1014,9 @@ fn a_run_beyond_ulimit_v_is_refused_before_the_work() {
 /// leaving nothing behind: never an abort. The limits step by 49 MiB
 /// over a part whose oracle alone needs about 150 MiB, so that every
 /// stage (starting, reading, the grid, the oracle's BVH, the traces)
-/// meets one, up to limits under which both commands run.
+/// meets one, up to limits under which every command runs; `merge` and
+/// `report`, which count no memory of their own, aborted on their first
+/// allocation under the lowest.
 #[cfg(target_os = "linux")]
 #[test]
 fn no_address_space_limit_ends_in_an_abort() {
@@ -1028,18 +1030,45 @@ fn no_address_space_limit_ends_in_an_abort() {
         "--out",
         part.to_str().unwrap(),
     ]);
-    // `verify` on a few starts; `analyze` with its sample check.
-    let commands = [("verify", " --starts 4"), ("analyze", "")];
+    // A small run and its two shards, for `merge` and `report`.
+    let part_small = scenario("bump");
+    let small = |name: &str, extra: &[&str]| {
+        let d = dir.join(name).display().to_string();
+        let mut args = vec!["analyze", &part_small, "--pitch", "8", "--angles=-30,0,30"];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--out", &d]);
+        run_ok(&args);
+        d
+    };
+    let run = small("run", &[]);
+    let shards = [
+        small("s1", &["--shard", "1/2"]),
+        small("s2", &["--shard", "2/2"]),
+    ];
+    let p = part.display();
+    // `verify` on a few starts; `analyze` with its sample check; the
+    // commands that count no memory of their own.
+    let commands = [
+        (
+            "verify",
+            format!("verify {p} --pitch 4 --angles=0 --threads 2 --starts 4"),
+        ),
+        (
+            "analyze",
+            format!("analyze {p} --pitch 4 --angles=0 --threads 2"),
+        ),
+        ("merge", format!("merge {} {}", shards[0], shards[1])),
+        ("report", format!("report {run}")),
+    ];
     let (mut refused, mut ran) = (0, 0);
     for k in (100_000..=1_200_000).step_by(50_000) {
-        for (command, extra) in commands {
+        for (command, args) in &commands {
             let out = dir.join("out");
             let o = Command::new("sh")
                 .arg("-c")
                 .arg(format!(
-                    "ulimit -v {k} && exec {} {command} {} --pitch 4 --angles=0 --threads 2{extra} --out {}",
+                    "ulimit -v {k} && exec {} {args} --out {}",
                     env!("CARGO_BIN_EXE_kneeform"),
-                    part.display(),
                     out.display()
                 ))
                 .env_remove("RUST_BACKTRACE")
@@ -1076,7 +1105,11 @@ fn no_address_space_limit_ends_in_an_abort() {
                 assert!(!out.exists(), "{what}: an output directory");
             } else {
                 ran += 1;
-                std::fs::remove_dir_all(&out).unwrap();
+                if out.is_dir() {
+                    std::fs::remove_dir_all(&out).unwrap();
+                } else {
+                    std::fs::remove_file(&out).unwrap();
+                }
             }
         }
     }
