@@ -121,6 +121,7 @@ cd "$W/runs" || exit 1
 "$K" analyze "$BUMP" "${FAST[@]}" --out a >/dev/null 2>&1
 "$K" analyze "$BUMP" "${FAST[@]}" --no-check --out anocheck >/dev/null 2>&1
 "$K" verify "$BUMP" "${ONE[@]}" --starts 4 --out v >/dev/null 2>&1
+"$K" converge "$BUMP" --pitches 16,8 --angles=0 --threads 2 --starts 4 --out c >/dev/null 2>&1
 for k in 1 2; do
     "$K" analyze "$BUMP" "${FAST[@]}" --shard $k/2 --out as$k >/dev/null 2>&1
     "$K" analyze "$BUMP" "${FAST[@]}" --shard $k/2 --no-check --out an$k >/dev/null 2>&1
@@ -434,15 +435,21 @@ done
 # debris and the previous result whole; after a KILL, the next --force run
 # succeeds and leaves no debris.
 for sig in INT TERM KILL; do
-    for delay in 0.02 0.1 0.3 0.6 1.0 1.5; do
-        for cmd in analyze verify; do
+    for delay in 0.01 0.05 0.1 0.2 0.3 0.45 0.6 0.8 1.0 1.5 2.0; do
+        for cmd in analyze verify converge; do
             fresh
-            if [[ $cmd == analyze ]]; then cp -r "$R/a" o; else cp -r "$R/v" o; fi
+            case $cmd in
+            analyze) cp -r "$R/a" o ;;
+            verify) cp -r "$R/v" o ;;
+            converge) cp -r "$R/c" o ;;
+            esac
             before=$(cd o && find . -type f -exec sha256sum {} + | sort)
             if [[ $cmd == analyze ]]; then
                 args=(analyze "$BUMP" --pitch 2 --angles=-30:30:5 --threads 2 --force --out o --report)
-            else
+            elif [[ $cmd == verify ]]; then
                 args=(verify "$BUMP" --pitch 4 --angles=-10,0,10 --threads 2 --starts 30 --force --out o)
+            else
+                args=(converge "$BUMP" --pitches 8,4 --angles=-10,0,10 --threads 2 --starts 30 --force --out o)
             fi
             "$K" "${args[@]}" >/dev/null 2>"$W/err" &
             pid=$!
