@@ -387,6 +387,48 @@ mod tests {
         std::fs::remove_dir_all(root).unwrap();
     }
 
+    /// The sample check runs after the engine has freed its buffers: it
+    /// raises the peak only where what the analysis keeps and the
+    /// oracle's copy pass the analysis's (or the reading's) own peak.
+    #[test]
+    fn the_sample_check_is_a_phase_of_its_own() {
+        let mib = MIB;
+        let analysis = |engine: f64| MemoryEstimate {
+            items: vec![
+                ("program", 10.0 * mib),
+                ("part", 72.0 * mib),
+                ("height grid", 8.0 * mib),
+                ("ranks", engine),
+                ("masks", 2.0 * mib),
+            ],
+        };
+        // A million triangles: the oracle's 400 MB pass an engine of 100
+        // MiB; the peak is the check's, on what the analysis keeps.
+        let mut big = analysis(100.0 * mib);
+        big.add_sample_check(1_000_000);
+        let kept = (10.0 + 72.0 + 8.0 + 2.0) * mib;
+        assert_eq!(big.bytes(), kept + 4e8);
+        // A thousand triangles: 0.4 MB of oracle beside a 100 MiB engine
+        // raise no peak.
+        let mut small = analysis(100.0 * mib);
+        small.add_sample_check(1000);
+        assert_eq!(small.bytes(), analysis(100.0 * mib).bytes());
+        // Reading the part held more than either: the peak stays its.
+        let mut read = analysis(0.0);
+        read.cover_reading(2000.0 * mib);
+        read.add_sample_check(1_000_000);
+        assert_eq!(read.bytes(), 2000.0 * mib);
+    }
+
+    #[test]
+    fn what_cannot_be_mapped_is_found_and_what_can_is_not() {
+        assert_eq!(unmappable(MIB), None);
+        // 2^60 bytes are beyond any address space of today (2^48 to 2^57).
+        let huge = (1u64 << 60) as f64;
+        let room = unmappable(huge).unwrap();
+        assert!(room > MIB && room < huge, "{room}");
+    }
+
     #[test]
     fn this_process_has_a_peak_and_the_machine_memory() {
         if cfg!(target_os = "linux") {
