@@ -263,8 +263,8 @@ pub(crate) fn cgroup_limit_under(root: &std::path::Path, proc_cgroup: &str) -> O
 
 /// Whether this process can map `bytes` more now, found by asking for
 /// them (`Vec::try_reserve_exact`, given back at once, no page touched):
-/// `None` where it can, else about the most it can (bytes, to a 64th of
-/// `bytes`). What the figures of [`limit_bytes`] miss refuses here before
+/// `None` where it can, else about the most it can (bytes, to a MiB).
+/// What the figures of [`limit_bytes`] miss refuses here before
 /// any work, in a line, rather than in an abort part way: `ulimit -v` with
 /// `/proc` unreadable, a strict overcommit policy (`vm.overcommit_memory`
 /// 2), an address space already crowded.
@@ -274,7 +274,7 @@ pub(crate) fn unmappable(bytes: f64) -> Option<f64> {
         return None;
     }
     let (mut lo, mut hi) = (0.0, bytes);
-    while hi - lo > bytes / 64.0 {
+    while hi - lo > MIB {
         let mid = 0.5 * (lo + hi);
         if fits(mid) {
             lo = mid;
