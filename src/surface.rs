@@ -79,6 +79,9 @@ const BISECT_DEPTH: u32 = 5;
 pub(crate) const BLOCK: usize = 16;
 /// Nodes per side of the blocks whose minima bound the surface.
 const COARSE: usize = 4;
+/// Levels of [`SurfaceGrid`]'s row spans: exact bounds over fewer than
+/// `2^(SPAN_LEVELS + 1)` columns.
+const SPAN_LEVELS: usize = 3;
 /// The largest `tau`, in pitches.
 const TAU_CAP: f64 = 0.25;
 
@@ -92,6 +95,9 @@ pub(crate) struct SurfaceGrid<'a> {
     cnx: usize,
     /// Per coarse row, the prefix minimum of `coarse` along it.
     prefix: Vec<f64>,
+    /// `spans[k][j * nx + i]`: the least height of nodes `i..i + 2^(k+1)`
+    /// of row `j` (those on the grid), for the runs' tight bounds.
+    spans: Vec<Vec<f64>>,
 }
 
 impl<'a> SurfaceGrid<'a> {
@@ -113,11 +119,24 @@ impl<'a> SurfaceGrid<'a> {
                 row[b] = row[b].min(row[b - 1]);
             }
         }
+        let mut spans: Vec<Vec<f64>> = Vec::with_capacity(SPAN_LEVELS);
+        for k in 0..SPAN_LEVELS {
+            let half = 1usize << k;
+            let last = spans.last().unwrap_or(&grid.h);
+            let mut next = last.clone();
+            for (row, from) in next.chunks_exact_mut(nx).zip(last.chunks_exact(nx)) {
+                for i in 0..nx.saturating_sub(half) {
+                    row[i] = from[i].min(from[i + half]);
+                }
+            }
+            spans.push(next);
+        }
         SurfaceGrid {
             grid,
             coarse,
             cnx,
             prefix,
+            spans,
         }
     }
 
@@ -196,11 +215,34 @@ impl<'a> SurfaceGrid<'a> {
     /// `c_lo..=c_hi` and rows `w_lo..=w_hi` (grid units): the least height
     /// of their nodes, read from the block minima (`+inf` off the grid),
     /// less a margin for rounding.
+    ///
+    /// Where the columns are fewer than `2^(SPAN_LEVELS + 1)` the least
+    /// height is exact (the spans' two overlapping windows per row);
+    /// otherwise it is read from the `COARSE x COARSE` block minima.
     #[inline]
     pub fn bound(&self, (c_lo, c_hi): (i64, i64), (w_lo, w_hi): (f64, f64)) -> f64 {
         let (nx, nz) = (self.grid.spec.nx as i64, self.grid.spec.nz as f64);
         if c_hi < 0 || c_lo > nx - 1 || w_hi < 0.0 || w_lo > nz - 1.0 {
             return f64::INFINITY;
+        }
+        let (lo, hi) = (
+            c_lo.clamp(0, nx - 1) as usize,
+            c_hi.clamp(0, nx - 1) as usize,
+        );
+        let k = (hi - lo + 1).ilog2() as usize;
+        if k <= SPAN_LEVELS {
+            let node_row = |v: f64| v.max(0.0).min(nz - 1.0) as usize;
+            let (r_lo, r_hi) = (node_row(w_lo.floor()), node_row(w_hi.floor() + 1.0));
+            let (table, second) = match k {
+                0 => (&self.grid.h, lo),
+                _ => (&self.spans[k - 1], hi + 1 - (1 << k)),
+            };
+            let nx = nx as usize;
+            let mut least = f64::INFINITY;
+            for r in r_lo..=r_hi {
+                least = least.min(table[r * nx + lo]).min(table[r * nx + second]);
+            }
+            return below(least);
         }
         let column = |c: i64| (c.clamp(0, nx - 1) as usize) / COARSE;
         let row = |v: f64| (v.max(0.0).min(nz - 1.0) as usize) / COARSE;
@@ -402,6 +444,72 @@ impl Lowest {
     }
 }
 
+/// [`SurfaceGrid::bound`] of each run of leading samples ([`BLOCK`]) of
+/// one start row, by the first column the run reads: the same for every
+/// start of the row, so read once per row.
+#[derive(Debug, Default)]
+struct Bounds {
+    /// The first column of the table.
+    lo: i64,
+    /// Columns per run.
+    width: usize,
+    /// `[run * width + column - lo]`, NaN where not read yet.
+    table: Vec<f64>,
+}
+
+impl Bounds {
+    /// A table for the runs of `sf` over the columns the slides of a row
+    /// of `nx` starts read (others are read as asked, not kept).
+    fn new(sf: &SurfaceFootprint, nx: usize) -> Bounds {
+        let (du_lo, du_hi) = sf
+            .blocks
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (_, e)| {
+                (lo.min(e[0]), hi.max(e[0]))
+            });
+        if !(du_lo.is_finite() && du_hi.is_finite()) {
+            return Bounds::default();
+        }
+        let lo = floor(du_lo) - reach(sf) - 2;
+        let hi = nx as i64 + floor(du_hi) + 2;
+        let width = usize::try_from(hi - lo + 1).unwrap_or(0);
+        Bounds {
+            lo,
+            width,
+            table: vec![f64::NAN; sf.blocks.len() * width],
+        }
+    }
+
+    /// The bound of run `b`, its extent `e`, when the outline's reference
+    /// sits at `(base, j0)`.
+    #[inline]
+    fn get(&mut self, sg: &SurfaceGrid, b: usize, e: &[f64; 4], (base, j0): (f64, f64)) -> f64 {
+        let cols = columns(base, e);
+        let read = || sg.bound(cols, (j0 + e[2], j0 + e[3]));
+        let Some(n) = usize::try_from(cols.0 - self.lo)
+            .ok()
+            .filter(|&c| c < self.width)
+            .map(|c| b * self.width + c)
+        else {
+            return read();
+        };
+        if self.table[n].is_nan() {
+            self.table[n] = read();
+        }
+        self.table[n]
+    }
+}
+
+/// Buffers a slide reuses from strike to strike (and a row from start to
+/// start).
+#[derive(Debug, Default)]
+struct Scratch {
+    /// The leading outline's values at one travel, where evaluated.
+    values: Vec<f64>,
+    /// Per run of [`BLOCK`] samples, whether `values` holds it.
+    evaluated: Vec<bool>,
+}
+
 /// The slide's state.
 struct Slide<'s, 'g> {
     sg: &'s SurfaceGrid<'g>,
@@ -413,13 +521,15 @@ struct Slide<'s, 'g> {
     witness: [f64; 2],
     history: LevelHistory,
     out: SurfaceTrace,
-    /// Per block: the columns its bound was read for, and the bound.
-    cached: Vec<(i64, f64)>,
+    /// The runs' bounds.
+    bounds: Bounds,
     /// The step's contact as an earlier slide struck it at this position
     /// (level and witness), where the trail recorded one.
     prior: Option<(f64, [f64; 2])>,
     /// Whether the step's contact struck.
     struck: bool,
+    /// The tie scan's buffers.
+    scratch: Scratch,
 }
 
 /// The columns whose cells the samples of a run with extent `e` read
@@ -457,12 +567,7 @@ impl Slide<'_, '_> {
         let base = self.i0 - t / STEPS_PER_PITCH;
         let mut lowest = Lowest(None);
         for (b, (range, e)) in self.sf.blocks.iter().enumerate() {
-            let cols = columns(base, e);
-            if self.cached[b].0 != cols.0 {
-                let bound = self.sg.bound(cols, (self.j0 + e[2], self.j0 + e[3]));
-                self.cached[b] = (cols.0, bound);
-            }
-            if self.cached[b].1 >= limit {
+            if self.bounds.get(self.sg, b, e, (base, self.j0)) >= limit {
                 continue;
             }
             for &[du, dw] in &self.sf.lead[range.clone()] {
@@ -505,37 +610,58 @@ impl Slide<'_, '_> {
 
     /// Marks the leading outline's points at travel `t` steps (`s` mm)
     /// within `tau` of the new level `level`, beside the witness `at`.
+    ///
+    /// Only the runs that can reach `level + TAU_CAP p` are evaluated and
+    /// scanned: a point of a skipped run lies above every candidate, so it
+    /// reads as `+inf` beside one (and is no candidate itself).
     fn ties(&mut self, t: f64, s: f64, level: f64, at: [f64; 2]) {
         let base = self.i0 - t / STEPS_PER_PITCH;
         let reach = level + TAU_CAP * self.sf.pitch;
-        // The outline's values, `+inf` in runs that cannot reach `reach`
-        // (their values lie above every candidate's, as `+inf` does).
-        let mut values = vec![f64::INFINITY; self.sf.lead.len()];
-        for (range, e) in &self.sf.blocks {
-            let bound = self
-                .sg
-                .bound(columns(base, e), (self.j0 + e[2], self.j0 + e[3]));
-            if bound > reach {
-                continue;
-            }
-            for n in range.clone() {
-                let [du, dw] = self.sf.lead[n];
-                values[n] = self.sg.at(base + du, self.j0 + dw);
+        let lead = &self.sf.lead;
+        let values = &mut self.scratch.values;
+        let evaluated = &mut self.scratch.evaluated;
+        values.resize(lead.len(), f64::INFINITY);
+        evaluated.clear();
+        for (b, (range, e)) in self.sf.blocks.iter().enumerate() {
+            let bound = self.bounds.get(self.sg, b, e, (base, self.j0));
+            let on = !(bound > reach);
+            evaluated.push(on);
+            if on {
+                for n in range.clone() {
+                    let [du, dw] = lead[n];
+                    values[n] = self.sg.at(base + du, self.j0 + dw);
+                }
             }
         }
-        for (n, &value) in values.iter().enumerate() {
-            let before = if n > 0 { values[n - 1] } else { f64::INFINITY };
-            let after = values.get(n + 1).copied().unwrap_or(f64::INFINITY);
-            // One point per site: the first of a run of equal lowest
-            // values along the outline.
-            if !(value < before && value <= after) {
-                continue;
-            }
-            let [du, dw] = self.sf.lead[n];
-            let here = [base + du, self.j0 + dw];
-            // `tau` is at most `TAU_CAP p`: a point above `reach` is no tie.
-            if here != at && value <= reach && value <= level + self.sg.tau(here[0], here[1]) {
-                self.out.strikes.push((nearest(here), s));
+        // The value of point `n` as the scan reads it: `+inf` in a
+        // skipped run and off the outline.
+        let read = |n: usize| match (evaluated.get(n / BLOCK), values.get(n)) {
+            (Some(true), Some(&value)) => value,
+            _ => f64::INFINITY,
+        };
+        for (range, _) in self
+            .sf
+            .blocks
+            .iter()
+            .zip(evaluated.iter())
+            .filter_map(|(block, &on)| on.then_some(block))
+        {
+            for n in range.clone() {
+                let value = values[n];
+                let before = if n > 0 { read(n - 1) } else { f64::INFINITY };
+                let after = read(n + 1);
+                // One point per site: the first of a run of equal lowest
+                // values along the outline.
+                if !(value < before && value <= after) {
+                    continue;
+                }
+                let [du, dw] = lead[n];
+                let here = [base + du, self.j0 + dw];
+                // `tau` is at most `TAU_CAP p`: a point above `reach` is no
+                // tie.
+                if here != at && value <= reach && value <= level + self.sg.tau(here[0], here[1]) {
+                    self.out.strikes.push((nearest(here), s));
+                }
             }
         }
     }
@@ -603,6 +729,18 @@ pub(crate) fn trace_row(
     placed
 }
 
+/// How far left of column 0 (in columns) a slide's outline and its nodes
+/// in front can reach, with a margin.
+fn reach(sf: &SurfaceFootprint) -> i64 {
+    sf.extent.0.abs().ceil() as i64
+        + sf.rows
+            .iter()
+            .map(|r| i64::from(r.3).abs())
+            .max()
+            .unwrap_or(0)
+        + 4
+}
+
 /// What a start's slide left at one position of the row's travel lattice.
 #[derive(Debug, Clone, Copy)]
 struct Record {
@@ -658,6 +796,10 @@ pub(crate) struct RowTrail {
     outline: Vec<Known>,
     /// Per position, the contact a slide struck there.
     struck: Vec<Option<(f64, [f64; 2])>>,
+    /// The slides' buffers, handed from one to the next.
+    scratch: Scratch,
+    /// The runs' bounds, handed from one slide to the next.
+    bounds: Bounds,
 }
 
 /// The first lowest node inside the footprint of one start, as the push
@@ -765,16 +907,7 @@ impl RowTrail {
     const UNWRITTEN: u32 = u32::MAX;
 
     fn new(sf: &SurfaceFootprint, nx: usize, rule: &StrikeRule) -> RowTrail {
-        // The lowest position a slide reaches: its outline and its nodes
-        // in front left of column 0 (a margin beyond).
-        let reach = sf.extent.0.abs().ceil() as i64
-            + sf.rows
-                .iter()
-                .map(|r| i64::from(r.3).abs())
-                .max()
-                .unwrap_or(0)
-            + 4;
-        let lo = -(STEPS_PER_PITCH as i64) * reach;
+        let lo = -(STEPS_PER_PITCH as i64) * reach(sf);
         let hi = STEPS_PER_PITCH as i64 * nx as i64;
         let window = (rule.window * STEPS_PER_PITCH / sf.pitch).ceil();
         RowTrail {
@@ -792,6 +925,8 @@ impl RowTrail {
             struck: vec![None; (hi - lo + 1) as usize],
             parent: Vec::new(),
             windows: PushNodes::default(),
+            scratch: Scratch::default(),
+            bounds: Bounds::new(sf, nx),
             need: if window.is_finite() && window < f64::from(u32::MAX / 2) {
                 window as u32 + 2
             } else {
@@ -971,9 +1106,16 @@ fn slide_start(
             yr: pushed.value,
             ..SurfaceTrace::default()
         },
-        cached: vec![(i64::MIN, 0.0); sf.blocks.len()],
+        bounds: match trail.as_deref_mut() {
+            Some(trail) => std::mem::take(&mut trail.bounds),
+            None => Bounds::new(sf, nx as usize),
+        },
         prior: None,
         struck: false,
+        scratch: trail
+            .as_deref_mut()
+            .map(|trail| std::mem::take(&mut trail.scratch))
+            .unwrap_or_default(),
     };
     // The nodes in front as one stream by distance: layer `layer` (the
     // `layer`-th node in front of each row), rows in the slide's order;
@@ -1063,6 +1205,10 @@ fn slide_start(
                 break;
             }
         }
+    }
+    if let Some(trail) = trail {
+        trail.scratch = std::mem::take(&mut slide.scratch);
+        trail.bounds = std::mem::take(&mut slide.bounds);
     }
     slide.out
 }
