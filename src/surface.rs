@@ -96,8 +96,12 @@ pub(crate) struct SurfaceGrid<'a> {
     /// Per coarse row, the prefix minimum of `coarse` along it.
     prefix: Vec<f64>,
     /// `spans[k][j * nx + i]`: the least height of nodes `i..i + 2^(k+1)`
-    /// of row `j` (those on the grid), for the runs' tight bounds.
+    /// of row `j` (those on the grid), for the runs' tight bounds; empty
+    /// unless [`SurfaceGrid::with_spans`].
     spans: Vec<Vec<f64>>,
+    /// The largest [`SurfaceGrid::tau`] per block of `COARSE x COARSE`
+    /// cells; empty unless [`SurfaceGrid::with_spans`].
+    taus: Vec<f64>,
 }
 
 impl<'a> SurfaceGrid<'a> {
@@ -119,10 +123,25 @@ impl<'a> SurfaceGrid<'a> {
                 row[b] = row[b].min(row[b - 1]);
             }
         }
+        SurfaceGrid {
+            grid,
+            coarse,
+            cnx,
+            prefix,
+            spans: Vec::new(),
+            taus: Vec::new(),
+        }
+    }
+
+    /// With the row spans that make [`SurfaceGrid::bound`] exact over
+    /// narrow runs (three more copies of the heights: for the engine's
+    /// slides, not for one start's trace).
+    pub fn with_spans(mut self) -> SurfaceGrid<'a> {
+        let nx = self.grid.spec.nx;
         let mut spans: Vec<Vec<f64>> = Vec::with_capacity(SPAN_LEVELS);
         for k in 0..SPAN_LEVELS {
             let half = 1usize << k;
-            let last = spans.last().unwrap_or(&grid.h);
+            let last = spans.last().unwrap_or(&self.grid.h);
             let mut next = last.clone();
             for (row, from) in next.chunks_exact_mut(nx).zip(last.chunks_exact(nx)) {
                 for i in 0..nx.saturating_sub(half) {
@@ -131,13 +150,20 @@ impl<'a> SurfaceGrid<'a> {
             }
             spans.push(next);
         }
-        SurfaceGrid {
-            grid,
-            coarse,
-            cnx,
-            prefix,
-            spans,
+        self.spans = spans;
+        let (nx, nz) = (self.grid.spec.nx, self.grid.spec.nz);
+        if nx >= 2 && nz >= 2 {
+            let tnx = (nx - 1).div_ceil(COARSE);
+            let mut taus = vec![0.0f64; tnx * (nz - 1).div_ceil(COARSE)];
+            for j in 0..nz - 1 {
+                for i in 0..nx - 1 {
+                    let t = &mut taus[(j / COARSE) * tnx + i / COARSE];
+                    *t = t.max(self.tau_cell(i, j));
+                }
+            }
+            self.taus = taus;
         }
+        self
     }
 
     /// The cell `(i, j)` holding `(u, w)` and the position in it, or
@@ -190,6 +216,11 @@ impl<'a> SurfaceGrid<'a> {
         let Some((i, j, _, _)) = self.cell(u, w) else {
             return 0.0;
         };
+        self.tau_cell(i, j)
+    }
+
+    /// [`SurfaceGrid::tau`] at cell `(i, j)`.
+    fn tau_cell(&self, i: usize, j: usize) -> f64 {
         let (nx, nz) = (self.grid.spec.nx as i64, self.grid.spec.nz as i64);
         let h = |i: i64, j: i64| {
             if (0..nx).contains(&i) && (0..nz).contains(&j) {
@@ -216,8 +247,8 @@ impl<'a> SurfaceGrid<'a> {
     /// of their nodes, read from the block minima (`+inf` off the grid),
     /// less a margin for rounding.
     ///
-    /// Where the columns are fewer than `2^(SPAN_LEVELS + 1)` the least
-    /// height is exact (the spans' two overlapping windows per row);
+    /// Where the columns are fewer than `2^(SPAN_LEVELS + 1)` (and the
+    /// spans are built) the least height is exact (the spans' two overlapping windows per row);
     /// otherwise it is read from the `COARSE x COARSE` block minima.
     #[inline]
     pub fn bound(&self, (c_lo, c_hi): (i64, i64), (w_lo, w_hi): (f64, f64)) -> f64 {
@@ -230,7 +261,7 @@ impl<'a> SurfaceGrid<'a> {
             c_hi.clamp(0, nx - 1) as usize,
         );
         let k = (hi - lo + 1).ilog2() as usize;
-        if k <= SPAN_LEVELS {
+        if k <= self.spans.len() {
             let node_row = |v: f64| v.max(0.0).min(nz - 1.0) as usize;
             let (r_lo, r_hi) = (node_row(w_lo.floor()), node_row(w_hi.floor() + 1.0));
             let (table, second) = match k {
@@ -257,21 +288,62 @@ impl<'a> SurfaceGrid<'a> {
         below(least)
     }
 
+    /// An upper bound of [`SurfaceGrid::tau`] at every cell in columns
+    /// `c_lo..=c_hi` and rows `w_lo..=w_hi` (grid units, as
+    /// [`SurfaceGrid::bound`] reads them): the largest `tau` of the
+    /// `COARSE x COARSE` blocks of cells holding them, or its cap where
+    /// the spans are not built.
+    #[inline]
+    pub fn tau_bound(&self, (c_lo, c_hi): (i64, i64), (w_lo, w_hi): (f64, f64)) -> f64 {
+        let cap = TAU_CAP * self.grid.spec.pitch;
+        let (nx, nz) = (self.grid.spec.nx as i64, self.grid.spec.nz as i64);
+        if self.taus.is_empty() || nx < 2 || nz < 2 {
+            return cap;
+        }
+        let (cells_x, cells_z) = (nx - 1, nz - 1);
+        let tnx = (cells_x as usize).div_ceil(COARSE);
+        let column = |c: i64| c.clamp(0, cells_x - 1) as usize / COARSE;
+        let row = |v: f64| floor(v.clamp(0.0, (cells_z - 1) as f64)) as usize / COARSE;
+        let (b_lo, b_hi) = (column(c_lo), column(c_hi));
+        let (r_lo, r_hi) = (row(w_lo), row(w_hi + 1.0));
+        let mut most = 0.0f64;
+        for r in r_lo..=r_hi {
+            for &t in &self.taus[r * tnx + b_lo..=r * tnx + b_hi] {
+                most = most.max(t);
+            }
+        }
+        most.min(cap)
+    }
+
     /// [`SurfaceGrid::bound`] of every node in columns `0..=u_hi` and rows
-    /// `w_lo..=w_hi` (grid units).
-    pub fn bound_before(&self, u_hi: f64, (w_lo, w_hi): (f64, f64)) -> f64 {
-        let (nx, nz) = (self.grid.spec.nx as f64, self.grid.spec.nz as f64);
+    /// `w_lo..=w_hi` (grid units). `memo` keeps the last block column read
+    /// and its bound: a slide asks at every step for the same rows, and
+    /// the block column changes once in `8 COARSE` steps.
+    pub fn bound_before(
+        &self,
+        u_hi: f64,
+        (w_lo, w_hi): (f64, f64),
+        memo: &mut Option<(usize, f64)>,
+    ) -> f64 {
+        let (nx, nz) = (self.grid.spec.nx as i64, self.grid.spec.nz as f64);
         if u_hi < 0.0 || w_hi < 0.0 || w_lo > nz - 1.0 {
             return f64::INFINITY;
         }
+        let b = (floor(u_hi) + 1).clamp(0, nx - 1) as usize / COARSE;
+        if let Some((column, bound)) = *memo
+            && column == b
+        {
+            return bound;
+        }
         let clip = |v: f64, n: f64| (v.max(0.0).min(n - 1.0) as usize) / COARSE;
-        let b = clip(u_hi.floor() + 1.0, nx);
         let (r_lo, r_hi) = (clip(w_lo.floor(), nz), clip(w_hi.floor() + 1.0, nz));
         let mut least = f64::INFINITY;
         for r in r_lo..=r_hi {
             least = least.min(self.prefix[r * self.cnx + b]);
         }
-        below(least)
+        let bound = below(least);
+        *memo = Some((b, bound));
+        bound
     }
 }
 
@@ -455,28 +527,55 @@ struct Bounds {
     width: usize,
     /// `[run * width + column - lo]`, NaN where not read yet.
     table: Vec<f64>,
+    /// The same for [`SurfaceGrid::tau_bound`].
+    taus: Vec<f64>,
+    /// Per run, its columns beyond the first ([`span`]).
+    spans: Vec<i64>,
+    /// The least bound of each group of [`GROUP`] runs by position on the
+    /// travel lattice: `[group * positions + m - m_lo]`, NaN where not
+    /// read yet.
+    groups: Vec<f64>,
+    /// The first position of `groups`.
+    m_lo: i64,
+    /// Positions per group.
+    positions: usize,
 }
 
+/// Runs per group of [`Bounds`]: a group whose least bound is at or above
+/// the limit is skipped whole.
+const GROUP: usize = 8;
+
 impl Bounds {
-    /// A table for the runs of `sf` over the columns the slides of a row
-    /// of `nx` starts read (others are read as asked, not kept).
-    fn new(sf: &SurfaceFootprint, nx: usize) -> Bounds {
-        let (du_lo, du_hi) = sf
-            .blocks
+    /// A table for the runs `blocks` over the columns the slides of a row
+    /// of `nx` starts read (others are read as asked, not kept), `reach`
+    /// columns left of column 0 at most.
+    fn new(blocks: &[(std::ops::Range<usize>, [f64; 4])], nx: usize, reach: i64) -> Bounds {
+        let (du_lo, du_hi) = blocks
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (_, e)| {
                 (lo.min(e[0]), hi.max(e[0]))
             });
+        let spans = blocks.iter().map(|(_, e)| span(e)).collect();
         if !(du_lo.is_finite() && du_hi.is_finite()) {
-            return Bounds::default();
+            return Bounds {
+                spans,
+                ..Bounds::default()
+            };
         }
-        let lo = floor(du_lo) - reach(sf) - 2;
+        let lo = floor(du_lo) - reach - 2;
         let hi = nx as i64 + floor(du_hi) + 2;
         let width = usize::try_from(hi - lo + 1).unwrap_or(0);
+        let m_lo = -(STEPS_PER_PITCH as i64) * reach;
+        let positions = usize::try_from(STEPS_PER_PITCH as i64 * nx as i64 - m_lo + 1).unwrap_or(0);
         Bounds {
             lo,
             width,
-            table: vec![f64::NAN; sf.blocks.len() * width],
+            table: vec![f64::NAN; blocks.len() * width],
+            taus: vec![f64::NAN; blocks.len() * width],
+            spans,
+            groups: vec![f64::NAN; blocks.len().div_ceil(GROUP) * positions],
+            m_lo,
+            positions,
         }
     }
 
@@ -484,7 +583,8 @@ impl Bounds {
     /// sits at `(base, j0)`.
     #[inline]
     fn get(&mut self, sg: &SurfaceGrid, b: usize, e: &[f64; 4], (base, j0): (f64, f64)) -> f64 {
-        let cols = columns(base, e);
+        let first = floor(base + e[0]);
+        let cols = (first, first + self.spans[b]);
         let read = || sg.bound(cols, (j0 + e[2], j0 + e[3]));
         let Some(n) = usize::try_from(cols.0 - self.lo)
             .ok()
@@ -498,16 +598,100 @@ impl Bounds {
         }
         self.table[n]
     }
+
+    /// [`SurfaceGrid::tau_bound`] over the cells run `b`, its extent
+    /// `e`, reads at `(base, j0)`.
+    #[inline]
+    fn tau(&mut self, sg: &SurfaceGrid, b: usize, e: &[f64; 4], (base, j0): (f64, f64)) -> f64 {
+        let first = floor(base + e[0]);
+        let cols = (first, first + self.spans[b]);
+        let read = || sg.tau_bound(cols, (j0 + e[2], j0 + e[3]));
+        let Some(n) = usize::try_from(cols.0 - self.lo)
+            .ok()
+            .filter(|&c| c < self.width)
+            .map(|c| b * self.width + c)
+        else {
+            return read();
+        };
+        if self.taus[n].is_nan() {
+            self.taus[n] = read();
+        }
+        self.taus[n]
+    }
+
+    /// The least bound of the runs of group `g` of `blocks` at `(base,
+    /// j0)`: kept by position where `base` lies on the travel lattice.
+    #[inline]
+    fn group(
+        &mut self,
+        sg: &SurfaceGrid,
+        blocks: &[(std::ops::Range<usize>, [f64; 4])],
+        g: usize,
+        (base, j0): (f64, f64),
+    ) -> f64 {
+        let runs = g * GROUP..((g + 1) * GROUP).min(blocks.len());
+        let m = base * STEPS_PER_PITCH;
+        let slot = (m == m.trunc())
+            .then(|| usize::try_from(m as i64 - self.m_lo).ok())
+            .flatten()
+            .filter(|&n| n < self.positions)
+            .map(|n| g * self.positions + n);
+        if let Some(n) = slot
+            && !self.groups[n].is_nan()
+        {
+            return self.groups[n];
+        }
+        let mut least = f64::INFINITY;
+        for b in runs {
+            least = least.min(self.get(sg, b, &blocks[b].1, (base, j0)));
+        }
+        if let Some(n) = slot {
+            self.groups[n] = least;
+        }
+        least
+    }
 }
 
 /// Buffers a slide reuses from strike to strike (and a row from start to
 /// start).
 #[derive(Debug, Default)]
 struct Scratch {
-    /// The leading outline's values at one travel, where evaluated.
+    /// The leading outline's values with its reference at `u = base`
+    /// (grid units), in the runs `have` marks.
     values: Vec<f64>,
+    /// The position `values` holds (NaN where none).
+    base: f64,
     /// Per run of [`BLOCK`] samples, whether `values` holds it.
-    evaluated: Vec<bool>,
+    have: Vec<bool>,
+    /// Per run, how the tie scan reads it.
+    evaluated: Vec<Run>,
+}
+
+/// How the tie scan reads a run of the outline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Run {
+    /// Its bound lies above `level + TAU_CAP p`: as `+inf`.
+    Above,
+    /// Below that, but above `level` plus its cells' largest `tau`: no
+    /// tie, its values read beside one.
+    Near,
+    /// Evaluated and scanned.
+    Scanned,
+}
+
+impl Scratch {
+    /// Ready to hold the outline `sf`'s values at position `base`: the
+    /// runs held so far are kept where `base` is the one they were
+    /// evaluated at (every value is a function of the position and the
+    /// row alone).
+    fn at(&mut self, sf: &SurfaceFootprint, base: f64) {
+        if self.base != base || self.values.len() != sf.lead.len() {
+            self.values.resize(sf.lead.len(), f64::INFINITY);
+            self.have.clear();
+            self.have.resize(sf.blocks.len(), false);
+            self.base = base;
+        }
+    }
 }
 
 /// The slide's state.
@@ -532,13 +716,12 @@ struct Slide<'s, 'g> {
     scratch: Scratch,
 }
 
-/// The columns whose cells the samples of a run with extent `e` read
-/// when the outline's reference sits at `base` (grid units): a function
-/// of the first column alone, so that a bound read for it holds while it
-/// stays.
-fn columns(base: f64, e: &[f64; 4]) -> (i64, i64) {
-    let first = floor(base + e[0]);
-    (first, first + (e[1] - e[0]).ceil() as i64 + 2)
+/// The columns a run with extent `e` reads beyond its first, whatever
+/// the position: the run at reference `base` reads columns `first ..=
+/// first + span` with `first = floor(base + e[0])`, a function of the
+/// first column alone, so that a bound read for it holds while it stays.
+fn span(e: &[f64; 4]) -> i64 {
+    (e[1] - e[0]).ceil() as i64 + 2
 }
 
 /// `v.floor()` as an integer, for `|v| < 2^52`, without the library call
@@ -566,16 +749,33 @@ impl Slide<'_, '_> {
     fn lowest_below(&mut self, t: f64, limit: f64) -> Lowest {
         let base = self.i0 - t / STEPS_PER_PITCH;
         let mut lowest = Lowest(None);
-        for (b, (range, e)) in self.sf.blocks.iter().enumerate() {
-            if self.bounds.get(self.sg, b, e, (base, self.j0)) >= limit {
+        self.scratch.at(self.sf, base);
+        let blocks = &self.sf.blocks;
+        for g in 0..blocks.len().div_ceil(GROUP) {
+            if self.bounds.group(self.sg, blocks, g, (base, self.j0)) >= limit {
                 continue;
             }
-            for &[du, dw] in &self.sf.lead[range.clone()] {
-                let at = [base + du, self.j0 + dw];
-                let value = self.sg.at(at[0], at[1]);
-                if value < limit {
-                    lowest.take(value, at);
+            for b in g * GROUP..((g + 1) * GROUP).min(blocks.len()) {
+                let (range, e) = &blocks[b];
+                if self.bounds.get(self.sg, b, e, (base, self.j0)) >= limit {
+                    continue;
                 }
+                let have = self.scratch.have[b];
+                for n in range.clone() {
+                    let [du, dw] = self.sf.lead[n];
+                    let at = [base + du, self.j0 + dw];
+                    let value = if have {
+                        self.scratch.values[n]
+                    } else {
+                        let value = self.sg.at(at[0], at[1]);
+                        self.scratch.values[n] = value;
+                        value
+                    };
+                    if value < limit {
+                        lowest.take(value, at);
+                    }
+                }
+                self.scratch.have[b] = true;
             }
         }
         lowest
@@ -611,55 +811,93 @@ impl Slide<'_, '_> {
     /// Marks the leading outline's points at travel `t` steps (`s` mm)
     /// within `tau` of the new level `level`, beside the witness `at`.
     ///
-    /// Only the runs that can reach `level + TAU_CAP p` are evaluated and
-    /// scanned: a point of a skipped run lies above every candidate, so it
-    /// reads as `+inf` beside one (and is no candidate itself).
+    /// SPEC's scan reads every point, a run whose bound lies above
+    /// `reach = level + TAU_CAP p` as `+inf` (it holds no candidate and
+    /// lies above every candidate beside it). Only the runs that can hold
+    /// a tie are evaluated and scanned: bound at most `reach` and at most
+    /// `level` plus the largest `tau` of their cells (a point is a tie
+    /// only within its own cell's `tau` of the level); a neighbour in a
+    /// run not scanned is read as SPEC's scan reads it.
     fn ties(&mut self, t: f64, s: f64, level: f64, at: [f64; 2]) {
         let base = self.i0 - t / STEPS_PER_PITCH;
         let reach = level + TAU_CAP * self.sf.pitch;
+        let (sg, j0) = (self.sg, self.j0);
         let lead = &self.sf.lead;
-        let values = &mut self.scratch.values;
-        let evaluated = &mut self.scratch.evaluated;
-        values.resize(lead.len(), f64::INFINITY);
+        self.scratch.at(self.sf, base);
+        let Scratch {
+            values,
+            have,
+            evaluated,
+            ..
+        } = &mut self.scratch;
         evaluated.clear();
-        for (b, (range, e)) in self.sf.blocks.iter().enumerate() {
-            let bound = self.bounds.get(self.sg, b, e, (base, self.j0));
-            let on = !(bound > reach);
-            evaluated.push(on);
-            if on {
+        let blocks = &self.sf.blocks;
+        let mut group_near = false;
+        for (b, (range, e)) in blocks.iter().enumerate() {
+            if b % GROUP == 0 {
+                let least = self.bounds.group(sg, blocks, b / GROUP, (base, j0));
+                group_near = !(least > reach);
+            }
+            // A group's least bound above `reach` puts each of its runs'
+            // above it.
+            let bound = if group_near {
+                self.bounds.get(sg, b, e, (base, j0))
+            } else {
+                f64::INFINITY
+            };
+            let near = group_near && !(bound > reach);
+            let on = near && !(bound > level + self.bounds.tau(sg, b, e, (base, j0)));
+            evaluated.push(match (near, on) {
+                (_, true) => Run::Scanned,
+                (true, false) => Run::Near,
+                _ => Run::Above,
+            });
+            if on && !have[b] {
                 for n in range.clone() {
                     let [du, dw] = lead[n];
-                    values[n] = self.sg.at(base + du, self.j0 + dw);
+                    values[n] = sg.at(base + du, j0 + dw);
                 }
+                have[b] = true;
             }
         }
-        // The value of point `n` as the scan reads it: `+inf` in a
-        // skipped run and off the outline.
-        let read = |n: usize| match (evaluated.get(n / BLOCK), values.get(n)) {
-            (Some(true), Some(&value)) => value,
+        let (values, have, evaluated) = (&*values, &*have, &*evaluated);
+        // The value of point `n` as SPEC's scan reads it: `+inf` in a run
+        // above `reach` and off the outline.
+        let read = |n: usize| match evaluated.get(n / BLOCK) {
+            Some(Run::Scanned) => values[n],
+            Some(Run::Near) if have[n / BLOCK] => values[n],
+            Some(Run::Near) => {
+                let [du, dw] = lead[n];
+                sg.at(base + du, j0 + dw)
+            }
             _ => f64::INFINITY,
         };
-        for (range, _) in self
-            .sf
-            .blocks
+        for (range, _) in blocks
             .iter()
             .zip(evaluated.iter())
-            .filter_map(|(block, &on)| on.then_some(block))
+            .filter_map(|(block, &run)| (run == Run::Scanned).then_some(block))
         {
             for n in range.clone() {
                 let value = values[n];
+                // `tau` is at most `TAU_CAP p`: a point above `reach` is no
+                // tie.
+                if !(value <= reach) {
+                    continue;
+                }
                 let before = if n > 0 { read(n - 1) } else { f64::INFINITY };
-                let after = read(n + 1);
+                let after = if n + 1 < lead.len() {
+                    read(n + 1)
+                } else {
+                    f64::INFINITY
+                };
                 // One point per site: the first of a run of equal lowest
                 // values along the outline.
                 if !(value < before && value <= after) {
                     continue;
                 }
                 let [du, dw] = lead[n];
-                let here = [base + du, self.j0 + dw];
-                // `tau` is at most `TAU_CAP p`: a point above `reach` is no
-                // tie.
-                if here != at && value <= reach && value <= level + self.sg.tau(here[0], here[1]) {
+                let here = [base + du, j0 + dw];
+                if here != at && value <= level + sg.tau(here[0], here[1]) {
                     self.out.strikes.push((nearest(here), s));
                 }
             }
@@ -798,8 +1036,10 @@ pub(crate) struct RowTrail {
     struck: Vec<Option<(f64, [f64; 2])>>,
     /// The slides' buffers, handed from one to the next.
     scratch: Scratch,
-    /// The runs' bounds, handed from one slide to the next.
+    /// The leading runs' bounds, handed from one slide to the next.
     bounds: Bounds,
+    /// The trailing runs' bounds (the push's).
+    trail_bounds: Bounds,
 }
 
 /// The first lowest node inside the footprint of one start, as the push
@@ -926,7 +1166,8 @@ impl RowTrail {
             parent: Vec::new(),
             windows: PushNodes::default(),
             scratch: Scratch::default(),
-            bounds: Bounds::new(sf, nx),
+            bounds: Bounds::new(&sf.blocks, nx, reach(sf)),
+            trail_bounds: Bounds::new(&sf.trail_blocks, nx, reach(sf)),
             need: if window.is_finite() && window < f64::from(u32::MAX / 2) {
                 window as u32 + 2
             } else {
@@ -1059,12 +1300,25 @@ fn slide_start(
     };
     // A run of outline samples whose bound lies above the lowest point so
     // far (outline or nodes) holds no first lowest point: skipped.
+    let (mut bounds, mut trail_bounds) = match trail.as_deref_mut() {
+        Some(trail) => (
+            std::mem::take(&mut trail.bounds),
+            std::mem::take(&mut trail.trail_bounds),
+        ),
+        None => (
+            Bounds::new(&sf.blocks, nx as usize, reach(sf)),
+            Bounds::new(&sf.trail_blocks, nx as usize, reach(sf)),
+        ),
+    };
     let mut push = Lowest(None);
     let cut = nodes.map_or(f64::INFINITY, |n| n.value);
-    for (side, blocks) in [(&sf.lead, &sf.blocks), (&sf.trail, &sf.trail_blocks)] {
-        for (range, e) in blocks {
+    for (side, blocks, bounds) in [
+        (&sf.lead, &sf.blocks, &mut bounds),
+        (&sf.trail, &sf.trail_blocks, &mut trail_bounds),
+    ] {
+        for (b, (range, e)) in blocks.iter().enumerate() {
             let limit = push.0.map_or(cut, |p| p.value.min(cut));
-            if sg.bound(columns(u0, e), (w0 + e[2], w0 + e[3])) > limit {
+            if bounds.get(sg, b, e, (u0, w0)) > limit {
                 continue;
             }
             for &[du, dw] in &side[range.clone()] {
@@ -1088,6 +1342,9 @@ fn slide_start(
         })
         .collect();
     let Some(pushed) = push.0 else {
+        if let Some(trail) = trail {
+            (trail.bounds, trail.trail_bounds) = (bounds, trail_bounds);
+        }
         return SurfaceTrace {
             yr: f64::INFINITY,
             ..SurfaceTrace::default()
@@ -1106,10 +1363,7 @@ fn slide_start(
             yr: pushed.value,
             ..SurfaceTrace::default()
         },
-        bounds: match trail.as_deref_mut() {
-            Some(trail) => std::mem::take(&mut trail.bounds),
-            None => Bounds::new(sf, nx as usize),
-        },
+        bounds,
         prior: None,
         struck: false,
         scratch: trail
@@ -1126,6 +1380,7 @@ fn slide_start(
     let rows_span = (w0 + dw_lo, w0 + dw_hi);
     let mut met: Vec<(usize, f64, [f64; 2])> = Vec::new();
     let mut walk = trail.as_deref_mut().map(RowTrail::start);
+    let mut ahead = None;
     let position = |k: u64| STEPS_PER_PITCH as i64 * i0 as i64 - k as i64;
     let mut k = 0u64;
     loop {
@@ -1139,7 +1394,7 @@ fn slide_start(
             break;
         }
         let floor = slide.f - rule.e0;
-        if sg.bound_before(outline_at.max(node_at as f64), rows_span) >= floor {
+        if sg.bound_before(outline_at.max(node_at as f64), rows_span, &mut ahead) >= floor {
             break;
         }
         let mut step = match trail.as_deref_mut() {
@@ -1208,7 +1463,7 @@ fn slide_start(
     }
     if let Some(trail) = trail {
         trail.scratch = std::mem::take(&mut slide.scratch);
-        trail.bounds = std::mem::take(&mut slide.bounds);
+        (trail.bounds, trail.trail_bounds) = (std::mem::take(&mut slide.bounds), trail_bounds);
     }
     slide.out
 }

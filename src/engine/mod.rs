@@ -200,7 +200,7 @@ fn surface_masks(
             .map(|m| m.probes_met)
             .collect()
     };
-    let surface = SurfaceGrid::new(grid);
+    let surface = SurfaceGrid::new(grid).with_spans();
     let rows: Vec<usize> = match &options.start_rows {
         Some(rows) => rows.iter().copied().filter(|&j| j < grid.spec.nz).collect(),
         None => (0..grid.spec.nz).collect(),
