@@ -755,8 +755,7 @@ impl Slide<'_, '_> {
             if self.bounds.group(self.sg, blocks, g, (base, self.j0)) >= limit {
                 continue;
             }
-            for b in g * GROUP..((g + 1) * GROUP).min(blocks.len()) {
-                let (range, e) = &blocks[b];
+            for (b, (range, e)) in blocks.iter().enumerate().skip(g * GROUP).take(GROUP) {
                 if self.bounds.get(self.sg, b, e, (base, self.j0)) >= limit {
                     continue;
                 }
@@ -836,7 +835,7 @@ impl Slide<'_, '_> {
         for (b, (range, e)) in blocks.iter().enumerate() {
             if b % GROUP == 0 {
                 let least = self.bounds.group(sg, blocks, b / GROUP, (base, j0));
-                group_near = !(least > reach);
+                group_near = least <= reach;
             }
             // A group's least bound above `reach` puts each of its runs'
             // above it.
@@ -845,8 +844,8 @@ impl Slide<'_, '_> {
             } else {
                 f64::INFINITY
             };
-            let near = group_near && !(bound > reach);
-            let on = near && !(bound > level + self.bounds.tau(sg, b, e, (base, j0)));
+            let near = group_near && bound <= reach;
+            let on = near && bound <= level + self.bounds.tau(sg, b, e, (base, j0));
             evaluated.push(match (near, on) {
                 (_, true) => Run::Scanned,
                 (true, false) => Run::Near,
@@ -881,7 +880,7 @@ impl Slide<'_, '_> {
                 let value = values[n];
                 // `tau` is at most `TAU_CAP p`: a point above `reach` is no
                 // tie.
-                if !(value <= reach) {
+                if value > reach || value.is_nan() {
                     continue;
                 }
                 let before = if n > 0 { read(n - 1) } else { f64::INFINITY };
