@@ -204,8 +204,11 @@ pub struct SetupArgs {
     /// piecewise-linear surface between the nodes; each strike at the node
     /// nearest where it touched). `surface` takes `--rate window`,
     /// `--algorithm fast` and `--approach slide` only, and is slow: about
-    /// 150 times the node level's time (2.5 minutes per angle on the
-    /// bundled console at 1.24 mm on 2 cores; `results/ab.md`).
+    /// 100 to 140 times the node level's time (over a minute per angle on
+    /// the bundled console at 1.24 mm on 2 cores; `results/ab.md`).
+    /// `verify` and `converge` run the whole analysis at each angle too
+    /// (the area their misses are measured to), so under `surface` they
+    /// take at least as long as that analysis
     #[arg(
         long,
         default_value = "node",

@@ -177,8 +177,8 @@ pub fn colliding_masks(
 /// each row's starts through [`crate::surface::trace_row`] (a start stops
 /// where it continues an earlier start's slide). There is no streaming
 /// form across rows yet: on the README console at 1.24 mm an angle takes
-/// about 150 s on a loaded 2-core machine, where the node level's takes
-/// 2 s (`results/ab.md`). The blind spots' probes are still judged at the node level,
+/// about 80 s on a loaded 2-core machine (the paper workload's angle),
+/// where the node level's takes under a second (`results/ab.md`). The blind spots' probes are still judged at the node level,
 /// which is never below the surface level (the surface's minimum is taken
 /// over the nodes too), so a blind spot the surface level meets is
 /// reported.
