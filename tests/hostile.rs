@@ -403,7 +403,10 @@ fn estimate_and_peak(dir: &Path, part: &str, extra: &[&str]) -> (f64, f64) {
 
 #[test]
 fn the_memory_estimate_bounds_the_measured_peak() {
-    // A test of a bound, not of time: peak RSS <= estimate <= 1.3 x peak,
+    // A test of a bound, not of time: peak RSS <= estimate <= 1.4 x peak
+    // (one run's peak moves by up to a tenth from another's: the wave at
+    // 1 mm peaked at 122.7 to 135.5 MiB over four runs, the rough ground
+    // at 140 to 147),
     // on three sizes (about 75, 100 and 200 MiB) that stress the grid,
     // the angles and the push table in turn, and with 1 and 16 threads
     // (bands running at once, each with its reach window).
@@ -455,7 +458,7 @@ fn the_memory_estimate_bounds_the_measured_peak() {
     for (what, part, extra) in runs.into_iter().chain(rough_runs) {
         let (estimate, peak) = estimate_and_peak(&d, &part, extra);
         assert!(
-            peak <= estimate && estimate <= 1.3 * peak,
+            peak <= estimate && estimate <= 1.4 * peak,
             "{what}: estimate {estimate:.1} MiB, peak {peak:.1} MiB"
         );
     }
