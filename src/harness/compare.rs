@@ -1941,6 +1941,29 @@ mod tests {
         assert_eq!(rows(&StartSelection::Sample { count: 5, seed: 1 }), 1);
     }
 
+    /// A part with creases between node rows: a 5 mm lattice of a ridged,
+    /// tilted surface, 320 x 220 mm.
+    fn creased_part() -> Vec<Triangle> {
+        let (xs, zs) = (
+            axis((-160.0, 160.0), 5.0, &[]),
+            axis((-110.0, 110.0), 5.0, &[]),
+        );
+        tessellate(&xs, &zs, |i, k| {
+            let (x, z) = (xs[i], zs[k]);
+            12.0 * (x / 17.0).sin().abs() * (z / 31.0).cos() + 0.3 * x
+        })
+    }
+
+    /// The comparison's options at their defaults (blind depth 0.5 mm).
+    fn default_options() -> CompareOptions {
+        CompareOptions {
+            knee: KneeForm::default(),
+            rule: StrikeRule::default(),
+            tie_band_per_mm: TieBand::DEFAULT_PER_MM,
+            blind_depth: 0.5,
+        }
+    }
+
     /// The refinement's finer grid holds only the rows the footprint
     /// covers from the start: on a part with creases between node rows
     /// (a 5 mm lattice, rows 2 mm apart), each start's inside miss at half
@@ -1948,21 +1971,9 @@ mod tests {
     /// finer grid gives.
     #[test]
     fn a_finer_band_gives_the_whole_finer_grid_s_answer() {
-        let (xs, zs) = (
-            axis((-160.0, 160.0), 5.0, &[]),
-            axis((-110.0, 110.0), 5.0, &[]),
-        );
-        let tris = tessellate(&xs, &zs, |i, k| {
-            let (x, z) = (xs[i], zs[k]);
-            12.0 * (x / 17.0).sin().abs() * (z / 31.0).cos() + 0.3 * x
-        });
+        let tris = creased_part();
         let grid = HeightGrid::sample(&tris, GridSpec::explicit(-150.0, -100.0, 151, 101, 2.0));
-        let options = CompareOptions {
-            knee: KneeForm::default(),
-            rule: StrikeRule::default(),
-            tie_band_per_mm: TieBand::DEFAULT_PER_MM,
-            blind_depth: 0.5,
-        };
+        let options = default_options();
         let nodes = [(120, 50), (100, 30), (140, 70), (90, 55)];
         let starts: Vec<[f64; 2]> = nodes
             .iter()
@@ -2062,21 +2073,9 @@ mod tests {
     /// in time).
     #[test]
     fn the_area_misses_are_measured_to_the_analysis_s_area() {
-        let (xs, zs) = (
-            axis((-160.0, 160.0), 5.0, &[]),
-            axis((-110.0, 110.0), 5.0, &[]),
-        );
-        let tris = tessellate(&xs, &zs, |i, k| {
-            let (x, z) = (xs[i], zs[k]);
-            12.0 * (x / 17.0).sin().abs() * (z / 31.0).cos() + 0.3 * x
-        });
+        let tris = creased_part();
         let grid = HeightGrid::sample(&tris, GridSpec::explicit(-150.0, -100.0, 76, 51, 4.0));
-        let options = CompareOptions {
-            knee: KneeForm::default(),
-            rule: StrikeRule::default(),
-            tie_band_per_mm: TieBand::DEFAULT_PER_MM,
-            blind_depth: 0.5,
-        };
+        let options = default_options();
         let starts = [
             [grid.spec.x(40), grid.spec.z(25)],
             [grid.spec.x(30), grid.spec.z(20)],
