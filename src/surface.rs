@@ -541,6 +541,19 @@ struct Bounds {
     positions: usize,
 }
 
+/// `read()`, kept in `table[n]` (NaN until read) where `n` is a slot;
+/// read each time where it is not.
+#[inline]
+fn kept(table: &mut [f64], n: Option<usize>, read: impl FnOnce() -> f64) -> f64 {
+    let Some(n) = n else {
+        return read();
+    };
+    if table[n].is_nan() {
+        table[n] = read();
+    }
+    table[n]
+}
+
 /// Runs per group of [`Bounds`]: a group whose least bound is at or above
 /// the limit is skipped whole.
 const GROUP: usize = 8;
@@ -579,44 +592,37 @@ impl Bounds {
         }
     }
 
+    /// The columns run `b`, its extent `e`, reads when the outline's
+    /// reference sits at `base`, and their slot in `table` and `taus`
+    /// (`None` where the table does not keep them).
+    #[inline]
+    fn slot(&self, b: usize, e: &[f64; 4], base: f64) -> ((i64, i64), Option<usize>) {
+        let first = floor(base + e[0]);
+        let n = usize::try_from(first - self.lo)
+            .ok()
+            .filter(|&c| c < self.width)
+            .map(|c| b * self.width + c);
+        ((first, first + self.spans[b]), n)
+    }
+
     /// The bound of run `b`, its extent `e`, when the outline's reference
     /// sits at `(base, j0)`.
     #[inline]
     fn get(&mut self, sg: &SurfaceGrid, b: usize, e: &[f64; 4], (base, j0): (f64, f64)) -> f64 {
-        let first = floor(base + e[0]);
-        let cols = (first, first + self.spans[b]);
-        let read = || sg.bound(cols, (j0 + e[2], j0 + e[3]));
-        let Some(n) = usize::try_from(cols.0 - self.lo)
-            .ok()
-            .filter(|&c| c < self.width)
-            .map(|c| b * self.width + c)
-        else {
-            return read();
-        };
-        if self.table[n].is_nan() {
-            self.table[n] = read();
-        }
-        self.table[n]
+        let (cols, n) = self.slot(b, e, base);
+        kept(&mut self.table, n, || {
+            sg.bound(cols, (j0 + e[2], j0 + e[3]))
+        })
     }
 
     /// [`SurfaceGrid::tau_bound`] over the cells run `b`, its extent
     /// `e`, reads at `(base, j0)`.
     #[inline]
     fn tau(&mut self, sg: &SurfaceGrid, b: usize, e: &[f64; 4], (base, j0): (f64, f64)) -> f64 {
-        let first = floor(base + e[0]);
-        let cols = (first, first + self.spans[b]);
-        let read = || sg.tau_bound(cols, (j0 + e[2], j0 + e[3]));
-        let Some(n) = usize::try_from(cols.0 - self.lo)
-            .ok()
-            .filter(|&c| c < self.width)
-            .map(|c| b * self.width + c)
-        else {
-            return read();
-        };
-        if self.taus[n].is_nan() {
-            self.taus[n] = read();
-        }
-        self.taus[n]
+        let (cols, n) = self.slot(b, e, base);
+        kept(&mut self.taus, n, || {
+            sg.tau_bound(cols, (j0 + e[2], j0 + e[3]))
+        })
     }
 
     /// The least bound of the runs of group `g` of `blocks` at `(base,
