@@ -7,6 +7,11 @@
 #     bash results/regenerate.sh converge   # the convergence studies only
 #     bash results/regenerate.sh bench      # the benchmark only
 #     bash results/regenerate.sh converge-direct  # the direct approach's studies only
+#     bash results/regenerate.sh converge-off  # results/converge-off/: the studies
+#                                           # with the part moved off the lattice
+#     bash results/regenerate.sh converge-surface  # results/converge-surface/ and
+#     bash results/regenerate.sh converge-surface-off  # converge-surface-off/:
+#                                           # the same under --level surface
 #     bash results/regenerate.sh converge-table  # results/README.md's convergence
 #                                           # table alone, from the studies' files
 #     bash results/regenerate.sh ab REV     # results/ab.md: this tree against
@@ -39,27 +44,54 @@ what="${1:-all}"
 cargo build --release --quiet
 bin=target/release/kneeform
 
-if [[ "$what" == all || "$what" == converge ]]; then
+# One convergence study per scenario family into results/DIR/<scenario>/:
+# `studies DIR OPTION...`, the options (the level, the frame) passed on.
+studies() {
+  local dir=$1
+  shift
+  mkdir -p "results/$dir"
   for file in scenarios/*.toml; do
     name=$(basename "$file" .toml)
     pitches=4,2,1,0.5
     # The wave and the depression also at 0.25 mm (SPEC's smooth parts,
     # cheap enough); the console stops at 0.5 mm (12 million nodes).
     [[ "$name" == wave || "$name" == depression ]] && pitches=4,2,1,0.5,0.25
-    echo "== $name"
+    echo "== $dir/$name"
     # A study refuses an existing --out (issue 41): the committed one is
     # this script's own, in git.
-    rm -rf "results/converge/$name"
-    "$bin" converge "$file" --pitches "$pitches" --angles=-30,0,30 --seed 1 \
-      --tolerance 1 --out "results/converge/$name"
+    rm -rf "results/$dir/$name"
+    "$bin" converge "$file" "$@" --pitches "$pitches" --angles=-30,0,30 --seed 1 \
+      --tolerance 1 --out "results/$dir/$name"
   done
+}
+
+# The part moved off the grid's lattice by a sub-pitch translation,
+# (0.37, 0, 0.61) mm: the scenarios' features sit on multiples of every
+# pitch studied, which flatters any grid; moved off it they sit on none.
+off=(--frame @results/gate/off-lattice.txt)
+
+if [[ "$what" == all || "$what" == converge ]]; then
+  studies converge
+fi
+if [[ "$what" == all || "$what" == converge-off ]]; then
+  studies converge-off "${off[@]}"
+fi
+# The surface level (SPEC v4) on and off the lattice: about a hundred times
+# the node level's engine time, so not part of "all".
+if [[ "$what" == converge-surface ]]; then
+  studies converge-surface --level surface
+fi
+if [[ "$what" == converge-surface-off ]]; then
+  studies converge-surface-off --level surface "${off[@]}"
 fi
 
-if [[ "$what" == all || "$what" == converge || "$what" == converge-table ]]; then
-  # The table of results/README.md's "What converges, and at what order",
-  # one row per scenario, from each study's converge.csv and converge.json:
-  # written in place of the README's table (its header row to the last
-  # scenario's row).
+if [[ "$what" == all || "$what" == converge* ]]; then
+  # The tables of results/README.md's "What converges, and at what order",
+  # one per study folder (the node level on and off the lattice, the
+  # surface level on and off it), one row per scenario, from each study's
+  # converge.csv and converge.json: each written in place between its
+  # markers `<!-- table: DIR -->` and `<!-- end table -->`; a scenario whose
+  # study is not there reads "not run".
   python3 - results <<'PY'
 import csv, json, os, sys
 root = sys.argv[1]
@@ -72,34 +104,44 @@ metrics = [("miss_distance_decided", True), ("first_contact_error_decided", True
            ("area_miss_distance_decided", True), ("false_alarm_distance_decided", True),
            ("area_false_alarm_distance_decided", True), ("push_error_decided", True),
            ("level_error_bound", False), ("area_distance_blind", False)]
-rows = ["| part | finest pitch | miss | first contact | area miss | false alarm | area false alarm "
-        "| push | level-error bound | blind area distance | outcome at the finest pitch | coarsest PASS at 1 mm |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
-for name in order:
-    d = os.path.join(root, "converge", name)
-    c = json.load(open(os.path.join(d, "converge.json")))
-    finest = min(c["pitches_mm"])
-    table = {(float(r["pitch_mm"]), r["metric"]): r for r in csv.DictReader(open(os.path.join(d, "converge.csv")))}
-    verdict = next(v for v in c["verdicts"] if v["pitch_mm"] == finest)
-    cells = []
-    for metric, fitted in metrics:
-        v = float(table[(finest, metric)]["max"])
-        cell = "0" if v == 0 else f"{v:.2f}"
-        fit = c["fits"].get(metric) if fitted else None
-        if fit and v > 1e-6:
-            cell += f" ({fit['alpha']:.2f})"
-        named = [f["mechanism"] for f in verdict["failures"] if f["metric"] == metric and f["value"] is not None and abs(f["value"] - v) < 1e-9]
-        if named:
-            cell += " " + named[0]
-        cells.append(cell)
-    rec = c["recommended_pitch_mm"]
-    rows.append(f"| {names.get(name, name.replace('-', ' '))} | {finest:g} | " + " | ".join(cells)
-                + f" | {verdict['outcome']} | {'none' if rec is None else f'{rec:g} mm'} |")
+def table(folder):
+    rows = ["| part | finest pitch | miss | first contact | area miss | false alarm | area false alarm "
+            "| push | level-error bound | blind area distance | outcome at the finest pitch | coarsest PASS at 1 mm |",
+            "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for name in order:
+        label = names.get(name, name.replace('-', ' '))
+        d = os.path.join(root, folder, name)
+        if not os.path.exists(os.path.join(d, "converge.json")):
+            rows.append(f"| {label} | not run |" + " |" * 10)
+            continue
+        c = json.load(open(os.path.join(d, "converge.json")))
+        finest = min(c["pitches_mm"])
+        table = {(float(r["pitch_mm"]), r["metric"]): r for r in csv.DictReader(open(os.path.join(d, "converge.csv")))}
+        verdict = next(v for v in c["verdicts"] if v["pitch_mm"] == finest)
+        cells = []
+        for metric, fitted in metrics:
+            v = float(table[(finest, metric)]["max"])
+            cell = "0" if v == 0 else f"{v:.2f}"
+            fit = c["fits"].get(metric) if fitted else None
+            if fit and v > 1e-6:
+                cell += f" ({fit['alpha']:.2f})"
+            named = [f["mechanism"] for f in verdict["failures"] if f["metric"] == metric and f["value"] is not None and abs(f["value"] - v) < 1e-9]
+            if named:
+                cell += " " + named[0]
+            cells.append(cell)
+        rec = c["recommended_pitch_mm"]
+        rows.append(f"| {label} | {finest:g} | " + " | ".join(cells)
+                    + f" | {verdict['outcome']} | {'none' if rec is None else f'{rec:g} mm'} |")
+    return rows
 readme = os.path.join(root, "README.md")
 lines = open(readme).read().split("\n")
-first = next(n for n, l in enumerate(lines) if l.startswith("| part | finest pitch |"))
-last = next(n for n, l in enumerate(lines) if n > first and l.startswith("| **console**"))
-lines[first:last + 1] = rows
+for folder in ["converge", "converge-off", "converge-surface", "converge-surface-off"]:
+    marker = f"<!-- table: {folder} -->"
+    if marker not in lines:
+        continue
+    first = lines.index(marker) + 1
+    last = next(n for n in range(first, len(lines)) if lines[n] == "<!-- end table -->")
+    lines[first:last] = [""] + table(folder) + [""]
 open(readme, "w").write("\n".join(lines))
 PY
 fi
