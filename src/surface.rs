@@ -82,6 +82,8 @@ const COARSE: usize = 4;
 /// Levels of [`SurfaceGrid`]'s row spans: exact bounds over fewer than
 /// `2^(SPAN_LEVELS + 1)` columns.
 const SPAN_LEVELS: usize = 3;
+/// Rows of [`SurfaceGrid`]'s tall spans.
+const TALL: usize = 4;
 /// The largest `tau`, in pitches.
 const TAU_CAP: f64 = 0.25;
 
@@ -99,6 +101,11 @@ pub(crate) struct SurfaceGrid<'a> {
     /// of row `j` (those on the grid), for the runs' tight bounds; empty
     /// unless [`SurfaceGrid::with_spans`].
     spans: Vec<Vec<f64>>,
+    /// `tall[k][j * nx + i]`: the least of `spans[k]` over rows `j..j +
+    /// TALL` (rows `j <= nz - TALL`), so that a bound over `TALL ..= 2
+    /// TALL` rows reads two overlapping windows of rows, not each row;
+    /// empty unless [`SurfaceGrid::with_spans`].
+    tall: Vec<Vec<f64>>,
     /// The largest [`SurfaceGrid::tau`] per block of `COARSE x COARSE`
     /// cells; empty unless [`SurfaceGrid::with_spans`].
     taus: Vec<f64>,
@@ -129,6 +136,7 @@ impl<'a> SurfaceGrid<'a> {
             cnx,
             prefix,
             spans: Vec::new(),
+            tall: Vec::new(),
             taus: Vec::new(),
         }
     }
@@ -150,6 +158,20 @@ impl<'a> SurfaceGrid<'a> {
             }
             spans.push(next);
         }
+        let nz = self.grid.spec.nz;
+        self.tall = spans
+            .iter()
+            .map(|span| {
+                let mut tall = span.clone();
+                for j in 0..(nz + 1).saturating_sub(TALL) {
+                    for i in 0..nx {
+                        tall[j * nx + i] = (0..TALL)
+                            .fold(f64::INFINITY, |least, d| least.min(span[(j + d) * nx + i]));
+                    }
+                }
+                tall
+            })
+            .collect();
         self.spans = spans;
         let (nx, nz) = (self.grid.spec.nx, self.grid.spec.nz);
         if nx >= 2 && nz >= 2 {
@@ -188,12 +210,40 @@ impl<'a> SurfaceGrid<'a> {
     /// with a node of infinite height.
     #[inline(always)]
     pub fn at(&self, u: f64, w: f64) -> f64 {
-        let Some((i, j, fx, fz)) = self.cell(u, w) else {
+        self.at_in(u, self.row_of(w))
+    }
+
+    /// The cell row holding `w` (grid units) as [`SurfaceGrid::at_in`]
+    /// reads it: the index of its first node and the position in it,
+    /// `None` off the grid. The same for every sample of a start row at
+    /// the same `dw`, so found once per row.
+    #[inline(always)]
+    pub fn row_of(&self, w: f64) -> Option<(usize, f64)> {
+        let (nx, nz) = (self.grid.spec.nx, self.grid.spec.nz);
+        if nx < 2 || nz < 2 || !(0.0..=(nz - 1) as f64).contains(&w) {
+            return None;
+        }
+        // `w >= 0` here, where truncation is the floor.
+        let j = (w as usize).min(nz - 2);
+        Some((j * nx, w - j as f64))
+    }
+
+    /// [`SurfaceGrid::at`] at `(u, w)`, `w`'s cell row `row` as
+    /// [`SurfaceGrid::row_of`] finds it (the same cell and position as
+    /// [`SurfaceGrid::cell`]'s, so the same value to the bit).
+    #[inline(always)]
+    pub fn at_in(&self, u: f64, row: Option<(usize, f64)>) -> f64 {
+        let nx = self.grid.spec.nx;
+        let Some((first, fz)) = row else {
             return f64::INFINITY;
         };
-        let nx = self.grid.spec.nx;
+        if !(0.0..=(nx - 1) as f64).contains(&u) {
+            return f64::INFINITY;
+        }
+        let i = (u as usize).min(nx - 2);
+        let fx = u - i as f64;
         let h = &self.grid.h;
-        let n = j * nx + i;
+        let n = first + i;
         let (h00, h10, h01, h11) = (h[n], h[n + 1], h[n + nx], h[n + nx + 1]);
         if !(h00.is_finite() && h10.is_finite() && h01.is_finite() && h11.is_finite()) {
             return f64::INFINITY;
@@ -262,13 +312,26 @@ impl<'a> SurfaceGrid<'a> {
         );
         let k = (hi - lo + 1).ilog2() as usize;
         if k <= self.spans.len() {
-            let node_row = |v: f64| v.max(0.0).min(nz - 1.0) as usize;
-            let (r_lo, r_hi) = (node_row(w_lo.floor()), node_row(w_hi.floor() + 1.0));
+            // The crate's `floor`: the library's is a call per bound.
+            let node_row = |v: i64| v.clamp(0, nz as i64 - 1) as usize;
+            let (r_lo, r_hi) = (node_row(floor(w_lo)), node_row(floor(w_hi) + 1));
             let (table, second) = match k {
                 0 => (&self.grid.h, lo),
                 _ => (&self.spans[k - 1], hi + 1 - (1 << k)),
             };
             let nx = nx as usize;
+            let rows = r_hi - r_lo + 1;
+            if k >= 1 && (TALL..=2 * TALL).contains(&rows) {
+                // The same nodes, so the same least height, to the bit.
+                let tall = &self.tall[k - 1];
+                let (top, bottom) = (r_lo * nx, (r_hi + 1 - TALL) * nx);
+                return below(
+                    tall[top + lo]
+                        .min(tall[top + second])
+                        .min(tall[bottom + lo])
+                        .min(tall[bottom + second]),
+                );
+            }
             let mut least = f64::INFINITY;
             for r in r_lo..=r_hi {
                 least = least.min(table[r * nx + lo]).min(table[r * nx + second]);
@@ -276,9 +339,9 @@ impl<'a> SurfaceGrid<'a> {
             return below(least);
         }
         let column = |c: i64| (c.clamp(0, nx - 1) as usize) / COARSE;
-        let row = |v: f64| (v.max(0.0).min(nz - 1.0) as usize) / COARSE;
+        let row = |v: i64| v.clamp(0, nz as i64 - 1) as usize / COARSE;
         let (b_lo, b_hi) = (column(c_lo), column(c_hi));
-        let (r_lo, r_hi) = (row(w_lo.floor()), row(w_hi.floor() + 1.0));
+        let (r_lo, r_hi) = (row(floor(w_lo)), row(floor(w_hi) + 1));
         let mut least = f64::INFINITY;
         for r in r_lo..=r_hi {
             for &c in &self.coarse[r * self.cnx + b_lo..=r * self.cnx + b_hi] {
@@ -532,9 +595,11 @@ struct Bounds {
     /// Per run, its columns beyond the first ([`span`]).
     spans: Vec<i64>,
     /// The least bound of each group of [`GROUP`] runs by position on the
-    /// travel lattice: `[group * positions + m - m_lo]`, NaN where not
-    /// read yet.
+    /// travel lattice: `[(m - m_lo) * per + group]` (a position's groups
+    /// side by side: a step reads them in turn), NaN where not read yet.
     groups: Vec<f64>,
+    /// Groups per position.
+    per: usize,
     /// The first position of `groups`.
     m_lo: i64,
     /// Positions per group.
@@ -587,6 +652,7 @@ impl Bounds {
             taus: vec![f64::NAN; blocks.len() * width],
             spans,
             groups: vec![f64::NAN; blocks.len().div_ceil(GROUP) * positions],
+            per: blocks.len().div_ceil(GROUP),
             m_lo,
             positions,
         }
@@ -637,11 +703,12 @@ impl Bounds {
     ) -> f64 {
         let runs = g * GROUP..((g + 1) * GROUP).min(blocks.len());
         let m = base * STEPS_PER_PITCH;
-        let slot = (m == m.trunc())
+        // Whole (without the library's `trunc`): a position's slot.
+        let slot = (m as i64 as f64 == m)
             .then(|| usize::try_from(m as i64 - self.m_lo).ok())
             .flatten()
             .filter(|&n| n < self.positions)
-            .map(|n| g * self.positions + n);
+            .map(|n| n * self.per + g);
         if let Some(n) = slot
             && !self.groups[n].is_nan()
         {
@@ -671,6 +738,11 @@ struct Scratch {
     have: Vec<bool>,
     /// Per run, how the tie scan reads it.
     evaluated: Vec<Run>,
+    /// Per leading sample, its cell row ([`SurfaceGrid::row_of`]) in the
+    /// start row `rows_of`.
+    rows: Vec<Option<(usize, f64)>>,
+    /// The start row `rows` holds.
+    rows_of: Option<f64>,
 }
 
 /// How the tie scan reads a run of the outline.
@@ -696,6 +768,17 @@ impl Scratch {
             self.have.clear();
             self.have.resize(sf.blocks.len(), false);
             self.base = base;
+        }
+    }
+
+    /// Ready to read the cell rows of the outline `sf`'s samples in start
+    /// row `j0`.
+    fn rows_for(&mut self, sg: &SurfaceGrid, sf: &SurfaceFootprint, j0: f64) {
+        if self.rows_of != Some(j0) || self.rows.len() != sf.lead.len() {
+            self.rows.clear();
+            self.rows
+                .extend(sf.lead.iter().map(|&[_, dw]| sg.row_of(j0 + dw)));
+            self.rows_of = Some(j0);
         }
     }
 }
@@ -755,32 +838,36 @@ impl Slide<'_, '_> {
     fn lowest_below(&mut self, t: f64, limit: f64) -> Lowest {
         let base = self.i0 - t / STEPS_PER_PITCH;
         let mut lowest = Lowest(None);
-        self.scratch.at(self.sf, base);
-        let blocks = &self.sf.blocks;
+        let (sg, sf, j0) = (self.sg, self.sf, self.j0);
+        self.scratch.at(sf, base);
+        self.scratch.rows_for(sg, sf, j0);
+        let Scratch {
+            values, have, rows, ..
+        } = &mut self.scratch;
+        let blocks = &sf.blocks;
         for g in 0..blocks.len().div_ceil(GROUP) {
-            if self.bounds.group(self.sg, blocks, g, (base, self.j0)) >= limit {
+            if self.bounds.group(sg, blocks, g, (base, j0)) >= limit {
                 continue;
             }
             for (b, (range, e)) in blocks.iter().enumerate().skip(g * GROUP).take(GROUP) {
-                if self.bounds.get(self.sg, b, e, (base, self.j0)) >= limit {
+                if self.bounds.get(sg, b, e, (base, j0)) >= limit {
                     continue;
                 }
-                let have = self.scratch.have[b];
+                let held = have[b];
                 for n in range.clone() {
-                    let [du, dw] = self.sf.lead[n];
-                    let at = [base + du, self.j0 + dw];
-                    let value = if have {
-                        self.scratch.values[n]
+                    let value = if held {
+                        values[n]
                     } else {
-                        let value = self.sg.at(at[0], at[1]);
-                        self.scratch.values[n] = value;
+                        let value = sg.at_in(base + sf.lead[n][0], rows[n]);
+                        values[n] = value;
                         value
                     };
                     if value < limit {
-                        lowest.take(value, at);
+                        let [du, dw] = sf.lead[n];
+                        lowest.take(value, [base + du, j0 + dw]);
                     }
                 }
-                self.scratch.have[b] = true;
+                have[b] = true;
             }
         }
         lowest
@@ -829,10 +916,12 @@ impl Slide<'_, '_> {
         let (sg, j0) = (self.sg, self.j0);
         let lead = &self.sf.lead;
         self.scratch.at(self.sf, base);
+        self.scratch.rows_for(sg, self.sf, j0);
         let Scratch {
             values,
             have,
             evaluated,
+            rows,
             ..
         } = &mut self.scratch;
         evaluated.clear();
@@ -859,8 +948,7 @@ impl Slide<'_, '_> {
             });
             if on && !have[b] {
                 for n in range.clone() {
-                    let [du, dw] = lead[n];
-                    values[n] = sg.at(base + du, j0 + dw);
+                    values[n] = sg.at_in(base + lead[n][0], rows[n]);
                 }
                 have[b] = true;
             }
@@ -1321,9 +1409,15 @@ fn slide_start(
         (&sf.lead, &sf.blocks, &mut bounds),
         (&sf.trail, &sf.trail_blocks, &mut trail_bounds),
     ] {
+        let mut above = false;
         for (b, (range, e)) in blocks.iter().enumerate() {
             let limit = push.0.map_or(cut, |p| p.value.min(cut));
-            if bounds.get(sg, b, e, (u0, w0)) > limit {
+            // The limit only falls: a group whose least bound lies above
+            // it at its first run has every run above it at its own.
+            if b % GROUP == 0 {
+                above = bounds.group(sg, blocks, b / GROUP, (u0, w0)) > limit;
+            }
+            if above || bounds.get(sg, b, e, (u0, w0)) > limit {
                 continue;
             }
             for &[du, dw] in &side[range.clone()] {
