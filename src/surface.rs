@@ -63,6 +63,8 @@
 //! of everything still ahead is. `tests/surface.rs` holds it equal to a
 //! brute force transcribed from SPEC that evaluates everything.
 
+use std::cmp::Ordering;
+
 use crate::grid::{HeightGrid, NODE_TOL};
 use crate::kneeform::GridFootprint;
 use crate::strike::{LevelHistory, StrikeRule};
@@ -977,15 +979,28 @@ impl Slide<'_, '_> {
                 if value > reach || value.is_nan() {
                     continue;
                 }
-                let before = if n > 0 { read(n - 1) } else { f64::INFINITY };
-                let after = if n + 1 < lead.len() {
-                    read(n + 1)
-                } else {
-                    f64::INFINITY
+                // A neighbour in the same run (scanned) is read from
+                // `values`, as `read` would; `after` only where `before`
+                // leaves the point a candidate.
+                let before = match n {
+                    0 => f64::INFINITY,
+                    _ if n % BLOCK != 0 => values[n - 1],
+                    _ => read(n - 1),
                 };
                 // One point per site: the first of a run of equal lowest
                 // values along the outline.
-                if !(value < before && value <= after) {
+                if !matches!(value.partial_cmp(&before), Some(Ordering::Less)) {
+                    continue;
+                }
+                let after = match n + 1 {
+                    next if next >= lead.len() => f64::INFINITY,
+                    next if next % BLOCK != 0 => values[next],
+                    next => read(next),
+                };
+                if !matches!(
+                    value.partial_cmp(&after),
+                    Some(Ordering::Less | Ordering::Equal)
+                ) {
                     continue;
                 }
                 let [du, dw] = lead[n];
