@@ -1589,6 +1589,59 @@ mod tests {
     use crate::kneeform::KneeForm;
     use crate::strike::Level;
 
+    /// [`SurfaceGrid::bound`] with the spans (their tall windows of rows
+    /// among them) is the least height of the nodes it covers, less its
+    /// margin, to the bit, over the column and row ranges the runs read
+    /// (1 to 9 columns, 1 to 10 rows, clipped at the grid's edges), on a
+    /// grid with a hole (infinite heights).
+    #[test]
+    fn the_bound_is_the_least_height_of_the_nodes_it_covers() {
+        let spec = GridSpec::explicit(0.0, 0.0, 23, 19, 1.0);
+        let grid = HeightGrid::from_fn(spec, |x, z| {
+            if (x - 7.0).hypot(z - 5.0) < 1.5 {
+                f64::INFINITY
+            } else {
+                (0.9 * x).sin() * (0.4 * z).cos() + 0.01 * x * z
+            }
+        });
+        let sg = SurfaceGrid::new(&grid).with_spans();
+        let (nx, nz) = (spec.nx as i64, spec.nz as i64);
+        let mut tall = 0;
+        for c_lo in -2..nx + 2 {
+            for width in 0..9 {
+                for w_lo in [-1.5, 0.0, 0.3, 4.7, 12.2, 14.9, 17.9] {
+                    for height in [0.0, 0.5, 2.0, 3.2, 4.6, 5.5, 6.9, 7.5] {
+                        let (c_hi, w_hi) = (c_lo + width, w_lo + height);
+                        let got = sg.bound((c_lo, c_hi), (w_lo, w_hi));
+                        if c_hi < 0 || c_lo > nx - 1 || w_hi < 0.0 || w_lo > (nz - 1) as f64 {
+                            assert_eq!(got, f64::INFINITY);
+                            continue;
+                        }
+                        let rows = (w_lo.floor() as i64).clamp(0, nz - 1)
+                            ..=(w_hi.floor() as i64 + 1).clamp(0, nz - 1);
+                        tall += usize::from((TALL..=2 * TALL).contains(&rows.clone().count()));
+                        let mut least = f64::INFINITY;
+                        for j in rows {
+                            for i in c_lo.clamp(0, nx - 1)..=c_hi.clamp(0, nx - 1) {
+                                least = least.min(grid.at(i as usize, j as usize));
+                            }
+                        }
+                        assert_eq!(
+                            got.to_bits(),
+                            below(least).to_bits(),
+                            "columns {c_lo}..={c_hi}, rows {w_lo}..={w_hi}"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(
+            tall > 1000,
+            "only {tall} bounds over {TALL} to {} rows",
+            2 * TALL
+        );
+    }
+
     /// [`trace_row`] (starts joined through the row's trail, the push's
     /// nodes from sliding windows, each position's outline once) marks
     /// exactly the union of the per-start [`trace`]s and places the same
