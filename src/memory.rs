@@ -16,6 +16,9 @@
 //! * per band task running (at most `T`, and at most the bands there
 //!   are): its reach window, strikes and probe-corner bits (`5.125 Nw`;
 //!   the paper path's band mask `Np` where that is larger);
+//! * under `--level surface`, its tables: the row spans and their tall
+//!   windows, six copies of the heights, and the block minima (`56 N`),
+//!   and each thread's fold of the angle's mask (`T N`);
 //! * per angle in flight (at most `min(T, A)`): its mask (`N`);
 //! * every finished angle's mask (`A N`, with the allocator's holes
 //!   between them: `MASK_BYTES_PER_NODE`) and the composite (`2 N`);

@@ -83,7 +83,7 @@ pub(crate) const BLOCK: usize = 16;
 const COARSE: usize = 4;
 /// Levels of [`SurfaceGrid`]'s row spans: exact bounds over fewer than
 /// `2^(SPAN_LEVELS + 1)` columns.
-const SPAN_LEVELS: usize = 3;
+pub(crate) const SPAN_LEVELS: usize = 3;
 /// Rows of [`SurfaceGrid`]'s tall spans.
 const TALL: usize = 4;
 /// The largest `tau`, in pitches.

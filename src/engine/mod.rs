@@ -392,7 +392,19 @@ pub(crate) fn working_bytes(
     let bands = footprints.len().max(1) * spec.nz.div_ceil(band).max(1);
     let tasks = threads.min(bands) as f64;
     let thresholds = if rule.window_mm().is_some() { 2.0 } else { 1.0 };
-    vec![
+    // The surface level's tables beside the heights: the row spans and
+    // their tall windows (`2 * SPAN_LEVELS` copies of the heights), the
+    // block minima, their prefix and the block `tau`s (under one copy),
+    // and each thread's fold of the angle's mask; its rows' trails and
+    // bounds are a few MiB a thread (`THREAD_BYTES` and the slack).
+    let surface = match rule.level {
+        Level::Surface => vec![(
+            "surface tables",
+            8.0 * n * (2 * crate::surface::SPAN_LEVELS + 1) as f64 + threads as f64 * n,
+        )],
+        Level::Node => Vec::new(),
+    };
+    let mut items = vec![
         ("height grid", 8.0 * n + 8.0 * padded),
         // The ranks, the strike thresholds (two under the window rule) and
         // the distinct heights (at most one per node).
@@ -405,5 +417,7 @@ pub(crate) fn working_bytes(
         // node.
         ("bands running", tasks * (5.125 * window).max(padded)),
         ("angles in flight", angles_in_flight * n),
-    ]
+    ];
+    items.extend(surface);
+    items
 }
