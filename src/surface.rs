@@ -190,22 +190,14 @@ impl<'a> SurfaceGrid<'a> {
         self
     }
 
-    /// The cell `(i, j)` holding `(u, w)` and the position in it, or
-    /// `None` off the grid. A point on the last column or row belongs to
-    /// the cell before it.
-    #[inline(always)]
-    fn cell(&self, u: f64, w: f64) -> Option<(usize, usize, f64, f64)> {
-        let (nx, nz) = (self.grid.spec.nx, self.grid.spec.nz);
-        if nx < 2 || nz < 2 || !(u >= 0.0 && w >= 0.0) {
-            return None;
-        }
-        if u > (nx - 1) as f64 || w > (nz - 1) as f64 {
-            return None;
-        }
-        // Both are >= 0 here, where truncation is the floor.
-        let i = (u as usize).min(nx - 2);
-        let j = (w as usize).min(nz - 2);
-        Some((i, j, u - i as f64, w - j as f64))
+    /// The cell `(i, j)` holding `(u, w)`, or `None` off the grid: the
+    /// column [`SurfaceGrid::column_of`] finds and the row
+    /// [`SurfaceGrid::row_of`] finds, as [`SurfaceGrid::at`] reads them. A
+    /// point on the last column or row belongs to the cell before it.
+    fn cell(&self, u: f64, w: f64) -> Option<(usize, usize)> {
+        let (first, _) = self.row_of(w)?;
+        let (i, _) = self.column_of(u)?;
+        Some((i, first / self.grid.spec.nx))
     }
 
     /// `S` at `(u, w)` (grid units): `+inf` off the grid and on a cell
@@ -230,20 +222,28 @@ impl<'a> SurfaceGrid<'a> {
         Some((j * nx, w - j as f64))
     }
 
+    /// The cell column holding `u` (grid units) and the position in it,
+    /// `None` off the grid (a point on the last column belongs to the
+    /// cell before it).
+    #[inline(always)]
+    fn column_of(&self, u: f64) -> Option<(usize, f64)> {
+        let (nx, nz) = (self.grid.spec.nx, self.grid.spec.nz);
+        if nx < 2 || nz < 2 || !(0.0..=(nx - 1) as f64).contains(&u) {
+            return None;
+        }
+        // `u >= 0` here, where truncation is the floor.
+        let i = (u as usize).min(nx - 2);
+        Some((i, u - i as f64))
+    }
+
     /// [`SurfaceGrid::at`] at `(u, w)`, `w`'s cell row `row` as
-    /// [`SurfaceGrid::row_of`] finds it (the same cell and position as
-    /// [`SurfaceGrid::cell`]'s, so the same value to the bit).
+    /// [`SurfaceGrid::row_of`] finds it once per start row.
     #[inline(always)]
     pub fn at_in(&self, u: f64, row: Option<(usize, f64)>) -> f64 {
         let nx = self.grid.spec.nx;
-        let Some((first, fz)) = row else {
+        let (Some((first, fz)), Some((i, fx))) = (row, self.column_of(u)) else {
             return f64::INFINITY;
         };
-        if !(0.0..=(nx - 1) as f64).contains(&u) {
-            return f64::INFINITY;
-        }
-        let i = (u as usize).min(nx - 2);
-        let fx = u - i as f64;
         let h = &self.grid.h;
         let n = first + i;
         let (h00, h10, h01, h11) = (h[n], h[n + 1], h[n + nx], h[n + nx + 1]);
@@ -265,7 +265,7 @@ impl<'a> SurfaceGrid<'a> {
     /// so this is twice it) and `p |delta g|` across a crease (the error
     /// is `p |delta g| / 4`). Where the heights are all equal it is 0.
     pub fn tau(&self, u: f64, w: f64) -> f64 {
-        let Some((i, j, _, _)) = self.cell(u, w) else {
+        let Some((i, j)) = self.cell(u, w) else {
             return 0.0;
         };
         self.tau_cell(i, j)
