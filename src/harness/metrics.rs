@@ -750,20 +750,71 @@ impl<'a> LevelErrorBound<'a> {
         fall.max(0.0) + self.rise_in_force(s)
     }
 
-    /// Whether a grid strike of a node of height `h` met at travel `s` may
-    /// owe its deflection test to the level error: under the window rule,
-    /// whether the drop from the exact level `W` back, raised by the bound
-    /// there, exceeds `sigma W` (the grid's level `W` back is at most that
-    /// much deeper). Under x-slope the grid's rate is no level's
-    /// difference: the level error explains no strike there.
+    /// Under the surface level where its error is measured, the
+    /// surface's error and the exact level's fall over one step from `s`
+    /// ([`LevelErrorBound::surface_at`]); `None` under the node level.
+    fn surface_in(&self, s: f64, rule: ExactRule) -> Option<(SurfaceError, f64)> {
+        match rule {
+            ExactRule::Window {
+                two_sided: true, ..
+            } => self.surface_at(s),
+            _ => None,
+        }
+    }
+
+    /// How much deeper than the exact level `f*(s)` the grid's level may
+    /// lie at a grid step at travel `s` (mm), by `rule`'s level: under the
+    /// surface level where its error is measured, the surface's `above`
+    /// near the exact contacts in force (the grid's level is the
+    /// surface's minimum over the swept footprint, which holds those
+    /// contacts: at most `above` deeper than the mesh's minimum there) plus
+    /// the exact level's fall over a step; otherwise the node level's
+    /// bound ([`LevelErrorBound::at`]).
+    pub fn deeper_at(&self, s: f64, rule: ExactRule) -> f64 {
+        match self.surface_in(s, rule) {
+            Some((error, fall)) => error.above + fall,
+            None => self.at(s),
+        }
+    }
+
+    /// Whether a grid strike whose new level is `h`, at a grid step at
+    /// travel `s`, may owe its deflection test to the level error: under
+    /// the window rule, whether the drop from the exact level `W` back,
+    /// raised by how much deeper the grid's level may lie there, exceeds
+    /// `sigma W`. Under the node level that is the bound at `s - W`
+    /// ([`LevelErrorBound::at`]). Under the surface level the grid reads
+    /// its level after its last step at or before `s - W`, at most a step
+    /// earlier (SPEC v4): at most the exact level a step before `s - W`
+    /// (the fall over that step) plus the surface's `above` near the
+    /// contacts in force over it. Under x-slope the grid's rate is no
+    /// level's difference: the level error explains no strike there.
     fn explains_drop(&self, h: f64, s: f64, sigma: f64, rule: ExactRule) -> bool {
         match rule {
             ExactRule::Rate => false,
             ExactRule::Window { window, .. } => {
                 let back = s - window;
-                self.curve.at(back).value - h + self.at(back) > sigma * window - LEVEL_TOL
+                let step = self.pitch / crate::surface::STEPS_PER_PITCH;
+                let deeper = match self.surface_in(back - step, rule) {
+                    Some((error, fall)) => error.above + fall,
+                    None => self.at(back),
+                };
+                self.curve.at(back).value - h + deeper > sigma * window - LEVEL_TOL
             }
         }
+    }
+
+    /// Whether a grid strike whose new level is `h` (the node's height, or
+    /// under the surface level the surface's at its witness), at travel
+    /// `s`, is the level error's: its level lies within
+    /// [`LevelErrorBound::deeper_at`] of the exact knee-form's there (a
+    /// node poking through the exact level by no more than that; under
+    /// the surface level, the grid's level cut that much deeper at a
+    /// crease near the exact contact), and its deflection test passes
+    /// only by the level error `W` back
+    /// ([`LevelErrorBound::explains_drop`]).
+    pub fn explains(&self, h: f64, s: f64, sigma: f64, rule: ExactRule) -> bool {
+        self.clearance(h, s) <= self.deeper_at(s, rule) + LEVEL_TOL
+            && self.explains_drop(h, s, sigma, rule)
     }
 
     /// How far a mesh point of height `h` met at travel `s` lies from
@@ -885,10 +936,10 @@ pub(crate) fn compare(
             continue;
         }
         let explained = bound.as_ref().is_some_and(|b| {
-            let (clearance, at) = (b.clearance(g.point[1], g.travel), b.at(g.travel));
+            let clearance = b.clearance(g.point[1], g.travel);
             level_clearance.push(clearance);
-            level_bound.push(at);
-            clearance <= at + LEVEL_TOL && b.explains_drop(g.point[1], g.travel, band.sigma, rule)
+            level_bound.push(b.deeper_at(g.travel, rule));
+            b.explains(g.point[1], g.travel, band.sigma, rule)
         });
         if k == 0 {
             first_grid_explained = explained;
@@ -1090,6 +1141,78 @@ mod tests {
         assert_eq!(decide(0.0215, false), Decision::NoStrike);
         assert_eq!(decide(0.0215, true), Decision::Undecided);
         assert_eq!(decide(0.01, true), Decision::NoStrike);
+    }
+
+    /// A start whose exact level holds at 10 mm to travel 10, where it
+    /// falls 0.03 mm (short of `sigma W`, 0.044 mm): a grid strike there
+    /// at a level 0.02 mm deeper than the exact one.
+    fn crease_cut_trace() -> StartTrace {
+        let contact = |travel: f64, face_level: f64| ContactPoint {
+            travel,
+            face_level,
+            witness: [-travel, face_level, 0.0],
+            rate: 0.0,
+            rate_error: 0.0,
+        };
+        StartTrace {
+            angle_deg: 0.0,
+            start: [0.0, 0.0],
+            status: StartStatus::Placed,
+            yr_star: Some(10.0),
+            push_witness: Some([0.0, 10.0, 0.0]),
+            contacts: vec![contact(2.0, 10.0), contact(10.0, 9.97)],
+            slide_end: kneeform_oracle::SlideEnd::Cleared,
+            casts: 0,
+        }
+    }
+
+    #[test]
+    fn a_surface_strike_is_explained_by_the_surface_s_own_error() {
+        let trace = crease_cut_trace();
+        // The nodes near both contacts rise 1 um: the node level's bound.
+        // The surface cuts a crease at the first contact 0.05 mm deep and
+        // stands 0.03 mm off the mesh at the second (`above`).
+        let errors = vec![
+            SurfaceError {
+                above: 0.05,
+                below: 0.0,
+            },
+            SurfaceError {
+                above: 0.03,
+                below: 0.0,
+            },
+        ];
+        let bound = LevelErrorBound {
+            curve: LevelCurve::of(&trace).unwrap(),
+            travels: vec![2.0, 10.0],
+            rises: vec![0.001, 0.001],
+            lowest: vec![0.001, 0.001],
+            push_rise: 0.001,
+            pitch: 1.0,
+            surface: Some((errors, SurfaceError::default())),
+        };
+        let sigma = 0.044 / 5.0;
+        let node = ExactRule::Window {
+            window: 5.0,
+            two_sided: false,
+        };
+        let surface = ExactRule::Window {
+            window: 5.0,
+            two_sided: true,
+        };
+        // The grid's level 0.02 mm deeper than the exact one at travel 10:
+        // it strikes when its level 5 mm back lay more than 0.034 mm deeper
+        // than the exact 10 mm, which the crease cut there allows (0.05)
+        // and the node level's bound there does not (0.001).
+        assert!(!bound.explains(9.99, 10.0, sigma, node));
+        assert!(bound.explains(9.99, 10.0, sigma, surface));
+        assert_eq!(bound.deeper_at(10.0, surface), 0.03);
+        // 0.04 mm deeper at travel 10: more than the surface's error there.
+        assert!(!bound.explains(10.01, 10.0, sigma, surface));
+        // Without the crease cut 5 mm back, the drop is not explained.
+        let mut flat = bound;
+        flat.surface.as_mut().unwrap().0[0].above = 0.01;
+        assert!(!flat.explains(9.99, 10.0, sigma, surface));
     }
 
     #[test]
