@@ -11,7 +11,12 @@
 //!   a grid strike the exact knee-form never touches: a false alarm, on the
 //!   safe side. A grid strike is explained by it when its node lies within
 //!   the stated bound of the grid's level error of the exact knee-form at
-//!   that travel ([`super::metrics::compare`]).
+//!   that travel ([`super::metrics::compare`]). Under the surface level
+//!   (SPEC v4) the bound is the surface's own error measured against the
+//!   mesh near the exact contacts ([`Cells::surface_error_near`]): its
+//!   level lies too deep where `S` cuts a convex crease or vertex between
+//!   nodes, by `S` less the mesh at the touched point, at the strike and
+//!   `W` back ([`super::metrics::LevelErrorBound::explains`]).
 //! * **Undecided.** The disagreement is on a contact in the tie band:
 //!   either answer is right at this pitch.
 //! * **Oracle failure.** No exact answer for the pair: never counted
