@@ -172,7 +172,12 @@ impl Cells {
     /// Where one of them has no height and the other has (a cell with a
     /// node off the part over mesh, the part's edge between the last node
     /// and the true edge; or a hole under a surface), `+inf`: the grid
-    /// cannot see what the exact knee-form rests on there.
+    /// cannot see what the exact knee-form rests on there. A sample on the
+    /// cell's edge reads the surface of either cell that has one there, as
+    /// [`Cells::surface_at`] does: a part whose edge lies on a node row has
+    /// mesh only on that row in the cell beyond it, and the grid's surface
+    /// covers it (the wave's edge rows, z = -150 on the lattice at 2 and
+    /// 1 mm).
     ///
     /// It is second order in the pitch on a smooth part (`p^2 |h''| / 8`),
     /// first order across a crease (`p |delta g| / 4`) and at a riser; it
@@ -188,6 +193,7 @@ impl Cells {
         }
         let (cx, cz) = (nx - 1, nz - 1);
         let k = SURFACE_SAMPLES;
+        let cells = &self;
         let bands: Vec<Vec<SurfaceError>> = (0..cz)
             .step_by(SURFACE_BAND_ROWS)
             .collect::<Vec<_>>()
@@ -210,7 +216,14 @@ impl Cells {
                             for fa in 0..=k {
                                 let y = mesh.at(k * i + fa, k * b + fb);
                                 let (fx, fz) = (fa as f64 / k as f64, fb as f64 / k as f64);
+                                let (x, z) = (mesh.spec.x(k * i + fa), mesh.spec.z(k * b + fb));
                                 let s = cell_surface(&grid.h, nx, (i, row), (fx, fz))
+                                    .or_else(|| {
+                                        // A corner off the part: on the
+                                        // cell's edge, a neighbour's
+                                        // surface may cover the mesh.
+                                        y.is_finite().then(|| cells.surface_at(x, z)).flatten()
+                                    })
                                     .unwrap_or(f64::INFINITY);
                                 let e = match (s.is_finite(), y.is_finite()) {
                                     (true, true) => SurfaceError {
@@ -761,6 +774,26 @@ mod tests {
         // Inside, more than half a pitch from that cell: measured, none.
         let inside = cells.surface_error_near([18.5, 0.0, 7.0]).unwrap();
         assert!(inside.above < 1e-9 && inside.below < 1e-9, "{inside:?}");
+    }
+
+    #[test]
+    fn a_part_edge_on_a_node_column_is_within_the_surface_of_the_cell_before_it() {
+        // The part ends at x = 20, on node column 10: the cell [20, 22]
+        // has nodes off the part, and mesh only on its edge x = 20, which
+        // the surface of the cell [18, 20] covers (the wave's edge rows at
+        // z = -150 on the lattice of every pitch that divides it).
+        let xs = [0.0, 10.0, 20.0];
+        let zs = [0.0, 10.0, 20.0];
+        let triangles = tessellate(&xs, &zs, |_, _| 0.0);
+        let grid = at_pitch_two(&triangles);
+        assert!(grid.h[10].is_finite() && grid.h[11].is_infinite());
+        let cells = Cells::of(&triangles, &grid, 10.0).with_surface_error(&triangles, &grid);
+        // On the edge and within half a pitch of the cell beyond it: the
+        // plane is read exactly, no error either way.
+        for p in [[20.0, 0.0, 7.0], [19.5, 0.0, 7.0], [20.0, 0.0, 20.0]] {
+            let e = cells.surface_error_near(p).unwrap();
+            assert!(e.above < 1e-9 && e.below < 1e-9, "{p:?}: {e:?}");
+        }
     }
 
     #[test]
