@@ -1708,4 +1708,59 @@ mod tests {
         }
         assert!(joined > 100, "only {joined} slides joined an earlier one");
     }
+
+    /// SPEC v4's ties take the contact's decision, not their own: a site
+    /// the knee-form rests on and is leaving is marked when a contact
+    /// elsewhere lowers the level by less than `tau`. The knee-form rides
+    /// a crest along x (height -1 on row 9, under its bottom rim) at the
+    /// pushed level -1, then its top rim meets a ramp rising towards it
+    /// (rows 18 on): the ramp's contacts strike, and the crest's outline
+    /// point, lowest along the outline, `tau = p / 4` at the crease, is
+    /// within `tau` of each new level down to -1.25, so it is marked,
+    /// though its own drop over the window, `f(s - W) - h = -1 - -1`, is
+    /// zero. Without the ramp nothing strikes. This is the angled
+    /// features' 98-100 mm decided false alarm at every pitch (the
+    /// diagonal ridge's top marked when the knee-form rides onto a boss,
+    /// `results/converge-surface/angled-features/`); judging each tie by
+    /// its own value, as the node level judges each node of a group,
+    /// would leave the crest clear (a SPEC change; flip this test with
+    /// it).
+    #[test]
+    fn a_tie_marks_the_site_the_knee_form_rests_on_when_it_leaves_it() {
+        let spec = GridSpec::explicit(0.0, 0.0, 60, 30, 1.0);
+        let crest = |_: f64, z: f64| (-1.0 + (z - 9.0).abs()).min(0.0);
+        let ramp = |x: f64, z: f64| -> f64 {
+            if z >= 18.0 {
+                (-1.0 + 0.2 * (x - 20.0)).clamp(-3.0, 0.0)
+            } else {
+                0.0
+            }
+        };
+        let knee = KneeForm {
+            triangle_side: 9.0,
+            radius: 3.0,
+            thickness: 120.0,
+        };
+        let fp = GridFootprint::new(&knee, 0.0, &spec);
+        let sf = SurfaceFootprint::new(&fp);
+        let rule = StrikeRule::default().with_level(Level::Surface);
+        let start = (40, 15);
+        let alone = HeightGrid::from_fn(spec, crest);
+        let t = trace(&SurfaceGrid::new(&alone), &sf, start, &rule);
+        assert_eq!(t.yr, -1.0);
+        assert!(t.strikes.is_empty(), "{:?}", t.strikes);
+        let both = HeightGrid::from_fn(spec, |x, z| crest(x, z).min(ramp(x, z)));
+        let t = trace(&SurfaceGrid::new(&both), &sf, start, &rule);
+        assert_eq!(t.yr, -1.0);
+        assert!(
+            t.strikes.iter().any(|&((_, j), _)| j >= 18),
+            "{:?}",
+            t.strikes
+        );
+        let resting: Vec<_> = t.strikes.iter().filter(|&&((_, j), _)| j == 9).collect();
+        assert!(!resting.is_empty(), "{:?}", t.strikes);
+        for &&((i, j), _) in &resting {
+            assert_eq!(both.at(i, j), t.yr, "the crest, at the pushed level");
+        }
+    }
 }
