@@ -216,12 +216,13 @@ impl Cells {
                             for fa in 0..=k {
                                 let y = mesh.at(k * i + fa, k * b + fb);
                                 let (fx, fz) = (fa as f64 / k as f64, fb as f64 / k as f64);
-                                let (x, z) = (mesh.spec.x(k * i + fa), mesh.spec.z(k * b + fb));
                                 let s = cell_surface(&grid.h, nx, (i, row), (fx, fz))
                                     .or_else(|| {
                                         // A corner off the part: on the
                                         // cell's edge, a neighbour's
                                         // surface may cover the mesh.
+                                        let (x, z) =
+                                            (mesh.spec.x(k * i + fa), mesh.spec.z(k * b + fb));
                                         y.is_finite().then(|| cells.surface_at(x, z)).flatten()
                                     })
                                     .unwrap_or(f64::INFINITY);
@@ -752,15 +753,20 @@ mod tests {
         assert!(on_node.above < 1e-9 && on_node.below < 1e-9, "{on_node:?}");
     }
 
+    /// A flat plate at y = 0 over x in [0, x_end], z in [0, 20], on the
+    /// 2 mm grid, with its cells' surface error measured.
+    fn flat_plate_ending_at(x_end: f64) -> (HeightGrid, Cells) {
+        let triangles = tessellate(&[0.0, 10.0, x_end], &[0.0, 10.0, 20.0], |_, _| 0.0);
+        let grid = at_pitch_two(&triangles);
+        let cells = Cells::of(&triangles, &grid, 10.0).with_surface_error(&triangles, &grid);
+        (grid, cells)
+    }
+
     #[test]
     fn the_surface_error_is_unbounded_where_the_grid_has_no_surface_over_the_mesh() {
         // The part ends at x = 21, between node columns 20 and 22: the
         // cell [20, 22] has a node off the part over mesh.
-        let xs = [0.0, 10.0, 21.0];
-        let zs = [0.0, 10.0, 20.0];
-        let triangles = tessellate(&xs, &zs, |_, _| 0.0);
-        let grid = at_pitch_two(&triangles);
-        let cells = Cells::of(&triangles, &grid, 10.0).with_surface_error(&triangles, &grid);
+        let (_, cells) = flat_plate_ending_at(21.0);
         let edge = cells.surface_error_near([20.8, 0.0, 7.0]).unwrap();
         assert_eq!(edge.above, f64::INFINITY);
         assert_eq!(edge.below, f64::INFINITY);
@@ -782,12 +788,8 @@ mod tests {
         // has nodes off the part, and mesh only on its edge x = 20, which
         // the surface of the cell [18, 20] covers (the wave's edge rows at
         // z = -150 on the lattice of every pitch that divides it).
-        let xs = [0.0, 10.0, 20.0];
-        let zs = [0.0, 10.0, 20.0];
-        let triangles = tessellate(&xs, &zs, |_, _| 0.0);
-        let grid = at_pitch_two(&triangles);
+        let (grid, cells) = flat_plate_ending_at(20.0);
         assert!(grid.h[10].is_finite() && grid.h[11].is_infinite());
-        let cells = Cells::of(&triangles, &grid, 10.0).with_surface_error(&triangles, &grid);
         // On the edge and within half a pitch of the cell beyond it: the
         // plane is read exactly, no error either way.
         for p in [[20.0, 0.0, 7.0], [19.5, 0.0, 7.0], [20.0, 0.0, 20.0]] {

@@ -812,9 +812,13 @@ impl<'a> LevelErrorBound<'a> {
     /// crease near the exact contact), and its deflection test passes
     /// only by the level error `W` back
     /// ([`LevelErrorBound::explains_drop`]).
-    pub fn explains(&self, h: f64, s: f64, sigma: f64, rule: ExactRule) -> bool {
-        self.clearance(h, s) <= self.deeper_at(s, rule) + LEVEL_TOL
-            && self.explains_drop(h, s, sigma, rule)
+    pub fn explains(&self, h: f64, s: f64, sigma: f64, rule: ExactRule) -> Explanation {
+        let (clearance, bound) = (self.clearance(h, s), self.deeper_at(s, rule));
+        Explanation {
+            clearance,
+            bound,
+            explained: clearance <= bound + LEVEL_TOL && self.explains_drop(h, s, sigma, rule),
+        }
     }
 
     /// How far a mesh point of height `h` met at travel `s` lies from
@@ -822,6 +826,17 @@ impl<'a> LevelErrorBound<'a> {
     pub fn clearance(&self, h: f64, s: f64) -> f64 {
         h - self.curve.at(s).value
     }
+}
+
+/// A grid strike against the level error ([`LevelErrorBound::explains`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Explanation {
+    /// How far its level lies from touching the exact knee-form (mm).
+    pub clearance: f64,
+    /// How much deeper than the exact level the grid's may lie there (mm).
+    pub bound: f64,
+    /// Whether the level error explains it.
+    pub explained: bool,
 }
 
 /// A clearance within its bound, up to rounding (mm).
@@ -936,10 +951,10 @@ pub(crate) fn compare(
             continue;
         }
         let explained = bound.as_ref().is_some_and(|b| {
-            let clearance = b.clearance(g.point[1], g.travel);
-            level_clearance.push(clearance);
-            level_bound.push(b.deeper_at(g.travel, rule));
-            b.explains(g.point[1], g.travel, band.sigma, rule)
+            let e = b.explains(g.point[1], g.travel, band.sigma, rule);
+            level_clearance.push(e.clearance);
+            level_bound.push(e.bound);
+            e.explained
         });
         if k == 0 {
             first_grid_explained = explained;
@@ -1204,15 +1219,15 @@ mod tests {
         // it strikes when its level 5 mm back lay more than 0.034 mm deeper
         // than the exact 10 mm, which the crease cut there allows (0.05)
         // and the node level's bound there does not (0.001).
-        assert!(!bound.explains(9.99, 10.0, sigma, node));
-        assert!(bound.explains(9.99, 10.0, sigma, surface));
+        assert!(!bound.explains(9.99, 10.0, sigma, node).explained);
+        assert!(bound.explains(9.99, 10.0, sigma, surface).explained);
         assert_eq!(bound.deeper_at(10.0, surface), 0.03);
         // 0.04 mm deeper at travel 10: more than the surface's error there.
-        assert!(!bound.explains(10.01, 10.0, sigma, surface));
+        assert!(!bound.explains(10.01, 10.0, sigma, surface).explained);
         // Without the crease cut 5 mm back, the drop is not explained.
         let mut flat = bound;
         flat.surface.as_mut().unwrap().0[0].above = 0.01;
-        assert!(!flat.explains(9.99, 10.0, sigma, surface));
+        assert!(!flat.explains(9.99, 10.0, sigma, surface).explained);
     }
 
     #[test]
