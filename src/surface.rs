@@ -37,19 +37,13 @@
 //!   only while its end witnesses are more than `p / 2` apart; midpoints are
 //!   applied in travel order, each fall of more than `e0` a contact;
 //! * **ties**: a contact that strikes marks, beside its witness, every
-//!   contact site of the outline at the same travel within `tau` of the
-//!   new level: each point whose value is within `tau` of the level and
-//!   lowest among its neighbours along the outline (below the one before,
-//!   at most the one after: one point per site, the first of a flat run).
-//!   SPEC says every outline point within `tau`; that marked runs of
-//!   neighbouring points at every step (README console, default
-//!   `verify`: 5,837 grid strikes a start against 286 at the node level,
-//!   decided area false alarm 50.4 mm; a SPEC change proposed). `tau` is
-//!   read at that point's own cell ([`SurfaceGrid::tau`]:
-//!   a quarter of the largest second difference there, at most `p / 4`).
-//!   SPEC reads `tau` at the witness's cell; read there, a crease's `tau`
-//!   would tie every point of a flat plate beside it within that much of
-//!   the level (a SPEC change proposed);
+//!   point of the leading outline at the same travel within `tau` of the
+//!   new level, `tau` read at the witness's cell ([`SurfaceGrid::tau`]: a
+//!   quarter of the largest second difference there, at most `p / 4`),
+//!   as SPEC says. (Until 2026-11-29 the engine marked one point per
+//!   contact site, within its own cell's `tau`: it missed the contact's
+//!   side of a crease between node columns, the README console's area
+//!   miss; `results/gate.md`.)
 //! * **strike**: SPEC's window rule on this level curve, through
 //!   [`StrikeRule::window_strikes`] with the new level as `h` (whatever the
 //!   rule's rate: the surface level has the window rule only);
@@ -62,8 +56,6 @@
 //! less `e0` (the level only falls), and the slide ends once such a bound
 //! of everything still ahead is. `tests/surface.rs` holds it equal to a
 //! brute force transcribed from SPEC that evaluates everything.
-
-use std::cmp::Ordering;
 
 use crate::grid::{HeightGrid, NODE_TOL};
 use crate::kneeform::GridFootprint;
@@ -108,9 +100,6 @@ pub(crate) struct SurfaceGrid<'a> {
     /// TALL` rows reads two overlapping windows of rows, not each row;
     /// empty unless [`SurfaceGrid::with_spans`].
     tall: Vec<Vec<f64>>,
-    /// The largest [`SurfaceGrid::tau`] per block of `COARSE x COARSE`
-    /// cells; empty unless [`SurfaceGrid::with_spans`].
-    taus: Vec<f64>,
 }
 
 impl<'a> SurfaceGrid<'a> {
@@ -139,7 +128,6 @@ impl<'a> SurfaceGrid<'a> {
             prefix,
             spans: Vec::new(),
             tall: Vec::new(),
-            taus: Vec::new(),
         }
     }
 
@@ -175,18 +163,6 @@ impl<'a> SurfaceGrid<'a> {
             })
             .collect();
         self.spans = spans;
-        let (nx, nz) = (self.grid.spec.nx, self.grid.spec.nz);
-        if nx >= 2 && nz >= 2 {
-            let tnx = (nx - 1).div_ceil(COARSE);
-            let mut taus = vec![0.0f64; tnx * (nz - 1).div_ceil(COARSE)];
-            for j in 0..nz - 1 {
-                for i in 0..nx - 1 {
-                    let t = &mut taus[(j / COARSE) * tnx + i / COARSE];
-                    *t = t.max(self.tau_cell(i, j));
-                }
-            }
-            self.taus = taus;
-        }
         self
     }
 
@@ -351,33 +327,6 @@ impl<'a> SurfaceGrid<'a> {
             }
         }
         below(least)
-    }
-
-    /// An upper bound of [`SurfaceGrid::tau`] at every cell in columns
-    /// `c_lo..=c_hi` and rows `w_lo..=w_hi` (grid units, as
-    /// [`SurfaceGrid::bound`] reads them): the largest `tau` of the
-    /// `COARSE x COARSE` blocks of cells holding them, or its cap where
-    /// the spans are not built.
-    #[inline]
-    pub fn tau_bound(&self, (c_lo, c_hi): (i64, i64), (w_lo, w_hi): (f64, f64)) -> f64 {
-        let cap = TAU_CAP * self.grid.spec.pitch;
-        let (nx, nz) = (self.grid.spec.nx as i64, self.grid.spec.nz as i64);
-        if self.taus.is_empty() || nx < 2 || nz < 2 {
-            return cap;
-        }
-        let (cells_x, cells_z) = (nx - 1, nz - 1);
-        let tnx = (cells_x as usize).div_ceil(COARSE);
-        let column = |c: i64| c.clamp(0, cells_x - 1) as usize / COARSE;
-        let row = |v: f64| floor(v.clamp(0.0, (cells_z - 1) as f64)) as usize / COARSE;
-        let (b_lo, b_hi) = (column(c_lo), column(c_hi));
-        let (r_lo, r_hi) = (row(w_lo), row(w_hi + 1.0));
-        let mut most = 0.0f64;
-        for r in r_lo..=r_hi {
-            for &t in &self.taus[r * tnx + b_lo..=r * tnx + b_hi] {
-                most = most.max(t);
-            }
-        }
-        most.min(cap)
     }
 
     /// [`SurfaceGrid::bound`] of every node in columns `0..=u_hi` and rows
@@ -592,8 +541,6 @@ struct Bounds {
     width: usize,
     /// `[run * width + column - lo]`, NaN where not read yet.
     table: Vec<f64>,
-    /// The same for [`SurfaceGrid::tau_bound`].
-    taus: Vec<f64>,
     /// Per run, its columns beyond the first ([`span`]).
     spans: Vec<i64>,
     /// The least bound of each group of [`GROUP`] runs by position on the
@@ -651,7 +598,6 @@ impl Bounds {
             lo,
             width,
             table: vec![f64::NAN; blocks.len() * width],
-            taus: vec![f64::NAN; blocks.len() * width],
             spans,
             groups: vec![f64::NAN; blocks.len().div_ceil(GROUP) * positions],
             per: blocks.len().div_ceil(GROUP),
@@ -661,7 +607,7 @@ impl Bounds {
     }
 
     /// The columns run `b`, its extent `e`, reads when the outline's
-    /// reference sits at `base`, and their slot in `table` and `taus`
+    /// reference sits at `base`, and their slot in `table`
     /// (`None` where the table does not keep them).
     #[inline]
     fn slot(&self, b: usize, e: &[f64; 4], base: f64) -> ((i64, i64), Option<usize>) {
@@ -680,16 +626,6 @@ impl Bounds {
         let (cols, n) = self.slot(b, e, base);
         kept(&mut self.table, n, || {
             sg.bound(cols, (j0 + e[2], j0 + e[3]))
-        })
-    }
-
-    /// [`SurfaceGrid::tau_bound`] over the cells run `b`, its extent
-    /// `e`, reads at `(base, j0)`.
-    #[inline]
-    fn tau(&mut self, sg: &SurfaceGrid, b: usize, e: &[f64; 4], (base, j0): (f64, f64)) -> f64 {
-        let (cols, n) = self.slot(b, e, base);
-        kept(&mut self.taus, n, || {
-            sg.tau_bound(cols, (j0 + e[2], j0 + e[3]))
         })
     }
 
@@ -738,25 +674,11 @@ struct Scratch {
     base: f64,
     /// Per run of [`BLOCK`] samples, whether `values` holds it.
     have: Vec<bool>,
-    /// Per run, how the tie scan reads it.
-    evaluated: Vec<Run>,
     /// Per leading sample, its cell row ([`SurfaceGrid::row_of`]) in the
     /// start row `rows_of`.
     rows: Vec<Option<(usize, f64)>>,
     /// The start row `rows` holds.
     rows_of: Option<f64>,
-}
-
-/// How the tie scan reads a run of the outline.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Run {
-    /// Its bound lies above `level + TAU_CAP p`: as `+inf`.
-    Above,
-    /// Below that, but above `level` plus its cells' largest `tau`: no
-    /// tie, its values read beside one.
-    Near,
-    /// Evaluated and scanned.
-    Scanned,
 }
 
 impl Scratch {
@@ -903,110 +825,39 @@ impl Slide<'_, '_> {
     }
 
     /// Marks the leading outline's points at travel `t` steps (`s` mm)
-    /// within `tau` of the new level `level`, beside the witness `at`.
-    ///
-    /// SPEC's scan reads every point, a run whose bound lies above
-    /// `reach = level + TAU_CAP p` as `+inf` (it holds no candidate and
-    /// lies above every candidate beside it). Only the runs that can hold
-    /// a tie are evaluated and scanned: bound at most `reach` and at most
-    /// `level` plus the largest `tau` of their cells (a point is a tie
-    /// only within its own cell's `tau` of the level); a neighbour in a
-    /// run not scanned is read as SPEC's scan reads it.
+    /// within `tau` of the new level `level`, beside the witness `at`:
+    /// SPEC v4's tie set, every outline point within the witness's cell's
+    /// `tau`. Only the runs whose bound lies within it are evaluated.
     fn ties(&mut self, t: f64, s: f64, level: f64, at: [f64; 2]) {
         let base = self.i0 - t / STEPS_PER_PITCH;
-        let reach = level + TAU_CAP * self.sf.pitch;
-        let (sg, j0) = (self.sg, self.j0);
-        let lead = &self.sf.lead;
-        self.scratch.at(self.sf, base);
-        self.scratch.rows_for(sg, self.sf, j0);
+        let (sg, sf, j0) = (self.sg, self.sf, self.j0);
+        let limit = level + sg.tau(at[0], at[1]);
+        self.scratch.at(sf, base);
+        self.scratch.rows_for(sg, sf, j0);
         let Scratch {
-            values,
-            have,
-            evaluated,
-            rows,
-            ..
+            values, have, rows, ..
         } = &mut self.scratch;
-        evaluated.clear();
-        let blocks = &self.sf.blocks;
-        let mut group_near = false;
-        for (b, (range, e)) in blocks.iter().enumerate() {
-            if b % GROUP == 0 {
-                let least = self.bounds.group(sg, blocks, b / GROUP, (base, j0));
-                group_near = least <= reach;
+        let blocks = &sf.blocks;
+        for g in 0..blocks.len().div_ceil(GROUP) {
+            if self.bounds.group(sg, blocks, g, (base, j0)) > limit {
+                continue;
             }
-            // A group's least bound above `reach` puts each of its runs'
-            // above it.
-            let bound = if group_near {
-                self.bounds.get(sg, b, e, (base, j0))
-            } else {
-                f64::INFINITY
-            };
-            let near = group_near && bound <= reach;
-            let on = near && bound <= level + self.bounds.tau(sg, b, e, (base, j0));
-            evaluated.push(match (near, on) {
-                (_, true) => Run::Scanned,
-                (true, false) => Run::Near,
-                _ => Run::Above,
-            });
-            if on && !have[b] {
+            for (b, (range, e)) in blocks.iter().enumerate().skip(g * GROUP).take(GROUP) {
+                if self.bounds.get(sg, b, e, (base, j0)) > limit {
+                    continue;
+                }
+                if !have[b] {
+                    for n in range.clone() {
+                        values[n] = sg.at_in(base + sf.lead[n][0], rows[n]);
+                    }
+                    have[b] = true;
+                }
                 for n in range.clone() {
-                    values[n] = sg.at_in(base + lead[n][0], rows[n]);
-                }
-                have[b] = true;
-            }
-        }
-        let (values, have, evaluated) = (&*values, &*have, &*evaluated);
-        // The value of point `n` as SPEC's scan reads it: `+inf` in a run
-        // above `reach` and off the outline.
-        let read = |n: usize| match evaluated.get(n / BLOCK) {
-            Some(Run::Scanned) => values[n],
-            Some(Run::Near) if have[n / BLOCK] => values[n],
-            Some(Run::Near) => {
-                let [du, dw] = lead[n];
-                sg.at(base + du, j0 + dw)
-            }
-            _ => f64::INFINITY,
-        };
-        for (range, _) in blocks
-            .iter()
-            .zip(evaluated.iter())
-            .filter_map(|(block, &run)| (run == Run::Scanned).then_some(block))
-        {
-            for n in range.clone() {
-                let value = values[n];
-                // `tau` is at most `TAU_CAP p`: a point above `reach` is no
-                // tie.
-                if value > reach || value.is_nan() {
-                    continue;
-                }
-                // A neighbour in the same run (scanned) is read from
-                // `values`, as `read` would; `after` only where `before`
-                // leaves the point a candidate.
-                let before = match n {
-                    0 => f64::INFINITY,
-                    _ if n % BLOCK != 0 => values[n - 1],
-                    _ => read(n - 1),
-                };
-                // One point per site: the first of a run of equal lowest
-                // values along the outline.
-                if !matches!(value.partial_cmp(&before), Some(Ordering::Less)) {
-                    continue;
-                }
-                let after = match n + 1 {
-                    next if next >= lead.len() => f64::INFINITY,
-                    next if next % BLOCK != 0 => values[next],
-                    next => read(next),
-                };
-                if !matches!(
-                    value.partial_cmp(&after),
-                    Some(Ordering::Less | Ordering::Equal)
-                ) {
-                    continue;
-                }
-                let [du, dw] = lead[n];
-                let here = [base + du, j0 + dw];
-                if here != at && value <= level + sg.tau(here[0], here[1]) {
-                    self.out.strikes.push((nearest(here), s));
+                    let [du, dw] = sf.lead[n];
+                    let here = [base + du, j0 + dw];
+                    if values[n] <= limit && here != at {
+                        self.out.strikes.push((nearest(here), s));
+                    }
                 }
             }
         }

@@ -712,10 +712,9 @@ pub fn surface_outline(knee: &KneeForm, angle_deg: f64, p: f64) -> [Vec<[f64; 2]
 /// no early end): the push over the whole outline and the nodes inside;
 /// steps of `p / 8` over the leading outline and the nodes met (a fall
 /// of more than `e0` a contact, a smaller one leaving the level); the
-/// bisection between witnesses more than `p / 2` apart; the tie set (each
-/// outline point within `tau` of the level that is lowest among its
-/// neighbours along the outline); the
-/// window rule on the level curve; the node nearest each struck witness.
+/// bisection between witnesses more than `p / 2` apart; the tie set
+/// (every outline point within the witness's cell's `tau` of the level);
+/// the window rule on the level curve; the node nearest each struck witness.
 /// The readings where SPEC leaves a choice are `kneeform`'s
 /// (`src/surface.rs`'s module comment). Returns the mask and the number
 /// of placed starts.
@@ -817,20 +816,11 @@ pub fn brute_force_surface(
                     .map_or(yr, |&(_, level)| level);
                 if back - value > sigma * window {
                     mask[nearest(at)] = 1;
-                    // One point per contact site: lowest among its
-                    // neighbours along the outline (the first of a flat
-                    // run).
-                    for (n, &(pv, pat)) in points.iter().enumerate() {
-                        let before = if n > 0 {
-                            points[n - 1].0
-                        } else {
-                            f64::INFINITY
-                        };
-                        let after = points.get(n + 1).map_or(f64::INFINITY, |q| q.0);
-                        if pv < before
-                            && pv <= after
-                            && pv <= value + surface_tau(grid, pat[0], pat[1])
-                        {
+                    // The tie set: every outline point within the
+                    // witness's cell's tau of the new level.
+                    let tau = surface_tau(grid, at[0], at[1]);
+                    for &(pv, pat) in points {
+                        if pv <= value + tau {
                             mask[nearest(pat)] = 1;
                         }
                     }
