@@ -1566,8 +1566,8 @@ mod tests {
     /// a crest along x (height -1 on row 9, under its bottom rim) at the
     /// pushed level -1, then its top rim meets a ramp rising towards it
     /// (rows 18 on): the ramp's contacts strike, and the crest's outline
-    /// point, lowest along the outline, `tau = p / 4` at the crease, is
-    /// within `tau` of each new level down to -1.25, so it is marked,
+    /// points lie within the witness's `tau` (`p / 4` at the ramp's
+    /// crease) of each new level down to -1.25, so they are marked,
     /// though its own drop over the window, `f(s - W) - h = -1 - -1`, is
     /// zero. Without the ramp nothing strikes. This is the angled
     /// features' 98-100 mm decided false alarm at every pitch (the
