@@ -713,8 +713,9 @@ pub fn surface_outline(knee: &KneeForm, angle_deg: f64, p: f64) -> [Vec<[f64; 2]
 /// steps of `p / 8` over the leading outline and the nodes met (a fall
 /// of more than `e0` a contact, a smaller one leaving the level); the
 /// bisection between witnesses more than `p / 2` apart; the tie set
-/// (every outline point within the witness's cell's `tau` of the level);
-/// the window rule on the level curve; the node nearest each struck witness.
+/// (every outline point within the witness's cell's `tau` of the level,
+/// each judged by the window rule on its own value); the window rule on
+/// the level curve; the node nearest each struck witness.
 /// The readings where SPEC leaves a choice are `kneeform`'s
 /// (`src/surface.rs`'s module comment). Returns the mask and the number
 /// of placed starts.
@@ -817,10 +818,11 @@ pub fn brute_force_surface(
                 if back - value > sigma * window {
                     mask[nearest(at)] = 1;
                     // The tie set: every outline point within the
-                    // witness's cell's tau of the new level.
+                    // witness's cell's tau of the new level, each judged
+                    // by the window rule on its own value.
                     let tau = surface_tau(grid, at[0], at[1]);
                     for &(pv, pat) in points {
-                        if pv <= value + tau {
+                        if pv <= value + tau && back - pv > sigma * window {
                             mask[nearest(pat)] = 1;
                         }
                     }
