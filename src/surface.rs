@@ -771,44 +771,61 @@ fn nearest(at: [f64; 2]) -> (usize, usize) {
     ((at[0] - 0.5).ceil() as usize, (at[1] - 0.5).ceil() as usize)
 }
 
+/// The leading outline of `sf` with its reference at `(base, j0)`, run
+/// by run, a group of runs or a run passed over where `skip` holds for its
+/// bound: `visit(value, at)` for each point of the runs read, in outline
+/// order, each run evaluated once per position (kept in `scratch`).
+#[inline(always)]
+fn scan_runs(
+    (sg, sf, (base, j0)): (&SurfaceGrid, &SurfaceFootprint, (f64, f64)),
+    (bounds, scratch): (&mut Bounds, &mut Scratch),
+    skip: impl Fn(f64) -> bool,
+    mut visit: impl FnMut(f64, [f64; 2]),
+) {
+    scratch.at(sf, base);
+    scratch.rows_for(sg, sf, j0);
+    let Scratch {
+        values, have, rows, ..
+    } = scratch;
+    let blocks = &sf.blocks;
+    for g in 0..blocks.len().div_ceil(GROUP) {
+        if skip(bounds.group(sg, blocks, g, (base, j0))) {
+            continue;
+        }
+        for (b, (range, e)) in blocks.iter().enumerate().skip(g * GROUP).take(GROUP) {
+            if skip(bounds.get(sg, b, e, (base, j0))) {
+                continue;
+            }
+            if !have[b] {
+                for n in range.clone() {
+                    values[n] = sg.at_in(base + sf.lead[n][0], rows[n]);
+                }
+                have[b] = true;
+            }
+            for n in range.clone() {
+                let [du, dw] = sf.lead[n];
+                visit(values[n], [base + du, j0 + dw]);
+            }
+        }
+    }
+}
+
 impl Slide<'_, '_> {
     /// The leading outline at travel `t` steps: its first lowest point
     /// below `limit`, skipping runs whose bound is at or above it.
     fn lowest_below(&mut self, t: f64, limit: f64) -> Lowest {
-        let base = self.i0 - t / STEPS_PER_PITCH;
         let mut lowest = Lowest(None);
-        let (sg, sf, j0) = (self.sg, self.sf, self.j0);
-        self.scratch.at(sf, base);
-        self.scratch.rows_for(sg, sf, j0);
-        let Scratch {
-            values, have, rows, ..
-        } = &mut self.scratch;
-        let blocks = &sf.blocks;
-        for g in 0..blocks.len().div_ceil(GROUP) {
-            if self.bounds.group(sg, blocks, g, (base, j0)) >= limit {
-                continue;
-            }
-            for (b, (range, e)) in blocks.iter().enumerate().skip(g * GROUP).take(GROUP) {
-                if self.bounds.get(sg, b, e, (base, j0)) >= limit {
-                    continue;
+        let position = (self.i0 - t / STEPS_PER_PITCH, self.j0);
+        scan_runs(
+            (self.sg, self.sf, position),
+            (&mut self.bounds, &mut self.scratch),
+            |bound| bound >= limit,
+            |value, at| {
+                if value < limit {
+                    lowest.take(value, at);
                 }
-                let held = have[b];
-                for n in range.clone() {
-                    let value = if held {
-                        values[n]
-                    } else {
-                        let value = sg.at_in(base + sf.lead[n][0], rows[n]);
-                        values[n] = value;
-                        value
-                    };
-                    if value < limit {
-                        let [du, dw] = sf.lead[n];
-                        lowest.take(value, [base + du, j0 + dw]);
-                    }
-                }
-                have[b] = true;
-            }
-        }
+            },
+        );
         lowest
     }
 
@@ -853,39 +870,19 @@ impl Slide<'_, '_> {
     /// evaluated.
     fn ties(&mut self, t: f64, s: f64, struck: Struck) {
         let Struck { level, at, earlier } = struck;
-        let base = self.i0 - t / STEPS_PER_PITCH;
-        let (sg, sf, j0) = (self.sg, self.sf, self.j0);
-        let limit = level + sg.tau(at[0], at[1]);
-        self.scratch.at(sf, base);
-        self.scratch.rows_for(sg, sf, j0);
-        let Scratch {
-            values, have, rows, ..
-        } = &mut self.scratch;
-        let blocks = &sf.blocks;
-        for g in 0..blocks.len().div_ceil(GROUP) {
-            if self.bounds.group(sg, blocks, g, (base, j0)) > limit {
-                continue;
-            }
-            for (b, (range, e)) in blocks.iter().enumerate().skip(g * GROUP).take(GROUP) {
-                if self.bounds.get(sg, b, e, (base, j0)) > limit {
-                    continue;
+        let limit = level + self.sg.tau(at[0], at[1]);
+        let (rule, strikes) = (self.rule, &mut self.out.strikes);
+        let position = (self.i0 - t / STEPS_PER_PITCH, self.j0);
+        scan_runs(
+            (self.sg, self.sf, position),
+            (&mut self.bounds, &mut self.scratch),
+            |bound| bound > limit,
+            |v, here| {
+                if v <= limit && here != at && rule.window_strikes(v, earlier) {
+                    strikes.push((nearest(here), s));
                 }
-                if !have[b] {
-                    for n in range.clone() {
-                        values[n] = sg.at_in(base + sf.lead[n][0], rows[n]);
-                    }
-                    have[b] = true;
-                }
-                for n in range.clone() {
-                    let [du, dw] = sf.lead[n];
-                    let here = [base + du, j0 + dw];
-                    let v = values[n];
-                    if v <= limit && here != at && self.rule.window_strikes(v, earlier) {
-                        self.out.strikes.push((nearest(here), s));
-                    }
-                }
-            }
-        }
+            },
+        );
     }
 
     /// SPEC v4's bisection of the travel between `lo` and `hi` steps, the
