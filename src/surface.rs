@@ -876,7 +876,9 @@ impl Slide<'_, '_> {
         scan_runs(
             (self.sg, self.sf, position),
             (&mut self.bounds, &mut self.scratch),
-            |bound| bound > limit,
+            // A run whose bound fails either test holds no tie: both are
+            // monotone in the value (a float subtraction is).
+            |bound| bound > limit || !rule.window_strikes(bound, earlier),
             |v, here| {
                 if v <= limit && here != at && rule.window_strikes(v, earlier) {
                     strikes.push((nearest(here), s));
