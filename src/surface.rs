@@ -866,8 +866,8 @@ impl Slide<'_, '_> {
     /// v4's tie set, every outline point within the witness's cell's `tau`
     /// of the new level, each judged by the window rule on its own value
     /// `v`, `f(s - W) - v > sigma W` (a proposed SPEC reading: see the
-    /// module comment). Only the runs whose bound lies within `tau` are
-    /// evaluated.
+    /// module comment). Only the runs whose bound lies within `tau` and
+    /// passes the window test are evaluated.
     fn ties(&mut self, t: f64, s: f64, struck: Struck) {
         let Struck { level, at, earlier } = struck;
         let limit = level + self.sg.tau(at[0], at[1]);
