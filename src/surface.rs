@@ -509,11 +509,28 @@ fn refine(
 pub(crate) struct SurfaceTrace {
     /// The pushed level (mm), `+inf` when not placed.
     pub yr: f64,
-    /// Each struck node `(i, j)` with the travel (mm) of its strike, in
-    /// travel order (a node may recur).
-    pub strikes: Vec<((usize, usize), f64)>,
+    /// Each strike, in travel order (a node may recur).
+    pub strikes: Vec<SurfaceStrike>,
     /// `(travel, level)` after each evaluation that lowered the level.
     pub levels: Vec<(f64, f64)>,
+}
+
+/// One strike of a [`SurfaceTrace`]: the node nearest its witness, and
+/// what the window rule judged there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SurfaceStrike {
+    /// The node `(i, j)` nearest the witness.
+    pub node: (usize, usize),
+    /// The travel of the strike (mm).
+    pub travel: f64,
+    /// The surface's value at the witness (mm): the new level for the
+    /// contact's own witness, the tie's own value (within `slack` above
+    /// the level) for a tie.
+    pub value: f64,
+    /// How far above the new level a witness could be and still count
+    /// (mm): 0 for the contact's witness, the witness cell's `tau` for a
+    /// tie.
+    pub slack: f64,
 }
 
 /// A point evaluated: its value and where it is (grid units).
@@ -851,7 +868,12 @@ impl Slide<'_, '_> {
             // marked the same nodes (ties read the position, the level, the
             // witness and the level over the window behind only).
             if self.prior != Some(struck) {
-                self.out.strikes.push((nearest(at), s));
+                self.out.strikes.push(SurfaceStrike {
+                    node: nearest(at),
+                    travel: s,
+                    value,
+                    slack: 0.0,
+                });
                 self.ties(t, s, struck);
             }
         }
@@ -870,7 +892,8 @@ impl Slide<'_, '_> {
     /// passes the window test are evaluated.
     fn ties(&mut self, t: f64, s: f64, struck: Struck) {
         let Struck { level, at, earlier } = struck;
-        let limit = level + self.sg.tau(at[0], at[1]);
+        let tau = self.sg.tau(at[0], at[1]);
+        let limit = level + tau;
         let (rule, strikes) = (self.rule, &mut self.out.strikes);
         let position = (self.i0 - t / STEPS_PER_PITCH, self.j0);
         scan_runs(
@@ -881,7 +904,12 @@ impl Slide<'_, '_> {
             |bound| bound > limit || !rule.window_strikes(bound, earlier),
             |v, here| {
                 if v <= limit && here != at && rule.window_strikes(v, earlier) {
-                    strikes.push((nearest(here), s));
+                    strikes.push(SurfaceStrike {
+                        node: nearest(here),
+                        travel: s,
+                        value: v,
+                        slack: tau,
+                    });
                 }
             },
         );
@@ -943,7 +971,7 @@ pub(crate) fn trace_row(
         trail.windows.lowest = windows.advance(sg.grid, i0);
         let trace = slide_start(sg, sf, (i0, j0), rule, Some(&mut trail));
         placed += usize::from(trace.yr.is_finite());
-        for ((i, j), _) in trace.strikes {
+        for SurfaceStrike { node: (i, j), .. } in trace.strikes {
             mask[j * nx + i] = 1;
         }
     }
@@ -1554,7 +1582,7 @@ mod tests {
                 for i0 in 0..spec.nx {
                     let t = trace(&sg, &sf, (i0, j0), &rule);
                     placed += usize::from(t.yr.is_finite());
-                    for ((i, j), _) in t.strikes {
+                    for SurfaceStrike { node: (i, j), .. } in t.strikes {
                         want[j * spec.nx + i] = 1;
                     }
                 }
@@ -1566,7 +1594,7 @@ mod tests {
                     trail.windows.lowest = windows.advance(&grid, i0);
                     let t = slide_start(&sg, &sf, (i0, j0), &rule, Some(&mut trail));
                     got_placed += usize::from(t.yr.is_finite());
-                    for ((i, j), _) in t.strikes {
+                    for SurfaceStrike { node: (i, j), .. } in t.strikes {
                         got[j * spec.nx + i] = 1;
                     }
                 }
@@ -1623,11 +1651,7 @@ mod tests {
         let both = HeightGrid::from_fn(spec, |x, z| crest(x, z).min(ramp(x, z)));
         let t = trace(&SurfaceGrid::new(&both), &sf, start, &rule);
         assert_eq!(t.yr, -1.0);
-        assert!(
-            t.strikes.iter().any(|&((_, j), _)| j >= 18),
-            "{:?}",
-            t.strikes
-        );
+        assert!(t.strikes.iter().any(|t| t.node.1 >= 18), "{:?}", t.strikes);
         // The crest's nodes on row 9 lie within the witness's `tau` of
         // the level (the precondition of a tie) and are not marked.
         assert!(
@@ -1635,10 +1659,6 @@ mod tests {
             "{:?}",
             t.levels
         );
-        assert!(
-            t.strikes.iter().all(|&((_, j), _)| j != 9),
-            "{:?}",
-            t.strikes
-        );
+        assert!(t.strikes.iter().all(|t| t.node.1 != 9), "{:?}", t.strikes);
     }
 }

@@ -803,17 +803,25 @@ impl<'a> LevelErrorBound<'a> {
         }
     }
 
-    /// Whether a grid strike whose new level is `h` (the node's height, or
-    /// under the surface level the surface's at its witness), at travel
-    /// `s`, is the level error's: its level lies within
-    /// [`LevelErrorBound::deeper_at`] of the exact knee-form's there (a
-    /// node poking through the exact level by no more than that; under
-    /// the surface level, the grid's level cut that much deeper at a
-    /// crease near the exact contact), and its deflection test passes
-    /// only by the level error `W` back
-    /// ([`LevelErrorBound::explains_drop`]).
-    pub fn explains(&self, h: f64, s: f64, sigma: f64, rule: ExactRule) -> Explanation {
-        let (clearance, bound) = (self.clearance(h, s), self.deeper_at(s, rule));
+    /// Whether a grid strike that judged the value `h` (the node's height;
+    /// under the surface level the surface's value at its witness: the
+    /// new level, or a tie's own value at most `slack` above it), at
+    /// travel `s`, is the level error's: `h` lies within
+    /// [`LevelErrorBound::deeper_at`] plus `slack` of the exact
+    /// knee-form's level there (a node poking through the exact level by
+    /// no more than that; under the surface level, the grid's level cut
+    /// that much deeper at a crease near the exact contact, a tie that
+    /// much above it: SPEC v4's tie set marks every outline point within
+    /// `tau` of the new level), and its deflection test passes only by the
+    /// level error `W` back ([`LevelErrorBound::explains_drop`]).
+    pub fn explains(
+        &self,
+        (h, slack): (f64, f64),
+        s: f64,
+        sigma: f64,
+        rule: ExactRule,
+    ) -> Explanation {
+        let (clearance, bound) = (self.clearance(h, s), self.deeper_at(s, rule) + slack);
         Explanation {
             clearance,
             bound,
@@ -951,7 +959,7 @@ pub(crate) fn compare(
             continue;
         }
         let explained = bound.as_ref().is_some_and(|b| {
-            let e = b.explains(g.point[1], g.travel, band.sigma, rule);
+            let e = b.explains((g.value, g.slack), g.travel, band.sigma, rule);
             level_clearance.push(e.clearance);
             level_bound.push(e.bound);
             e.explained
@@ -1219,15 +1227,27 @@ mod tests {
         // it strikes when its level 5 mm back lay more than 0.034 mm deeper
         // than the exact 10 mm, which the crease cut there allows (0.05)
         // and the node level's bound there does not (0.001).
-        assert!(!bound.explains(9.99, 10.0, sigma, node).explained);
-        assert!(bound.explains(9.99, 10.0, sigma, surface).explained);
+        assert!(!bound.explains((9.99, 0.0), 10.0, sigma, node).explained);
+        assert!(bound.explains((9.99, 0.0), 10.0, sigma, surface).explained);
         assert_eq!(bound.deeper_at(10.0, surface), 0.03);
         // 0.04 mm deeper at travel 10: more than the surface's error there.
-        assert!(!bound.explains(10.01, 10.0, sigma, surface).explained);
+        assert!(!bound.explains((10.01, 0.0), 10.0, sigma, surface).explained);
         // Without the crease cut 5 mm back, the drop is not explained.
         let mut flat = bound;
         flat.surface.as_mut().unwrap().0[0].above = 0.01;
-        assert!(!flat.explains(9.99, 10.0, sigma, surface).explained);
+        assert!(!flat.explains((9.99, 0.0), 10.0, sigma, surface).explained);
+        // A tie 0.04 mm above the exact level at travel 10, its drop
+        // explained by a deeper cut 5 mm back (0.1 mm): beyond the
+        // surface's error there (0.03) as a witness, within it and the
+        // tie's slack (0.02) as a tie.
+        let mut deep = flat;
+        deep.surface.as_mut().unwrap().0[0].above = 0.1;
+        assert!(!deep.explains((10.01, 0.0), 10.0, sigma, surface).explained);
+        let tie = deep.explains((10.01, 0.02), 10.0, sigma, surface);
+        assert!(tie.explained, "{tie:?}");
+        assert!((tie.bound - 0.05).abs() < 1e-12, "{tie:?}");
+        // The node level has no ties: its slack is 0, and its bound holds.
+        assert!(!deep.explains((10.01, 0.0), 10.0, sigma, node).explained);
     }
 
     #[test]

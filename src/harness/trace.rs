@@ -36,6 +36,13 @@ pub(crate) struct GridContact {
     pub point: [f64; 3],
     /// Distance (mm) the knee-form travelled in -x when it met the node.
     pub travel: f64,
+    /// The value the strike rule judged (mm): the node's height under the
+    /// node level; under the surface level the surface's value at the
+    /// witness (the new level, or a tie's own value).
+    pub value: f64,
+    /// How far above the grid's new level `value` may lie (mm): 0, or
+    /// under the surface level a tie's `tau` (SPEC v4's tie set).
+    pub slack: f64,
 }
 
 /// The grid's push and slide of one start.
@@ -288,6 +295,8 @@ fn slide(
                     node: (i, j),
                     point: [spec.x(i), hv, spec.z(j)],
                     travel: d,
+                    value: hv,
+                    slack: 0.0,
                 });
             }
             gmin = gmin.min(hv);
@@ -305,7 +314,11 @@ fn slide(
 /// [`slide`] under the surface level (SPEC v4): [`crate::surface::trace`]
 /// alone, with no fault and no neighbour joined (its bisections follow the
 /// start's own contacts, so two starts' curves need not agree once they
-/// meet), each strike at the node nearest its witness.
+/// meet), each strike at the node nearest its witness with the value the
+/// rule judged there. A node struck again at the same travel (several
+/// outline points of one tie set nearest it) is kept once, with the
+/// lowest of its values less their slack: the strike the level error
+/// explains most readily stands for them all (the mask is the same).
 fn surface_slide(
     grid: &HeightGrid,
     fp: &GridFootprint,
@@ -316,17 +329,33 @@ fn surface_slide(
     let spec = grid.spec;
     let surface = SurfaceGrid::new(grid);
     let trace = crate::surface::trace(&surface, &SurfaceFootprint::new(fp), (i0, j0), rule);
+    let mut colliding: Vec<GridContact> = trace
+        .strikes
+        .iter()
+        .map(|t| GridContact {
+            node: t.node,
+            point: [
+                spec.x(t.node.0),
+                grid.at(t.node.0, t.node.1),
+                spec.z(t.node.1),
+            ],
+            travel: t.travel,
+            value: t.value,
+            slack: t.slack,
+        })
+        .collect();
+    // By travel (the order they came in), then by node, each kept once.
+    let floor = |c: &GridContact| c.value - c.slack;
+    colliding.sort_by(|a, b| {
+        (a.travel.total_cmp(&b.travel))
+            .then(a.node.1.cmp(&b.node.1))
+            .then(a.node.0.cmp(&b.node.0))
+            .then(floor(a).total_cmp(&floor(b)))
+    });
+    colliding.dedup_by(|later, kept| later.travel == kept.travel && later.node == kept.node);
     GridTrace {
         yr: trace.yr,
-        colliding: trace
-            .strikes
-            .iter()
-            .map(|&((i, j), travel)| GridContact {
-                node: (i, j),
-                point: [spec.x(i), grid.at(i, j), spec.z(j)],
-                travel,
-            })
-            .collect(),
+        colliding,
         push_rows,
         levels: trace.levels,
     }
@@ -557,6 +586,67 @@ mod tests {
             );
             assert_ne!(node[0].mask, union, "angle {angle}");
         }
+    }
+
+    /// Under the surface level each strike carries the value the window
+    /// rule judged: the new level at the contact's own witness, a tie's
+    /// value at most its slack above it; never the node's own height
+    /// where the surface between nodes set it. Each node is struck once
+    /// per travel.
+    #[test]
+    fn surface_strikes_carry_the_judged_value_once_per_node_and_travel() {
+        let spec = GridSpec {
+            pitch: 2.0,
+            i_origin: -10,
+            j_origin: -5,
+            nx: 50,
+            nz: 24,
+        };
+        let grid = HeightGrid::from_fn(spec, |x, z| {
+            0.15 * x + 4.0 * (0.11 * x).sin() * (0.07 * z).cos()
+        });
+        let knee = KneeForm {
+            triangle_side: 20.0,
+            radius: 6.0,
+            thickness: 100.0,
+        };
+        let rule = StrikeRule::default().with_level(Level::Surface);
+        let (mut strikes, mut ties, mut off_node) = (0, 0, 0);
+        for angle in [-30.0, 12.0] {
+            let fp = GridFootprint::new(&knee, angle, &spec);
+            for j0 in 0..spec.nz {
+                for i0 in 0..spec.nx {
+                    let t = grid_trace(&grid, &fp, i0, j0, &rule, None);
+                    for (k, c) in t.colliding.iter().enumerate() {
+                        // The level after the evaluation at the strike's travel.
+                        let level = t
+                            .levels
+                            .iter()
+                            .rev()
+                            .find(|l| l.0 <= c.travel)
+                            .map(|l| l.1)
+                            .unwrap();
+                        assert!(
+                            level <= c.value && c.value <= level + c.slack,
+                            "start ({i0}, {j0}) angle {angle}: {c:?} at level {level}"
+                        );
+                        assert!(
+                            !t.colliding[..k]
+                                .iter()
+                                .any(|e| e.travel == c.travel && e.node == c.node),
+                            "{c:?} twice"
+                        );
+                        strikes += 1;
+                        ties += usize::from(c.slack > 0.0);
+                        off_node += usize::from((c.value - c.point[1]).abs() > 1e-9);
+                    }
+                }
+            }
+        }
+        assert!(
+            strikes > 100 && ties > 0 && off_node > 0,
+            "{strikes} {ties} {off_node}"
+        );
     }
 
     /// A start's trace joined to its -x neighbour's is its trace alone, to
