@@ -488,6 +488,53 @@ pub fn pdf_pages(page: &std::path::Path, dir: &std::path::Path) -> Option<usize>
     Some(pages)
 }
 
+/// How wide the page `page` lays out on a screen `width` px wide, and
+/// that width (px), measured in headless Chromium: the document's
+/// `scrollWidth` beyond the window's is a horizontal scrollbar the reader
+/// must use. `None` when Chromium is not installed ([`headless`]).
+pub fn screen_width(
+    page: &std::path::Path,
+    dir: &std::path::Path,
+    width: u32,
+) -> Option<(u32, u32)> {
+    let html = std::fs::read_to_string(page).expect("the page");
+    let probe = html.replacen(
+        "</head>",
+        "<script>
+addEventListener('load', () => {
+  const out = document.createElement('pre');
+  out.id = 'screen-width';
+  out.textContent = 'measured ' + document.documentElement.scrollWidth + ' ' + window.innerWidth;
+  document.body.appendChild(out);
+});
+</script></head>",
+        1,
+    );
+    let probe_path = dir.join("screen-probe.html");
+    std::fs::write(&probe_path, probe).unwrap();
+    let args = [
+        "--hide-scrollbars".to_string(),
+        format!("--window-size={width},1600"),
+        "--virtual-time-budget=5000".to_string(),
+        "--dump-dom".to_string(),
+    ];
+    let out = headless(&probe_path, dir, "screen width check", &args)?;
+    let dom = String::from_utf8_lossy(&out.stdout);
+    let start = dom
+        .find("<pre id=\"screen-width\">measured ")
+        .unwrap_or_else(|| {
+            panic!(
+                "the probe did not run: {}",
+                String::from_utf8_lossy(&out.stderr)
+            )
+        });
+    let rest = &dom[start + "<pre id=\"screen-width\">measured ".len()..];
+    let mut numbers = rest[..rest.find("</pre>").expect("the probe's end")]
+        .split(' ')
+        .map(|n| n.parse::<u32>().expect("a width"));
+    Some((numbers.next().unwrap(), numbers.next().unwrap()))
+}
+
 /// The tables of the page `page` wider than the printed page: the page's
 /// print stylesheet applied on screen (`@media print` read as `@media
 /// all`) with the body as wide as an A4 portrait page's text (186 mm:
@@ -503,7 +550,12 @@ pub fn tables_wider_than_print(
         html.contains("@media print"),
         "the page has no print stylesheet"
     );
-    let probe = html.replace("@media print", "@media all").replacen(
+    // The screen-only rules off: they would hold a wide table in a box of
+    // its own, hiding what print lays out.
+    let probe = html
+        .replace("@media print", "@media all")
+        .replace("@media screen", "@media not all")
+        .replacen(
         "</head>",
         "<style>body { width: 186mm !important; max-width: none !important; }</style>
 <script>

@@ -173,6 +173,11 @@ code, .mono { font-family: 'DejaVu Sans Mono', monospace; font-size: 12px; word-
 footer { margin-top: 32px; font-size: 11px; color: #555; border-top: 1px solid #999; padding-top: 4px; }
 * { -webkit-print-color-adjust: exact; print-color-adjust: exact; }
 table.csv-print { display: none; }
+/* On screen a wide table (verify.csv's 27 columns) scrolls in its own box, not the page. */
+@media screen {
+  table.csv { display: block; overflow-x: auto; max-width: 100%; }
+  table.csv caption { text-align: left; position: sticky; left: 0; max-width: 1150px; }
+}
 @page { size: A4; margin: 12mm; }
 @media print {
   table.metrics { width: 100%; max-width: 100%; }
