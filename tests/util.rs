@@ -498,41 +498,62 @@ pub fn screen_width(
     width: u32,
 ) -> Option<(u32, u32)> {
     let html = std::fs::read_to_string(page).expect("the page");
-    let probe = html.replacen(
-        "</head>",
-        "<script>
+    let script = "<script>
 addEventListener('load', () => {
   const out = document.createElement('pre');
   out.id = 'screen-width';
   out.textContent = 'measured ' + document.documentElement.scrollWidth + ' ' + window.innerWidth;
   document.body.appendChild(out);
 });
-</script></head>",
-        1,
-    );
-    let probe_path = dir.join("screen-probe.html");
-    std::fs::write(&probe_path, probe).unwrap();
-    let args = [
+</script>";
+    let flags = [
         "--hide-scrollbars".to_string(),
         format!("--window-size={width},1600"),
-        "--virtual-time-budget=5000".to_string(),
-        "--dump-dom".to_string(),
     ];
-    let out = headless(&probe_path, dir, "screen width check", &args)?;
-    let dom = String::from_utf8_lossy(&out.stdout);
-    let start = dom
-        .find("<pre id=\"screen-width\">measured ")
-        .unwrap_or_else(|| {
-            panic!(
-                "the probe did not run: {}",
-                String::from_utf8_lossy(&out.stderr)
-            )
-        });
-    let rest = &dom[start + "<pre id=\"screen-width\">measured ".len()..];
-    let mut numbers = rest[..rest.find("</pre>").expect("the probe's end")]
-        .split(' ')
+    let text = probe(
+        &html,
+        script,
+        (dir, "screen-probe.html", "screen width check"),
+        "screen-width",
+        &flags,
+    )?;
+    let mut numbers = text
+        .split_whitespace()
         .map(|n| n.parse::<u32>().expect("a width"));
     Some((numbers.next().unwrap(), numbers.next().unwrap()))
+}
+
+/// The page `html` with `head` added to its head, written to `name` in
+/// `dir` and loaded in headless Chromium (`flags` beside the virtual time
+/// and the DOM dump; `what` names the check): the text its script wrote
+/// after `measured` into `<pre id="ID">`, `ID` being `id`. `None` when
+/// Chromium is not installed ([`headless`]).
+fn probe(
+    html: &str,
+    head: &str,
+    (dir, name, what): (&std::path::Path, &str, &str),
+    id: &str,
+    flags: &[String],
+) -> Option<String> {
+    let page = html.replacen("</head>", &format!("{head}</head>"), 1);
+    let path = dir.join(name);
+    std::fs::write(&path, page).unwrap();
+    let mut args = flags.to_vec();
+    args.extend([
+        "--virtual-time-budget=5000".to_string(),
+        "--dump-dom".to_string(),
+    ]);
+    let out = headless(&path, dir, what, &args)?;
+    let dom = String::from_utf8_lossy(&out.stdout);
+    let marker = format!("<pre id=\"{id}\">measured");
+    let start = dom.find(&marker).unwrap_or_else(|| {
+        panic!(
+            "the probe did not run: {}",
+            String::from_utf8_lossy(&out.stderr)
+        )
+    });
+    let rest = &dom[start + marker.len()..];
+    Some(rest[..rest.find("</pre>").expect("the probe's end")].to_string())
 }
 
 /// The tables of the page `page` wider than the printed page: the page's
@@ -552,12 +573,10 @@ pub fn tables_wider_than_print(
     );
     // The screen-only rules off: they would hold a wide table in a box of
     // its own, hiding what print lays out.
-    let probe = html
+    let html = html
         .replace("@media print", "@media all")
-        .replace("@media screen", "@media not all")
-        .replacen(
-        "</head>",
-        "<style>body { width: 186mm !important; max-width: none !important; }</style>
+        .replace("@media screen", "@media not all");
+    let head = "<style>body { width: 186mm !important; max-width: none !important; }</style>
 <script>
 addEventListener('load', () => {
   const body = document.body.getBoundingClientRect();
@@ -573,27 +592,14 @@ addEventListener('load', () => {
   out.textContent = 'measured\\n' + over.join('\\n');
   document.body.appendChild(out);
 });
-</script></head>",
-        1,
-    );
-    let probe_path = dir.join("print-probe.html");
-    std::fs::write(&probe_path, probe).unwrap();
-    let args = [
-        "--virtual-time-budget=5000".to_string(),
-        "--dump-dom".to_string(),
-    ];
-    let out = headless(&probe_path, dir, "print width check", &args)?;
-    let dom = String::from_utf8_lossy(&out.stdout);
-    let start = dom
-        .find("<pre id=\"print-overflow\">measured")
-        .unwrap_or_else(|| {
-            panic!(
-                "the probe did not run: {}",
-                String::from_utf8_lossy(&out.stderr)
-            )
-        });
-    let rest = &dom[start..];
-    let text = &rest[..rest.find("</pre>").expect("the probe's end")];
+</script>";
+    let text = probe(
+        &html,
+        head,
+        (dir, "print-probe.html", "print width check"),
+        "print-overflow",
+        &[],
+    )?;
     Some(text.lines().skip(1).map(str::to_string).collect())
 }
 

@@ -953,7 +953,7 @@ pub(crate) fn compare(
     let mut level_bound = Vec::new();
     let mut first_grid_explained = false;
     for (k, g) in grid.colliding.iter().enumerate() {
-        let p = xz(g.point);
+        let p = g.point;
         if is_blind(g.travel) {
             grid_blind.push(p);
             continue;
@@ -1003,7 +1003,7 @@ pub(crate) fn compare(
         .map(|&(k, _)| brief(&exact.contacts, k, cells.pitch()))
         .collect();
     let pts = StartPoints {
-        grid: grid.colliding.iter().map(|c| xz(c.point)).collect(),
+        grid: grid.colliding.iter().map(|c| c.point).collect(),
         grid_decided,
         grid_unexplained,
         grid_blind,

@@ -32,8 +32,8 @@ pub(crate) enum Fault {
 pub(crate) struct GridContact {
     /// Column and row of the node.
     pub node: (usize, usize),
-    /// The node as a point: `(x, h, z)` in mm, analysis frame.
-    pub point: [f64; 3],
+    /// The node in xz (mm, analysis frame): where the strike is counted.
+    pub point: [f64; 2],
     /// Distance (mm) the knee-form travelled in -x when it met the node.
     pub travel: f64,
     /// The value the strike rule judged (mm): the node's height under the
@@ -293,7 +293,7 @@ fn slide(
             if rule.strikes(met) {
                 trace.colliding.push(GridContact {
                     node: (i, j),
-                    point: [spec.x(i), hv, spec.z(j)],
+                    point: [spec.x(i), spec.z(j)],
                     travel: d,
                     value: hv,
                     slack: 0.0,
@@ -334,11 +334,7 @@ fn surface_slide(
         .iter()
         .map(|t| GridContact {
             node: t.node,
-            point: [
-                spec.x(t.node.0),
-                grid.at(t.node.0, t.node.1),
-                spec.z(t.node.1),
-            ],
+            point: [spec.x(t.node.0), spec.z(t.node.1)],
             travel: t.travel,
             value: t.value,
             slack: t.slack,
@@ -541,10 +537,9 @@ mod tests {
         }
     }
 
-    /// Under the surface level too, the union of the per-start traces is
-    /// the engine's mask, and it is not the node level's.
-    #[test]
-    fn union_of_surface_start_traces_is_the_engine_mask() {
+    /// A wavy slope at 2 mm and a small knee-form: the surface level's
+    /// traces strike, tie and differ from the node level's on it.
+    fn wavy_surface_case() -> (GridSpec, HeightGrid, KneeForm) {
         let spec = GridSpec {
             pitch: 2.0,
             i_origin: -10,
@@ -560,6 +555,14 @@ mod tests {
             radius: 6.0,
             thickness: 100.0,
         };
+        (spec, grid, knee)
+    }
+
+    /// Under the surface level too, the union of the per-start traces is
+    /// the engine's mask, and it is not the node level's.
+    #[test]
+    fn union_of_surface_start_traces_is_the_engine_mask() {
+        let (spec, grid, knee) = wavy_surface_case();
         let rule = StrikeRule::default().with_level(Level::Surface);
         for angle in [-30.0, 12.0] {
             let fp = GridFootprint::new(&knee, angle, &spec);
@@ -595,21 +598,7 @@ mod tests {
     /// per travel.
     #[test]
     fn surface_strikes_carry_the_judged_value_once_per_node_and_travel() {
-        let spec = GridSpec {
-            pitch: 2.0,
-            i_origin: -10,
-            j_origin: -5,
-            nx: 50,
-            nz: 24,
-        };
-        let grid = HeightGrid::from_fn(spec, |x, z| {
-            0.15 * x + 4.0 * (0.11 * x).sin() * (0.07 * z).cos()
-        });
-        let knee = KneeForm {
-            triangle_side: 20.0,
-            radius: 6.0,
-            thickness: 100.0,
-        };
+        let (spec, grid, knee) = wavy_surface_case();
         let rule = StrikeRule::default().with_level(Level::Surface);
         let (mut strikes, mut ties, mut off_node) = (0, 0, 0);
         for angle in [-30.0, 12.0] {
@@ -638,7 +627,8 @@ mod tests {
                         );
                         strikes += 1;
                         ties += usize::from(c.slack > 0.0);
-                        off_node += usize::from((c.value - c.point[1]).abs() > 1e-9);
+                        off_node +=
+                            usize::from((c.value - grid.at(c.node.0, c.node.1)).abs() > 1e-9);
                     }
                 }
             }
